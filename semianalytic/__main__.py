@@ -1,0 +1,5 @@
+import sys
+
+from semianalytic.cli import main
+
+sys.exit(main())

@@ -1,0 +1,296 @@
+"""Case files: TOML in, validated frozen sections out.
+
+A case describes either a body of revolution in unbounded fluid (``[body]``) or a
+projectile penetrating a half-space target (``[projectile]``, ``[target]``, ``[impact]``),
+plus whatever the other analyses need (cavity material, ballistic-limit tables, ...).
+Quantities are unit strings (see :mod:`semianalytic.units`).  Every section rejects unknown
+keys; any error becomes one :class:`~semianalytic.errors.InputError` naming the field
+(``projectile.diameter``), the value and what was expected.
+
+Sections owned by other analyses register themselves in :data:`SECTIONS` as
+``"module:Model"``; they are imported only when a case uses them.
+"""
+
+from __future__ import annotations
+
+import importlib
+import math
+import tomllib
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Literal, Mapping
+
+from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+
+from semianalytic.errors import InputError
+from semianalytic.units import Angle, Density, Length, Mass, NonNegativeLength, Pressure, Velocity
+
+__all__ = [
+    "Section",
+    "BodySection",
+    "ProjectileSection",
+    "TargetSection",
+    "ImpactSection",
+    "BemSection",
+    "CoefficientsSection",
+    "Case",
+    "load_case",
+    "parse_case",
+    "validate_section",
+    "SECTIONS",
+]
+
+
+class Section(BaseModel):
+    """Base of every case-file section: frozen, unknown keys rejected."""
+
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+LengthUnit = Literal["m", "cm", "mm", "um"]
+_UNIT_SCALE = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6}
+
+
+class BodySection(Section):
+    """``[body]``: a closed body of revolution in unbounded fluid.
+
+    sphere: ``diameter``; spheroid (prolate or oblate): ``length`` along the axis and
+    ``diameter``; table: ``points = [[x, r], ...]`` in ``points_unit``, a meridian from one
+    axis point (r = 0) to the other.
+    """
+
+    shape: Literal["sphere", "spheroid", "table"]
+    length: Length | None = None
+    diameter: Length | None = None
+    points: list[tuple[float, float]] | None = None
+    points_unit: LengthUnit | None = None
+
+    @model_validator(mode="after")
+    def _complete(self):
+        if self.shape == "sphere":
+            if self.diameter is None:
+                raise ValueError("a sphere needs 'diameter' (e.g. '1 m')")
+            if self.length is not None and not math.isclose(self.length, self.diameter, rel_tol=1e-12):
+                raise ValueError("a sphere's 'length' must equal its 'diameter' (or be left out)")
+        elif self.shape == "spheroid":
+            if self.diameter is None or self.length is None:
+                raise ValueError("a spheroid needs 'length' (along the axis) and 'diameter'")
+        else:
+            if not self.points or self.points_unit is None:
+                raise ValueError("a table body needs 'points' = [[x, r], ...] and 'points_unit'")
+        return self
+
+    def points_si(self) -> list[tuple[float, float]]:
+        s = _UNIT_SCALE[self.points_unit or "m"]
+        return [(x * s, r * s) for x, r in (self.points or [])]
+
+
+class ProjectileSection(Section):
+    """``[projectile]``: nose shape, shank and material of a penetrator.
+
+    ``nose``: ogive (needs ``crh``, psi = s/d), sphere (hemispherical), cone (needs
+    ``half_angle``), flat (optional ``corner_radius``) or table (``points = [[x, r], ...]``
+    in ``points_unit``, x measured back from the tip, from (0, 0) to the shoulder at r = d/2).
+    ``shank_length`` is the cylindrical part: total length = shank + nose.
+    """
+
+    nose: Literal["ogive", "sphere", "cone", "flat", "table"]
+    diameter: Length
+    shank_length: NonNegativeLength
+    density: Density | None = None
+    mass: Mass | None = None
+    crh: float | None = Field(default=None, description="ogive caliber radius head psi = s/d")
+    half_angle: Angle | None = None
+    corner_radius: NonNegativeLength | None = None
+    points: list[tuple[float, float]] | None = None
+    points_unit: LengthUnit | None = None
+    # material (Part I, section 2: elastic projectile and critical velocity)
+    youngs_modulus: Pressure | None = None
+    poisson_ratio: float | None = None
+    yield_stress: Pressure | None = None
+    buckling: Literal["none", "johnson-euler", "table"] = "none"
+    buckling_table: list[tuple[float, float]] | None = None
+
+    @field_validator("poisson_ratio")
+    @classmethod
+    def _nu(cls, v):
+        if v is not None and not (-1.0 < v < 0.5):
+            raise ValueError(f"must lie in (-1, 0.5); got {v!r}")
+        return v
+
+    @model_validator(mode="after")
+    def _complete(self):
+        if self.nose == "ogive":
+            if self.crh is None:
+                raise ValueError("an ogive nose needs 'crh' (caliber radius head psi = s/d, >= 0.5)")
+            if not self.crh >= 0.5:
+                raise ValueError(f"'crh' must be >= 0.5 for a tangent ogive; got {self.crh!r}")
+        if self.nose == "cone":
+            if self.half_angle is None:
+                raise ValueError("a conical nose needs 'half_angle' (e.g. '30 deg')")
+            if not self.half_angle < math.pi / 2:
+                raise ValueError("'half_angle' must be below 90 deg")
+        if self.nose == "flat" and self.corner_radius is not None:
+            if not self.corner_radius <= self.diameter / 2:
+                raise ValueError("'corner_radius' must not exceed half the diameter")
+        if self.nose == "table" and (not self.points or self.points_unit is None):
+            raise ValueError("a table nose needs 'points' = [[x, r], ...] and 'points_unit'")
+        return self
+
+    def points_si(self) -> list[tuple[float, float]]:
+        s = _UNIT_SCALE[self.points_unit or "m"]
+        return [(x * s, r * s) for x, r in (self.points or [])]
+
+
+class TargetSection(Section):
+    """``[target]``: the half-space target.  ``resistance`` is validated by the penetration model."""
+
+    density: Density
+    resistance: dict[str, Any] | None = None
+
+
+class ImpactSection(Section):
+    """``[impact]``: striking velocities U_s (each > 0)."""
+
+    striking_velocities: list[Velocity] = Field(min_length=1)
+
+
+class BemSection(Section):
+    """``[bem]``: numerical options of the boundary-element solver (all optional)."""
+
+    order: int = Field(default=8, ge=2, le=16, description="Gauss points (unknowns) per panel")
+    refinement: float = Field(default=1.0, gt=0.0, le=8.0, description="panel-count multiplier")
+
+
+class CoefficientsSection(Section):
+    """``[coefficients]``: the A(P), B(P), C(P) table (all optional)."""
+
+    depths: int = Field(default=64, ge=8, le=2000)
+    max_depth_nose_lengths: float = Field(default=300.0, gt=1.0)
+    reading: Literal["body", "literal", "bernoulli"] = "body"
+
+
+# Other analyses' sections: name -> "module:Model" (imported only when used).
+SECTIONS: dict[str, str] = {
+    "material": "semianalytic.cavity.case:MaterialSection",
+    "ballistic_limit": "semianalytic.ballistic_limit.case:BallisticLimitSection",
+    "nanostrength": "semianalytic.nanostrength.case:NanostrengthSection",
+    "data": "semianalytic.penetration.case:DataSection",
+    "run": "semianalytic.report.case:RunSection",
+}
+
+_CORE = {
+    "body": BodySection,
+    "projectile": ProjectileSection,
+    "target": TargetSection,
+    "impact": ImpactSection,
+    "bem": BemSection,
+    "coefficients": CoefficientsSection,
+}
+_META_KEYS = {"title", "description", "reproduces", "source"}
+
+
+@dataclass(frozen=True)
+class Case:
+    """A validated case file.  Absent sections are ``None`` (``bem`` and ``coefficients``
+    always hold their defaults)."""
+
+    path: Path | None
+    title: str
+    reproduces: str
+    body: BodySection | None = None
+    projectile: ProjectileSection | None = None
+    target: TargetSection | None = None
+    impact: ImpactSection | None = None
+    bem: BemSection = field(default_factory=BemSection)
+    coefficients: CoefficientsSection = field(default_factory=CoefficientsSection)
+    sections: Mapping[str, Section] = field(default_factory=dict)
+    raw: Mapping[str, Any] = field(default_factory=dict, repr=False)
+
+    def section(self, name: str) -> Any:
+        """Any section by name (core or registered); ``None`` if the case has none."""
+        if name in _CORE:
+            return getattr(self, name)
+        return self.sections.get(name)
+
+    def require(self, name: str) -> Any:
+        """The section ``name``, or an ``InputError`` saying the case lacks it."""
+        out = self.section(name)
+        if out is None:
+            raise InputError(name, f"the case has no [{name}] section, which this analysis needs")
+        return out
+
+
+def _pydantic_message(err: dict) -> str:
+    msg = err.get("msg", "invalid")
+    typ = err.get("type", "")
+    if typ == "missing":
+        return "missing (required)"
+    if typ == "extra_forbidden":
+        return "unknown key"
+    for prefix in ("Value error, ", "Assertion failed, "):
+        if msg.startswith(prefix):
+            msg = msg[len(prefix):]
+    if "input" in err and typ not in ("value_error",) and not isinstance(err["input"], dict):
+        msg = f"{msg}; got {err['input']!r}"
+    return msg
+
+
+def validate_section(name: str, model: type[BaseModel], data: Any) -> Any:
+    """Validate one section's table with ``model``; errors become ``InputError``."""
+    if not isinstance(data, dict):
+        raise InputError(name, f"must be a table [{name}]; got {type(data).__name__}")
+    try:
+        return model.model_validate(data)
+    except ValidationError as exc:
+        err = exc.errors()[0]
+        loc = ".".join(str(p) for p in (name, *err.get("loc", ())))
+        raise InputError(loc, _pydantic_message(err)) from None
+
+
+def _section_model(name: str) -> type[BaseModel]:
+    if name in _CORE:
+        return _CORE[name]
+    module, _, attr = SECTIONS[name].partition(":")
+    try:
+        return getattr(importlib.import_module(module), attr)
+    except (ImportError, AttributeError):
+        raise InputError(name, f"section [{name}] is not supported by this version") from None
+
+
+def parse_case(data: Mapping[str, Any], path: Path | None = None) -> Case:
+    """Validate a case given as a dict (the parsed TOML)."""
+    unknown = [k for k in data if k not in _CORE and k not in SECTIONS and k not in _META_KEYS]
+    if unknown:
+        known = ", ".join(sorted([*_CORE, *SECTIONS]))
+        raise InputError(unknown[0], f"unknown section or key; known sections: {known}")
+    for key in _META_KEYS:
+        if key in data and not isinstance(data[key], str):
+            raise InputError(key, "must be a string")
+    core = {name: validate_section(name, model, data[name]) for name, model in _CORE.items() if name in data}
+    extra = {name: validate_section(name, _section_model(name), data[name]) for name in SECTIONS if name in data}
+    if "body" in core and "projectile" in core:
+        raise InputError("body", "a case is either a [body] in unbounded fluid or a [projectile] in a target, not both")
+    if "projectile" in core and "target" not in core:
+        raise InputError("target", "a [projectile] case needs a [target] section with 'density'")
+    return Case(
+        path=path,
+        title=str(data.get("title", path.stem if path else "case")),
+        reproduces=str(data.get("reproduces", "")),
+        sections=extra,
+        raw=dict(data),
+        **core,
+    )
+
+
+def load_case(path: str | Path) -> Case:
+    """Read and validate a TOML case file.  Raises ``InputError`` (exit status 2)."""
+    path = Path(path)
+    if not path.is_file():
+        raise InputError("case", f"file {str(path)!r} does not exist")
+    try:
+        with path.open("rb") as fh:
+            data = tomllib.load(fh)
+    except tomllib.TOMLDecodeError as exc:
+        raise InputError("case", f"{path.name} is not valid TOML: {exc}") from None
+    return parse_case(data, path)

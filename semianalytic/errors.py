@@ -1,0 +1,19 @@
+"""Errors that map onto the command-line exit statuses.
+
+``InputError`` is bad input (exit status 2): it names the offending field, e.g.
+``projectile.diameter``, and says what was expected.  Anything else escaping a command is
+an internal failure (exit status 1).
+"""
+
+
+class InputError(ValueError):
+    """Bad input in a case file or on the command line (exit status 2)."""
+
+    def __init__(self, field: str, message: str):
+        self.field = field
+        self.message = message
+        super().__init__(f"{field}: {message}" if field else message)
+
+
+class ModelValidityWarning(UserWarning):
+    """An input the model accepts but that lies outside its stated validity."""

@@ -1,0 +1,437 @@
+"""Meridian profiles of bodies of revolution (Part I, section 1.1 and Fig. 5).
+
+A meridian is a chain of analytic segments in the (x, r) half-plane, each a curve
+``y(t) = (x(t), r(t))`` for ``t`` in ``[t0, t1]``, traversed from the front (largest x)
+towards the rear.  With that orientation the normal pointing out of the body (into the
+target material) is ``n = (t_r, -t_x)`` for the unit tangent ``t`` (so ``n_x > 0`` on a
+nose; errata item 1b).
+
+Projectiles are described in a body frame with the tip at ``x = 0`` and the body along
+``-x``; in the target frame of a penetration to depth ``P`` the tip is at ``x = P``.
+Closed bodies (sphere, spheroid, table) are centred on the origin.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+from functools import cached_property
+
+import numpy as np
+from scipy.interpolate import CubicSpline
+
+from semianalytic.errors import InputError
+
+# ------------------------------------------------------------------------------------
+# segments
+
+
+@dataclass(frozen=True)
+class Line:
+    """Straight segment from ``p0`` to ``p1``; ``t`` in [0, 1]."""
+
+    p0: tuple[float, float]
+    p1: tuple[float, float]
+    t0: float = 0.0
+    t1: float = 1.0
+
+    def point(self, t):
+        t = np.asarray(t, dtype=float)
+        return (self.p0[0] + (self.p1[0] - self.p0[0]) * t, self.p0[1] + (self.p1[1] - self.p0[1]) * t)
+
+    def derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        one = np.ones_like(t)
+        return ((self.p1[0] - self.p0[0]) * one, (self.p1[1] - self.p0[1]) * one)
+
+    def second_derivative(self, t):
+        z = np.zeros_like(np.asarray(t, dtype=float))
+        return (z, z)
+
+
+@dataclass(frozen=True)
+class Arc:
+    """Circular arc ``(xc + R cos t, rc + R sin t)``, angle ``t`` from ``t0`` to ``t1``."""
+
+    center: tuple[float, float]
+    radius: float
+    t0: float
+    t1: float
+
+    def point(self, t):
+        t = np.asarray(t, dtype=float)
+        return (self.center[0] + self.radius * np.cos(t), self.center[1] + self.radius * np.sin(t))
+
+    def derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.radius * np.sin(t), self.radius * np.cos(t))
+
+    def second_derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.radius * np.cos(t), -self.radius * np.sin(t))
+
+
+@dataclass(frozen=True)
+class EllipseArc:
+    """Ellipse arc ``(xc + a cos t, b sin t)`` (a spheroid meridian for t in [0, pi])."""
+
+    xc: float
+    a: float  # semi-axis along x
+    b: float  # semi-axis along r
+    t0: float = 0.0
+    t1: float = math.pi
+
+    def point(self, t):
+        t = np.asarray(t, dtype=float)
+        return (self.xc + self.a * np.cos(t), self.b * np.sin(t))
+
+    def derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.a * np.sin(t), self.b * np.cos(t))
+
+    def second_derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.a * np.cos(t), -self.b * np.sin(t))
+
+
+@dataclass(frozen=True, eq=False)
+class SplineCurve:
+    """Parametric cubic spline through table points, parameter = cumulative chord length."""
+
+    xs: tuple[float, ...]
+    rs: tuple[float, ...]
+
+    @cached_property
+    def _splines(self):
+        x, r = np.array(self.xs), np.array(self.rs)
+        s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(r)))])
+        return s, CubicSpline(s, x), CubicSpline(s, r)
+
+    @property
+    def t0(self) -> float:
+        return 0.0
+
+    @property
+    def t1(self) -> float:
+        return float(self._splines[0][-1])
+
+    @property
+    def knots(self) -> np.ndarray:
+        return self._splines[0]
+
+    def point(self, t):
+        _, sx, sr = self._splines
+        return (sx(t), sr(t))
+
+    def derivative(self, t):
+        _, sx, sr = self._splines
+        return (sx(t, 1), sr(t, 1))
+
+    def second_derivative(self, t):
+        _, sx, sr = self._splines
+        return (sx(t, 2), sr(t, 2))
+
+
+Segment = Line | Arc | EllipseArc | SplineCurve
+
+
+def _gauss_integrate(segment: Segment, f, n: int = 48) -> float:
+    """Integrate ``f(x, r, dx, dr)`` dt over a segment with composite Gauss-Legendre."""
+    u, w = np.polynomial.legendre.leggauss(n)
+    edges = (
+        np.asarray(segment.knots)
+        if isinstance(segment, SplineCurve)
+        else np.linspace(segment.t0, segment.t1, 5)
+    )
+    total = 0.0
+    for a, b in zip(edges[:-1], edges[1:]):
+        t = 0.5 * (a + b) + 0.5 * (b - a) * u
+        x, r = segment.point(t)
+        dx, dr = segment.derivative(t)
+        total += 0.5 * (b - a) * float(np.sum(w * f(x, r, dx, dr)))
+    return total
+
+
+# ------------------------------------------------------------------------------------
+# meridians
+
+
+@dataclass(frozen=True)
+class Meridian:
+    """A chain of segments traversed from the front towards the rear.
+
+    ``closed`` meridians start and end on the axis (r = 0) and bound a body.
+    """
+
+    segments: tuple[Segment, ...]
+    closed: bool = True
+
+    def start(self) -> tuple[float, float]:
+        s = self.segments[0]
+        x, r = s.point(s.t0)
+        return float(x), float(r)
+
+    def end(self) -> tuple[float, float]:
+        s = self.segments[-1]
+        x, r = s.point(s.t1)
+        return float(x), float(r)
+
+    def arc_length(self) -> float:
+        return sum(_gauss_integrate(s, lambda x, r, dx, dr: np.hypot(dx, dr)) for s in self.segments)
+
+    def volume(self) -> float:
+        """V = pi * integral r^2 (-dx) along the meridian (exact to quadrature round-off)."""
+        return math.pi * sum(_gauss_integrate(s, lambda x, r, dx, dr: -(r**2) * dx) for s in self.segments)
+
+    def surface_area(self) -> float:
+        return 2 * math.pi * sum(_gauss_integrate(s, lambda x, r, dx, dr: r * np.hypot(dx, dr)) for s in self.segments)
+
+    def projected_area(self) -> float:
+        """C = integral of n_x dS = pi * integral 2 r (-dr)... over the part with n_x > 0."""
+        return 2 * math.pi * sum(
+            _gauss_integrate(s, lambda x, r, dx, dr: np.maximum(r * dr, 0.0)) for s in self.segments
+        )
+
+    def corners(self, tol: float = 1e-9) -> list[float]:
+        """Turning angle (rad) at each joint between consecutive segments."""
+        out = []
+        for a, b in zip(self.segments[:-1], self.segments[1:]):
+            ta = np.array(a.derivative(a.t1), dtype=float)
+            tb = np.array(b.derivative(b.t0), dtype=float)
+            ang = math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(ta @ tb))
+            out.append(ang if abs(ang) > tol else 0.0)
+        return out
+
+    def axis_angles(self) -> tuple[float, float]:
+        """Angle between the tangent and the axis-normal at the two axis ends (0 = smooth pole)."""
+
+        def angle(seg, t, sign):
+            dx, dr = (float(v) for v in seg.derivative(t))
+            return abs(math.atan2(sign * dx, abs(dr))) if (dx or dr) else 0.0
+
+        s0, s1 = self.segments[0], self.segments[-1]
+        return angle(s0, s0.t0, 1.0), angle(s1, s1.t1, 1.0)
+
+    def sample(self, n_per_segment: int = 50) -> np.ndarray:
+        """Points along the meridian, shape (m, 2), for plots and meshes."""
+        pts = []
+        for s in self.segments:
+            t = np.linspace(s.t0, s.t1, n_per_segment)
+            x, r = s.point(t)
+            pts.append(np.column_stack([x, r]))
+        return np.vstack(pts)
+
+
+# ------------------------------------------------------------------------------------
+# noses (body frame: tip at the origin, body along -x, shoulder at (-L_h, d/2))
+
+
+@dataclass(frozen=True)
+class Nose:
+    """A nose profile from the tip (0, 0) to the shoulder (-length, diameter/2).
+
+    ``kind`` names the shape; ``segments`` trace it; ``length`` is L_h.
+    """
+
+    kind: str
+    diameter: float
+    length: float
+    segments: tuple[Segment, ...]
+    parameters: dict = field(default_factory=dict, compare=False)
+
+    @property
+    def radius(self) -> float:
+        return 0.5 * self.diameter
+
+    def meridian(self) -> Meridian:
+        return Meridian(self.segments, closed=False)
+
+    def volume(self) -> float:
+        """Volume of the nose (between tip and shoulder)."""
+        return self.meridian().volume()
+
+    def tip_half_angle(self) -> float:
+        """Half-angle of the tip (pi/2 for a flat or spherical tip)."""
+        s = self.segments[0]
+        dx, dr = (float(v) for v in s.derivative(s.t0))
+        return math.atan2(abs(dr), abs(dx))
+
+
+def ogive_nose(diameter: float, crh: float) -> Nose:
+    """Tangent ogive of caliber radius head psi = s/d (Fig. 5: psi = 3; psi = 0.5 is a hemisphere).
+
+    Arc of radius s = psi d centred at (-L_h, R - s), nose length L_h = d sqrt(psi - 1/4).
+    """
+    if not diameter > 0:
+        raise InputError("projectile.diameter", "must be positive")
+    if not crh >= 0.5:
+        raise InputError("projectile.crh", f"must be >= 0.5 for a tangent ogive; got {crh!r}")
+    R = 0.5 * diameter
+    s = crh * diameter
+    L = math.sqrt(max(2 * s * R - R * R, 0.0))
+    theta_tip = math.atan2(s - R, L)
+    arc = Arc(center=(-L, R - s), radius=s, t0=theta_tip, t1=0.5 * math.pi)
+    kind = "sphere" if crh == 0.5 else "ogive"
+    return Nose(kind, diameter, L, (arc,), {"crh": crh})
+
+
+def sphere_nose(diameter: float) -> Nose:
+    """Hemispherical nose (psi = 0.5 in Fig. 5): L_h = d/2."""
+    return ogive_nose(diameter, 0.5)
+
+
+def cone_nose(diameter: float, half_angle: float) -> Nose:
+    """Conical nose of tip half-angle ``half_angle`` (rad): L_h = (d/2)/tan(half_angle)."""
+    if not 0 < half_angle < 0.5 * math.pi:
+        raise InputError("projectile.half_angle", "must lie strictly between 0 and 90 deg")
+    R = 0.5 * diameter
+    L = R / math.tan(half_angle)
+    return Nose("cone", diameter, L, (Line((0.0, 0.0), (-L, R)),), {"half_angle": half_angle})
+
+
+def flat_nose(diameter: float, corner_radius: float = 0.0) -> Nose:
+    """Flat (blunt) nose: a disk of radius d/2 - rc, then a quarter-circle corner of radius rc."""
+    R = 0.5 * diameter
+    if not 0 <= corner_radius <= R:
+        raise InputError("projectile.corner_radius", "must lie between 0 and d/2")
+    segs: list[Segment] = []
+    if corner_radius < R:
+        segs.append(Line((0.0, 0.0), (0.0, R - corner_radius)))
+    if corner_radius > 0:
+        segs.append(Arc((-corner_radius, R - corner_radius), corner_radius, 0.0, 0.5 * math.pi))
+    return Nose("flat", diameter, corner_radius, tuple(segs), {"corner_radius": corner_radius})
+
+
+def table_nose(points: list[tuple[float, float]], diameter: float, field_name: str = "projectile.points") -> Nose:
+    """Nose through user points (x back from the tip, r), from (0, 0) to (L_h, d/2).
+
+    The points must form a simple meridian: x non-decreasing, r > 0 after the tip, the
+    last radius equal to d/2.  A parametric cubic spline joins them.
+    """
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
+        raise InputError(field_name, "needs at least three [x, r] pairs")
+    if not np.all(np.isfinite(pts)):
+        raise InputError(field_name, "must be finite numbers")
+    if abs(pts[0, 0]) > 0 or abs(pts[0, 1]) > 0:
+        raise InputError(field_name, "must start at the tip [0, 0]")
+    if np.any(np.diff(pts[:, 0]) < 0):
+        raise InputError(field_name, "x (distance back from the tip) must not decrease: the table is not a simple meridian")
+    if np.any(np.hypot(np.diff(pts[:, 0]), np.diff(pts[:, 1])) == 0):
+        raise InputError(field_name, "has repeated points")
+    if np.any(pts[1:, 1] <= 0):
+        raise InputError(field_name, "radius must be positive after the tip")
+    if np.any(pts[:, 1] > 0.5 * diameter * (1 + 1e-9)):
+        raise InputError(field_name, "radius exceeds half the diameter")
+    if not math.isclose(pts[-1, 1], 0.5 * diameter, rel_tol=1e-6):
+        raise InputError(field_name, f"must end at the shoulder radius d/2 = {0.5 * diameter:g} m")
+    spline = SplineCurve(tuple(-pts[:, 0]), tuple(pts[:, 1]))
+    t = np.linspace(spline.t0, spline.t1, 400)
+    x, r = spline.point(t)
+    if np.any(np.diff(x) > 1e-12 * diameter) or np.any(r[1:] < 0):
+        raise InputError(field_name, "the spline through the points folds back; add points or smooth the table")
+    return Nose("table", diameter, float(pts[-1, 0]), (spline,), {"points": pts.tolist()})
+
+
+# ------------------------------------------------------------------------------------
+# projectile and bodies
+
+
+@dataclass(frozen=True)
+class Projectile:
+    """A nose on a cylindrical shank (Fig. 5).  Lengths in m, density in kg/m^3."""
+
+    nose: Nose
+    shank_length: float
+    density: float | None = None
+    mass_override: float | None = None
+
+    @property
+    def diameter(self) -> float:
+        return self.nose.diameter
+
+    @property
+    def nose_length(self) -> float:
+        return self.nose.length
+
+    @property
+    def length(self) -> float:
+        """L = L_c + L_h."""
+        return self.shank_length + self.nose.length
+
+    def meridian(self) -> Meridian:
+        """Closed meridian: nose, shank, flat rear face."""
+        R = self.nose.radius
+        segs = list(self.nose.segments)
+        if self.shank_length > 0:
+            segs.append(Line((-self.nose.length, R), (-self.length, R)))
+        segs.append(Line((-self.length, R), (-self.length, 0.0)))
+        return Meridian(tuple(segs), closed=True)
+
+    def volume(self) -> float:
+        return self.meridian().volume()
+
+    @property
+    def mass(self) -> float:
+        """Measured mass if given, else density times volume."""
+        if self.mass_override is not None:
+            return self.mass_override
+        if self.density is None:
+            raise InputError("projectile.density", "needed for the projectile mass (or give 'mass')")
+        return self.density * self.volume()
+
+
+def sphere_body(diameter: float) -> Meridian:
+    """Sphere of the given diameter, centred on the origin."""
+    if not diameter > 0:
+        raise InputError("body.diameter", "must be positive")
+    return Meridian((Arc((0.0, 0.0), 0.5 * diameter, 0.0, math.pi),))
+
+
+def spheroid_body(length: float, diameter: float) -> Meridian:
+    """Spheroid with semi-axes length/2 (along x) and diameter/2, centred on the origin."""
+    if not (length > 0 and diameter > 0):
+        raise InputError("body.length", "length and diameter must be positive")
+    return Meridian((EllipseArc(0.0, 0.5 * length, 0.5 * diameter),))
+
+
+def table_body(points: list[tuple[float, float]], field_name: str = "body.points") -> Meridian:
+    """Closed meridian through user points from one axis point to the other."""
+    pts = np.asarray(points, dtype=float)
+    if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 4:
+        raise InputError(field_name, "needs at least four [x, r] pairs")
+    if pts[0, 1] != 0 or pts[-1, 1] != 0:
+        raise InputError(field_name, "must start and end on the axis (r = 0)")
+    if np.any(pts[1:-1, 1] <= 0):
+        raise InputError(field_name, "radius must be positive between the two axis points")
+    if np.any(np.diff(pts[:, 0]) >= 0) and np.any(np.diff(pts[:, 0]) <= 0):
+        if not (np.all(np.diff(pts[:, 0]) <= 0) or np.all(np.diff(pts[:, 0]) >= 0)):
+            raise InputError(field_name, "x must change monotonically: the table is not a simple meridian")
+    if pts[0, 0] < pts[-1, 0]:
+        pts = pts[::-1]
+    return Meridian((SplineCurve(tuple(pts[:, 0]), tuple(pts[:, 1])),))
+
+
+def nose_from_section(sec) -> Nose:
+    """Build the nose of a ``[projectile]`` case section."""
+    if sec.nose in ("ogive", "sphere"):
+        return ogive_nose(sec.diameter, sec.crh if sec.nose == "ogive" else 0.5)
+    if sec.nose == "cone":
+        return cone_nose(sec.diameter, sec.half_angle)
+    if sec.nose == "flat":
+        return flat_nose(sec.diameter, sec.corner_radius or 0.0)
+    return table_nose(sec.points_si(), sec.diameter)
+
+
+def projectile_from_section(sec) -> Projectile:
+    """Build the projectile of a ``[projectile]`` case section."""
+    return Projectile(nose_from_section(sec), sec.shank_length, sec.density, sec.mass)
+
+
+def body_from_section(sec) -> Meridian:
+    """Build the closed meridian of a ``[body]`` case section."""
+    if sec.shape == "sphere":
+        return sphere_body(sec.diameter)
+    if sec.shape == "spheroid":
+        return spheroid_body(sec.length, sec.diameter)
+    return table_body(sec.points_si())
