@@ -1,0 +1,463 @@
+"""Meshes of the axisymmetric meridian domains: gmsh (Python API) -> .msh -> meshio -> scikit-fem.
+
+Two domains (Part I, section 1.2 and Fig. 1; sign conventions of errata item 1b):
+
+* ``body_domain``: a closed body of revolution in unbounded fluid.  The meridian half-plane
+  r >= 0 minus the body, closed by a half-circle of radius ``far_radius`` centred on the body.
+* ``halfspace_domain``: the target x >= 0 around a nose at depth P (tip at x = P, moving in
+  +x).  For P < L_h the nose is cut by the free surface x = 0 at the waterline radius r_w;
+  for P >= L_h the entry hole and the shank form one cylinder r = d/2, 0 <= x <= P - L_h
+  (n_x = 0 there, so the projectile length L does not enter, errata item 1b).  Closed by a
+  quarter circle of radius ``far_radius`` centred on the origin (the centre of the mirrored
+  source, errata item 2f).
+
+Boundary tags: ``body`` (Neumann -n_x), ``wall`` (hole and shank, 0), ``free`` (x = 0, 0),
+``axis`` (r = 0, natural), ``far`` (Robin far field).  Elements are graded towards the
+nose tip, the nose-shank junction and the free-surface corner or waterline.  Quadratic
+meshes (``order=2``) carry curved (isoparametric) boundary edges; every node of a curved
+boundary is moved onto the exact meridian curve of :mod:`semianalytic.geometry`.
+
+Generated meshes are cached in ``meshes/cache/`` (git-ignored), keyed by a hash of the
+geometry and mesh parameters; a cache hit skips gmsh entirely.
+"""
+
+from __future__ import annotations
+
+import contextlib
+import dataclasses
+import hashlib
+import io
+import json
+import math
+import os
+import tempfile
+from dataclasses import dataclass, field
+from pathlib import Path
+
+import meshio
+import numpy as np
+from skfem import MeshTri1, MeshTri2
+
+from semianalytic.errors import InputError
+from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, SplineCurve
+
+MESH_FORMAT_VERSION = 3  # bump when the domain construction changes (invalidates the cache)
+
+# ------------------------------------------------------------------------------------
+# curve pieces
+
+
+@dataclass(frozen=True)
+class Piece:
+    """A part ``t0 -> t1`` of a meridian segment (either direction), shifted by ``shift`` in x."""
+
+    segment: object
+    t0: float
+    t1: float
+    shift: float = 0.0
+
+    def point(self, t):
+        x, r = self.segment.point(t)
+        return np.asarray(x, float) + self.shift, np.asarray(r, float)
+
+    def derivative(self, t):
+        dx, dr = self.segment.derivative(t)
+        return np.asarray(dx, float), np.asarray(dr, float)
+
+    def second_derivative(self, t):
+        dx, dr = self.segment.second_derivative(t)
+        return np.asarray(dx, float), np.asarray(dr, float)
+
+    @property
+    def start(self) -> tuple[float, float]:
+        x, r = self.point(self.t0)
+        return float(x), float(r)
+
+    @property
+    def end(self) -> tuple[float, float]:
+        x, r = self.point(self.t1)
+        return float(x), float(r)
+
+    @property
+    def straight(self) -> bool:
+        return isinstance(self.segment, Line)
+
+    def describe(self) -> dict:
+        """JSON-able description (for the cache key)."""
+        seg = self.segment
+        if isinstance(seg, SplineCurve):
+            sd = {"type": "spline", "xs": list(seg.xs), "rs": list(seg.rs)}
+        else:
+            sd = {"type": type(seg).__name__, **{k: v for k, v in dataclasses.asdict(seg).items()}}
+        return {"segment": sd, "t0": self.t0, "t1": self.t1, "shift": self.shift}
+
+    def project(self, q: np.ndarray) -> np.ndarray:
+        """Closest points of the piece to the points ``q`` (M, 2) (Newton on the parameter)."""
+        q = np.atleast_2d(np.asarray(q, float))
+        lo, hi = min(self.t0, self.t1), max(self.t0, self.t1)
+        ts = np.linspace(lo, hi, 801)
+        xs, rs = self.point(ts)
+        d2 = (xs[None, :] - q[:, :1]) ** 2 + (rs[None, :] - q[:, 1:2]) ** 2
+        t = ts[np.argmin(d2, axis=1)]
+        for _ in range(8):
+            x, r = self.point(t)
+            dx, dr = self.derivative(t)
+            ddx, ddr = self.second_derivative(t)
+            ex, er = x - q[:, 0], r - q[:, 1]
+            f = ex * dx + er * dr
+            fp = dx * dx + dr * dr + ex * ddx + er * ddr
+            fp = np.where(np.abs(fp) > 0, fp, 1.0)
+            t = np.clip(t - f / fp, lo, hi)
+        x, r = self.point(t)
+        return np.column_stack([x, r])
+
+
+def _line(p0, p1) -> Piece:
+    return Piece(Line(tuple(map(float, p0)), tuple(map(float, p1))), 0.0, 1.0)
+
+
+# ------------------------------------------------------------------------------------
+# domains
+
+
+@dataclass(frozen=True)
+class MeshOptions:
+    """Mesh parameters, all relative to the length scale d of the domain (body or projectile diameter).
+
+    ``h``: element size on the body / d; ``corner``: size at the singular points (tip,
+    junction, free-surface corner or waterline) as a fraction of ``h``; ``growth``: the
+    element size at distance s from the body is h (d + growth s), so that refining ``h``
+    refines the whole mesh uniformly (needed for clean convergence rates); ``far``:
+    far radius / d (for the half-space: measured beyond the depth, R = P + far d);
+    ``order``: geometric order (1 straight edges, 2 curved isoparametric edges).
+    """
+
+    h: float = 0.08
+    corner: float = 0.25
+    growth: float = 3.0
+    far: float = 20.0
+    order: int = 2
+
+    def __post_init__(self):
+        if not 0 < self.h <= 1:
+            raise InputError("mesh.h", f"element size over diameter must lie in (0, 1]; got {self.h!r}")
+        if not 0 < self.corner <= 1:
+            raise InputError("mesh.corner", f"must lie in (0, 1]; got {self.corner!r}")
+        if not 0 < self.growth <= 50:
+            raise InputError("mesh.growth", f"must lie in (0, 50]; got {self.growth!r}")
+        if not self.far > 1:
+            raise InputError("mesh.far", f"far radius over diameter must exceed 1; got {self.far!r}")
+        if self.order not in (1, 2):
+            raise InputError("mesh.order", f"must be 1 or 2; got {self.order!r}")
+
+    def refined(self, factor: float) -> "MeshOptions":
+        """The same grading with all element sizes divided by ``factor``."""
+        return dataclasses.replace(self, h=self.h / factor)
+
+
+@dataclass(frozen=True)
+class Domain:
+    """A meridian domain: its boundary loop (counter-clockwise around the fluid), tagged."""
+
+    kind: str  # "body" | "halfspace"
+    loop: tuple[tuple[str, Piece], ...]
+    far_center: tuple[float, float]
+    far_radius: float
+    length_scale: float
+    refine_points: tuple[tuple[float, float], ...]
+    info: dict = field(default_factory=dict, compare=False)
+
+    def key(self, options: MeshOptions) -> str:
+        blob = {
+            "version": MESH_FORMAT_VERSION,
+            "kind": self.kind,
+            "loop": [(tag, p.describe()) for tag, p in self.loop],
+            "far": [self.far_center, self.far_radius],
+            "scale": self.length_scale,
+            "refine": self.refine_points,
+            "options": dataclasses.asdict(options),
+        }
+        text = json.dumps(blob, sort_keys=True, default=float)
+        return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+def _far_arc(center, radius, a0, a1) -> Piece:
+    return Piece(Arc((float(center[0]), float(center[1])), float(radius), a0, a1), a0, a1)
+
+
+def body_domain(meridian: Meridian, options: MeshOptions) -> Domain:
+    """Closed body in unbounded fluid: half-plane r >= 0 outside the body, far half-circle."""
+    if not meridian.closed:
+        raise InputError("body", "needs a closed meridian (from one axis point to the other)")
+    front, rear = meridian.start(), meridian.end()
+    pts = meridian.sample(60)
+    d = 2.0 * float(pts[:, 1].max())
+    length = front[0] - rear[0]
+    xc = 0.5 * (front[0] + rear[0])
+    R = options.far * max(d, length)
+    pieces = [("axis", _line(front, (xc + R, 0.0))), ("far", _far_arc((xc, 0.0), R, 0.0, 0.5 * math.pi)),
+              ("far", _far_arc((xc, 0.0), R, 0.5 * math.pi, math.pi)), ("axis", _line((xc - R, 0.0), rear))]
+    for seg in reversed(meridian.segments):
+        pieces.append(("body", Piece(seg, seg.t1, seg.t0)))
+    refine = [front, rear]
+    refine += [pieces[-1 - i][1].start for i in range(len(meridian.segments) - 1)] if len(meridian.segments) > 1 else []
+    return Domain("body", tuple(pieces), (xc, 0.0), R, d, tuple(tuple(map(float, p)) for p in refine),
+                  {"volume": meridian.volume(), "diameter": d, "length": length})
+
+
+def _nose_waterline(nose: Nose, depth: float) -> tuple[int, float]:
+    """(segment index, parameter) of the nose point at body x = -depth (0 < depth < L_h)."""
+    for i, seg in enumerate(nose.segments):
+        x0, _ = seg.point(seg.t0)
+        x1, _ = seg.point(seg.t1)
+        if min(x0, x1) - 1e-15 <= -depth <= max(x0, x1) + 1e-15:
+            lo, hi = seg.t0, seg.t1
+            flo = float(seg.point(lo)[0]) + depth
+            for _ in range(200):  # bisection: x(t) is monotone along a nose segment
+                mid = 0.5 * (lo + hi)
+                fm = float(seg.point(mid)[0]) + depth
+                if (fm > 0) == (flo > 0):
+                    lo, flo = mid, fm
+                else:
+                    hi = mid
+                if abs(hi - lo) < 1e-15 * max(1.0, abs(hi)):
+                    break
+            return i, 0.5 * (lo + hi)
+    raise InputError("depth", f"depth {depth!r} m does not cut the nose")
+
+
+def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
+    """Target x >= 0 around a nose at depth P (tip at x = P), quarter circle at R = P + far d."""
+    if not depth > 0:
+        raise InputError("depth", f"must be positive; got {depth!r} m")
+    d, Rb, Lh = nose.diameter, nose.radius, nose.length
+    Rf = depth + options.far * d
+    tip = (depth, 0.0)
+    pieces: list[tuple[str, Piece]] = [("axis", _line(tip, (Rf, 0.0))), ("far", _far_arc((0.0, 0.0), Rf, 0.0, 0.5 * math.pi))]
+    refine = [tip]
+    tol = 1e-9 * Lh
+    if depth < Lh - tol:
+        k, tw = _nose_waterline(nose, depth)
+        rw = float(nose.segments[k].point(tw)[1])
+        pieces.append(("free", _line((0.0, Rf), (0.0, rw))))
+        nose_pieces = [Piece(nose.segments[k], tw, nose.segments[k].t0, depth)]
+        nose_pieces += [Piece(s, s.t1, s.t0, depth) for s in reversed(nose.segments[:k])]
+        refine.append((0.0, rw))
+        info = {"waterline_radius": rw, "waterline_segment": k, "waterline_t": tw}
+    else:
+        pieces.append(("free", _line((0.0, Rf), (0.0, Rb))))
+        if depth > Lh + tol:
+            pieces.append(("wall", _line((0.0, Rb), (depth - Lh, Rb))))
+            refine.append((0.0, Rb))
+        nose_pieces = [Piece(s, s.t1, s.t0, depth) for s in reversed(nose.segments)]
+        info = {"waterline_radius": Rb}
+        refine.append((depth - Lh, Rb))
+    for p in nose_pieces:
+        pieces.append(("body", p))
+    for p in nose_pieces[1:]:
+        refine.append(p.start)
+    info.update({"depth": depth, "nose_length": Lh, "diameter": d})
+    return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info)
+
+
+# ------------------------------------------------------------------------------------
+# gmsh
+
+
+def cache_dir() -> Path:
+    """``meshes/cache`` of the repository (override with FEM_CHECK_MESH_CACHE)."""
+    env = os.environ.get("FEM_CHECK_MESH_CACHE")
+    path = Path(env) if env else Path(__file__).resolve().parents[1] / "meshes" / "cache"
+    path.mkdir(parents=True, exist_ok=True)
+    return path
+
+
+@contextlib.contextmanager
+def _gmsh_session():
+    import gmsh
+
+    started = not gmsh.isInitialized()
+    if started:
+        gmsh.initialize(readConfigFiles=False)
+    gmsh.option.setNumber("General.Terminal", 0)
+    gmsh.option.setNumber("General.NumThreads", 1)
+    gmsh.option.setNumber("General.Verbosity", 1)
+    name = f"fem_check_{os.getpid()}_{id(object())}"
+    gmsh.model.add(name)
+    try:
+        yield gmsh
+    finally:
+        gmsh.model.remove()
+        if started:
+            gmsh.finalize()
+
+
+def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
+    """Run gmsh on ``domain`` and write the mesh (msh 4.1) to ``path`` atomically."""
+    with _gmsh_session() as gmsh:
+        geo = gmsh.model.geo
+        d = domain.length_scale
+        h = options.h * d
+        point_tags: dict[tuple[float, float], int] = {}
+
+        def point(p):
+            key = (round(p[0], 14), round(p[1], 14))
+            for k, tag in point_tags.items():
+                if abs(k[0] - key[0]) <= 1e-12 * domain.far_radius and abs(k[1] - key[1]) <= 1e-12 * domain.far_radius:
+                    return tag
+            tag = geo.addPoint(float(p[0]), float(p[1]), 0.0, h)
+            point_tags[key] = tag
+            return tag
+
+        curves: list[int] = []
+        groups: dict[str, list[int]] = {}
+        for i, (tag, piece) in enumerate(domain.loop):
+            a, b = point(piece.start), point(piece.end)
+            if piece.straight:
+                c = geo.addLine(a, b)
+            elif tag == "far":
+                cx, cr = piece.segment.center
+                ctag = geo.addPoint(cx, cr, 0.0, h)
+                c = geo.addCircleArc(a, ctag, b)
+            else:
+                ts = np.linspace(piece.t0, piece.t1, 97)[1:-1]
+                xs, rs = piece.point(ts)
+                inner = [geo.addPoint(float(x), float(r), 0.0, h) for x, r in zip(xs, rs)]
+                c = geo.addSpline([a, *inner, b])
+            curves.append(c)
+            groups.setdefault(f"{tag}#{i}", []).append(c)
+        loop = geo.addCurveLoop(curves)
+        surf = geo.addPlaneSurface([loop])
+        geo.synchronize()
+        for name, tags in groups.items():
+            gmsh.model.addPhysicalGroup(1, tags, name=name)
+        gmsh.model.addPhysicalGroup(2, [surf], name="fluid")
+
+        # size field: h d on the body, h d corner at the singular points, growing like h (d + g s)
+        fm = gmsh.model.mesh.field
+        body_curves = [c for c, (tag, _) in zip(curves, domain.loop) if tag == "body"]
+        f1 = fm.add("Distance")
+        fm.setNumbers(f1, "CurvesList", body_curves)
+        fm.setNumber(f1, "Sampling", 400)
+        corner_pts = [point(p) for p in domain.refine_points]
+        f2 = fm.add("Distance")
+        fm.setNumbers(f2, "PointsList", corner_pts)
+        hc = h * options.corner
+        g = options.h * options.growth
+        hmax = 0.25 * domain.far_radius
+        f3 = fm.add("MathEval")
+        fm.setString(f3, "F", f"Min({hmax}, Min({h} + {g}*F{f1}, {hc} + {g}*F{f2}))")
+        fm.setAsBackgroundMesh(f3)
+        gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
+        gmsh.option.setNumber("Mesh.MeshSizeFromCurvature", 0)
+        gmsh.option.setNumber("Mesh.Algorithm", 6)
+        gmsh.option.setNumber("Mesh.MshFileVersion", 4.1)
+        gmsh.model.mesh.generate(2)
+        if options.order == 2:
+            gmsh.model.mesh.setOrder(2)
+        n_elem = sum(len(t) for t in gmsh.model.mesh.getElements(2)[1])
+        if n_elem == 0:
+            raise RuntimeError("gmsh produced no elements for the domain")
+        fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".msh", dir=path.parent)
+        os.close(fd)
+        try:
+            gmsh.write(tmp)
+            os.replace(tmp, path)
+        except BaseException:
+            with contextlib.suppress(FileNotFoundError):
+                os.unlink(tmp)
+            raise
+
+
+# ------------------------------------------------------------------------------------
+# meshio -> scikit-fem
+
+
+@dataclass
+class DomainMesh:
+    """A scikit-fem mesh of a :class:`Domain` with tagged boundary facets."""
+
+    domain: Domain
+    options: MeshOptions
+    mesh: MeshTri1 | MeshTri2
+    boundaries: dict[str, np.ndarray]  # tag -> facet indices
+    pieces: dict[int, np.ndarray]  # loop index -> facet indices
+    path: Path | None = None
+
+    @property
+    def order(self) -> int:
+        return self.options.order
+
+    def facet_nodes(self, facets: np.ndarray) -> np.ndarray:
+        """Indices (into ``mesh.doflocs``) of all geometry nodes on the given facets."""
+        nodes = [self.mesh.facets[:, facets].ravel()]
+        if isinstance(self.mesh, MeshTri2):
+            nodes.append(self.mesh.dofs.facet_dofs[:, facets].ravel())
+        return np.unique(np.concatenate(nodes))
+
+    def with_doflocs(self, doflocs: np.ndarray) -> "DomainMesh":
+        """Same topology and tags, moved nodes (for shape finite differences)."""
+        mesh = dataclasses.replace(self.mesh, doflocs=np.ascontiguousarray(doflocs))
+        return dataclasses.replace(self, mesh=mesh)
+
+
+def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):
+    cells = msh.cells_dict
+    ttype, ltype = ("triangle6", "line3") if order == 2 else ("triangle", "line")
+    if ttype not in cells:
+        raise RuntimeError(f"mesh file holds no {ttype} cells")
+    tri = cells[ttype]
+    used = np.unique(tri[:, :3])
+    renum = -np.ones(len(msh.points), dtype=np.int64)
+    renum[used] = np.arange(len(used))
+    p = msh.points[:, :2].T
+    if order == 1:
+        mesh = MeshTri1(np.ascontiguousarray(p[:, used]), np.ascontiguousarray(renum[tri].T))
+    else:
+        # MeshTri2 reorders: vertices first (in np.unique order, as ``used``), then edge nodes
+        mesh = MeshTri2(np.ascontiguousarray(p), np.ascontiguousarray(tri.T))
+    # boundary facets from the physical line groups
+    bf = mesh.boundary_facets()
+    fv = np.sort(mesh.facets[:, bf], axis=0)
+    lookup = {(int(a), int(b)): int(f) for a, b, f in zip(fv[0], fv[1], bf)}
+    phys = msh.cell_data_dict["gmsh:physical"][ltype]
+    names = {int(v[0]): k for k, v in msh.field_data.items() if v[1] == 1}
+    lines = cells[ltype][:, :2]
+    pieces: dict[int, list[int]] = {}
+    for (a, b), tag in zip(renum[lines], phys):
+        key = (int(min(a, b)), int(max(a, b)))
+        idx = int(names[int(tag)].split("#")[1])
+        pieces.setdefault(idx, []).append(lookup[key])
+    pieces_arr = {k: np.array(v, dtype=np.int64) for k, v in pieces.items()}
+    boundaries: dict[str, list] = {}
+    for idx, facets in pieces_arr.items():
+        boundaries.setdefault(domain.loop[idx][0], []).append(facets)
+    boundaries_arr = {k: np.concatenate(v) for k, v in boundaries.items()}
+    missing = set(bf) - set(np.concatenate(list(boundaries_arr.values())).tolist())
+    if missing:
+        raise RuntimeError(f"{len(missing)} boundary facets carry no tag")
+    return mesh, boundaries_arr, pieces_arr
+
+
+def _snap_curved(dm: DomainMesh) -> DomainMesh:
+    """Move every node of a curved boundary piece onto the exact curve."""
+    doflocs = dm.mesh.doflocs.copy()
+    for idx, facets in dm.pieces.items():
+        tag, piece = dm.domain.loop[idx]
+        if piece.straight:
+            continue
+        nodes = dm.facet_nodes(facets)
+        doflocs[:, nodes] = piece.project(doflocs[:, nodes].T).T
+    return dm.with_doflocs(doflocs)
+
+
+def build_mesh(domain: Domain, options: MeshOptions, use_cache: bool = True) -> DomainMesh:
+    """The scikit-fem mesh of ``domain`` (from the cache when possible)."""
+    path = cache_dir() / f"{domain.kind}_{domain.key(options)}.msh"
+    if not (use_cache and path.exists()):
+        _generate(domain, options, path)
+    with contextlib.redirect_stdout(io.StringIO()):  # meshio prints an empty line for msh 4.1
+        msh = meshio.read(path)
+    mesh, boundaries, pieces = _to_skfem(msh, domain, options.order)
+    return _snap_curved(DomainMesh(domain, options, mesh, boundaries, pieces, path))
