@@ -1,0 +1,124 @@
+"""The output folder of a run: built in a staging folder, swapped in at the end.
+
+Nothing appears under ``DIR`` until every file is written; a failure (bad input found late,
+an exception, Ctrl-C) leaves ``DIR`` exactly as it was.  An existing ``DIR`` is replaced only
+with ``force``; every relative path goes through :func:`semianalytic.io.contained_path`, so
+no name taken from a case file can escape the folder.
+"""
+
+from __future__ import annotations
+
+import json
+import os
+import shutil
+import tempfile
+from pathlib import Path
+from typing import Any
+
+from semianalytic.errors import InputError
+from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path
+
+
+def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out") -> Path:
+    """Refuse an existing ``out`` without ``force``, and a path that is a file."""
+    out = Path(out)
+    if out.exists() and not out.is_dir():
+        raise InputError(field, f"{str(out)!r} exists and is not a folder")
+    if out.exists() and not force and any(out.iterdir()):
+        raise InputError(field, f"{str(out)!r} exists; pass --force to overwrite it")
+    return out
+
+
+class StagedDir:
+    """``with StagedDir(out, force) as d: d.write_text("report.md", ...)``.
+
+    Files go to a hidden sibling folder; on a clean exit it replaces ``out`` (the old folder is
+    moved aside first and removed after the swap).  On an exception the staging folder is
+    removed and ``out`` is untouched.
+    """
+
+    def __init__(self, out: str | os.PathLike, force: bool = False, field: str = "--out"):
+        self.final = check_output_dir(out, force, field).absolute()
+        self.force = force
+        self.root: Path | None = None
+        self.files: list[str] = []
+
+    # -- context -------------------------------------------------------------------------
+    def __enter__(self) -> "StagedDir":
+        self.final.parent.mkdir(parents=True, exist_ok=True)
+        self.root = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.partial-", dir=self.final.parent))
+        return self
+
+    def __exit__(self, exc_type, exc, tb) -> bool:
+        if exc_type is not None:
+            shutil.rmtree(self.root, ignore_errors=True)
+            return False
+        self._commit()
+        return False
+
+    def _commit(self) -> None:
+        old = None
+        if self.final.exists():
+            check_output_dir(self.final, self.force)  # it may have appeared meanwhile
+            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.old-", dir=self.final.parent))
+            os.replace(self.final, old / "previous")
+        try:
+            os.replace(self.root, self.final)
+        except BaseException:
+            if old is not None:  # put the previous folder back
+                os.replace(old / "previous", self.final)
+            shutil.rmtree(self.root, ignore_errors=True)
+            raise
+        finally:
+            if old is not None:
+                shutil.rmtree(old, ignore_errors=True)
+        self.root = self.final
+
+    # -- writing -------------------------------------------------------------------------
+    def path(self, relative: str, field: str = "output") -> Path:
+        """Absolute staging path of ``relative``; refuses anything that leaves the folder."""
+        assert self.root is not None, "use StagedDir as a context manager"
+        p = contained_path(self.root, relative, field)
+        p.parent.mkdir(parents=True, exist_ok=True)
+        rel = p.relative_to(self.root.resolve()).as_posix()
+        if rel not in self.files:
+            self.files.append(rel)
+        return p
+
+    def write_bytes(self, relative: str, data: bytes, field: str = "output") -> str:
+        atomic_write_bytes(self.path(relative, field), data)
+        return relative
+
+    def write_text(self, relative: str, text: str, field: str = "output") -> str:
+        atomic_write_text(self.path(relative, field), text)
+        return relative
+
+    def write_json(self, relative: str, obj: Any, field: str = "output") -> str:
+        atomic_write_json(self.path(relative, field), json_safe(obj))
+        return relative
+
+
+def json_safe(obj: Any) -> Any:
+    """Convert numpy scalars/arrays and non-finite floats (-> None) into plain JSON values."""
+    import math
+
+    import numpy as np
+
+    if isinstance(obj, dict):
+        return {str(k): json_safe(v) for k, v in obj.items()}
+    if isinstance(obj, (list, tuple)):
+        return [json_safe(v) for v in obj]
+    if isinstance(obj, np.ndarray):
+        return json_safe(obj.tolist())
+    if isinstance(obj, (np.bool_,)):
+        return bool(obj)
+    if isinstance(obj, (np.integer,)):
+        return int(obj)
+    if isinstance(obj, (float, np.floating)):
+        v = float(obj)
+        return v if math.isfinite(v) else None
+    if isinstance(obj, Path):
+        return obj.as_posix()
+    if obj is None or isinstance(obj, (str, int, bool)):
+        return obj
+    return json.loads(json.dumps(obj, default=str))

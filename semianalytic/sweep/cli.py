@@ -1,0 +1,83 @@
+"""``python -m semianalytic sweep CASE.toml --vary KEY=START:STOP:STEP ... --out DIR``.
+
+Grid sweeps (``--vary``, repeatable: the Cartesian product) and seeded Monte-Carlo studies
+(``--sample KEY=normal(MEAN,SD) --samples N --seed S``), run with dask (a local cluster by
+default, ``--scheduler tcp://HOST:PORT`` for an existing one, ``--scheduler inline`` for no
+dask).  Each finished batch is appended to ``DIR/results.csv`` (or ``DIR/results.parquet/``)
+at once; ``--resume`` skips the finished cases after an interruption.  Examples::
+
+    python -m semianalytic sweep cases/fig15a_ogive.toml --out sweeps/vel \\
+        --vary impact.striking_velocity=400:1800:10 m/s \\
+        --vary target.resistance.yield_stress=250:550:5 MPa
+    python -m semianalytic sweep cases/fig15a_ogive.toml --out sweeps/mc --samples 2000 --seed 7 \\
+        --sample target.resistance.yield_stress=normal(400 MPa, 20 MPa) \\
+        --sample target.density=uniform(2690 kg/m^3, 2730 kg/m^3)
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+
+from semianalytic.errors import InputError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("case", help="case file (TOML)")
+    parser.add_argument("--out", required=True, help="output folder (results file + sweep.json)")
+    parser.add_argument("--vary", action="append", default=[], metavar="KEY=START:STOP:STEP",
+                        help="grid axis (STOP included) or KEY=V1,V2,...; repeat for a Cartesian product")
+    parser.add_argument("--sample", action="append", default=[], metavar="KEY=DIST(...)",
+                        help="random input: normal(MEAN,SD), uniform(LOW,HIGH), lognormal(MEDIAN,SIGMA), "
+                             "triangular(LOW,MODE,HIGH)")
+    parser.add_argument("--samples", type=int, default=0, help="number of Monte-Carlo samples (with --sample)")
+    parser.add_argument("--seed", type=int, default=0, help="seed of the Monte-Carlo draws (default 0)")
+    parser.add_argument("--analysis", choices=["penetration", "cavity"], default=None,
+                        help="what to compute per case (default: from the case's sections)")
+    parser.add_argument("--full", action="store_true",
+                        help="penetration: also quasi-rigid and elastic depths (slower, case by case)")
+    parser.add_argument("--format", dest="fmt", choices=["csv", "parquet"], default="csv")
+    parser.add_argument("--scheduler", default=None,
+                        help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process; "
+                             "default: a local cluster")
+    parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
+    parser.add_argument("--batch-size", type=int, default=None, help="cases per task (default: automatic)")
+    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache (default: the project's)")
+    parser.add_argument("--resume", action="store_true", help="continue an interrupted sweep in --out")
+    parser.add_argument("--force", action="store_true", help="discard existing results in --out")
+    parser.add_argument("--no-progress", action="store_true", help="no progress bar")
+    parser.add_argument("--json", action="store_true", help="print the summary as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from semianalytic.case import load_case
+    from semianalytic.sweep.engine import run_sweep
+    from semianalytic.sweep.kernels import select_kernel
+    from semianalytic.sweep.spec import build_spec
+
+    if args.resume and args.force:
+        raise InputError("--resume", "cannot be combined with --force")
+    if args.workers < 1:
+        raise InputError("--workers", "must be at least 1")
+    if args.batch_size is not None and args.batch_size < 1:
+        raise InputError("--batch-size", "must be at least 1")
+    if args.samples < 0:
+        raise InputError("--samples", "must not be negative")
+    spec = build_spec(args.vary, args.sample, args.samples, args.seed)
+    case = load_case(args.case)
+    kernel = select_kernel(case, args.analysis, cache_dir=args.cache_dir, full=args.full)
+    summary = run_sweep(
+        args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
+        scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size,
+        progress=not args.no_progress, kernel=kernel,
+    )
+    info = summary.to_json()
+    if args.json:
+        print(json.dumps(info, indent=2))
+    else:
+        print(
+            f"{info['n_run']} cases run ({info['n_ok']} ok, {info['n_invalid']} invalid, {info['n_error']} failed), "
+            f"{info['n_skipped_finished_before']} finished before; {summary.cases_per_second:.0f} cases/s "
+            f"on {info['workers']} worker(s); results: {info['results']}"
+        )
+    return 0 if summary.n_error == 0 else 1

@@ -1,0 +1,374 @@
+"""The sweep engine: cases -> batches -> dask -> results appended as batches finish.
+
+Execution: a dask ``LocalCluster`` (processes, one thread each) by default, an existing
+cluster with ``scheduler="tcp://host:port"``, or ``scheduler="inline"`` (this process, no
+dask; for small runs and tests).  The client process is the only writer of the results
+file, so appends never interleave.  Shared resources (coefficient tables) are prepared once
+per geometry, before the batches run, and sent to the workers with the tasks; the tables
+themselves are cached on disk by the content hash of the geometry and the BEM options
+(:func:`semianalytic.coefficients.table.cached_coefficient_table`), so a velocity sweep solves
+the BEM once, and a second sweep on the same geometry not at all.
+"""
+
+from __future__ import annotations
+
+import functools
+import hashlib
+import json
+import math
+import os
+import shutil
+import sys
+import time
+from collections import defaultdict
+from dataclasses import dataclass, field
+from pathlib import Path
+from typing import Any, Callable, Iterable, Mapping, Sequence
+
+import numpy as np
+
+from semianalytic.case import Case, load_case, parse_case
+from semianalytic.errors import InputError
+from semianalytic.io import atomic_write_json
+from semianalytic.sweep.kernels import Kernel, select_kernel
+from semianalytic.sweep.spec import Axis, SweepSpec, apply_overrides, raw_value
+from semianalytic.sweep.store import ResultStore, results_path
+
+BASE_COLUMNS = ("case_id", "status", "message")
+MANIFEST = "sweep.json"
+
+
+@dataclass(frozen=True)
+class Payload:
+    """Everything a worker needs to evaluate a batch (sent once, shared by all tasks)."""
+
+    raw_json: str  # the base case (parsed TOML) as JSON
+    case_path: str | None
+    spec: SweepSpec
+    kernel: Kernel
+    draws: Mapping[str, np.ndarray]
+    resources: Mapping[Any, Any]  # geometry key -> prepared resource (coefficient table)
+
+
+@dataclass
+class SweepSummary:
+    out: Path
+    results: Path
+    n_cases: int
+    n_skipped: int  # finished before (--resume)
+    n_run: int
+    n_ok: int = 0
+    n_invalid: int = 0
+    n_error: int = 0
+    seconds_total: float = 0.0
+    seconds_prepare: float = 0.0
+    seconds_cases: float = 0.0
+    scheduler: str = ""
+    workers: int = 0
+
+    @property
+    def cases_per_second(self) -> float:
+        return self.n_run / self.seconds_cases if self.seconds_cases > 0 else math.nan
+
+    def to_json(self) -> dict:
+        return {
+            "results": str(self.results),
+            "n_cases": self.n_cases,
+            "n_skipped_finished_before": self.n_skipped,
+            "n_run": self.n_run,
+            "n_ok": self.n_ok,
+            "n_invalid": self.n_invalid,
+            "n_error": self.n_error,
+            "seconds_total": self.seconds_total,
+            "seconds_prepare": self.seconds_prepare,
+            "seconds_cases": self.seconds_cases,
+            "cases_per_second": self.cases_per_second,
+            "scheduler": self.scheduler,
+            "workers": self.workers,
+        }
+
+
+# --------------------------------------------------------------------------------------
+# worker side
+
+
+@functools.lru_cache(maxsize=512)
+def _parse_cached(raw_json: str, overrides_json: str, case_path: str | None) -> Case:
+    """Validate the base case with overrides (cached per worker process: pure function)."""
+    raw = apply_overrides(json.loads(raw_json), json.loads(overrides_json))
+    return parse_case(raw, Path(case_path) if case_path else None)
+
+
+def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
+    """Rows for the case ids: inputs (SI), status and the kernel's outputs.
+
+    Cases that differ only in the kernel's fast keys (the striking velocity) share one
+    validated case and are evaluated together, vectorised.
+    """
+    spec, kernel = payload.spec, payload.kernel
+    ids = np.asarray(ids, dtype=np.int64)
+    values = spec.values(ids, payload.draws)
+    units = spec.units()
+    integer = spec.integer_keys()
+    columns = spec.columns
+    slow = [k for k in spec.keys if k not in kernel.fast_keys]
+    fast = [k for k in spec.keys if k in kernel.fast_keys]
+
+    groups: dict[tuple, list[int]] = defaultdict(list)
+    for j in range(len(ids)):
+        groups[tuple(float(values[k][j]) for k in slow)].append(j)
+
+    rows: list[dict | None] = [None] * len(ids)
+    for gvals, idx in groups.items():
+        idx = np.asarray(idx)
+        overrides = {k: raw_value(v, units[k], k in integer) for k, v in zip(slow, gvals)}
+        # the fast keys are validated by the kernel; the case is parsed with the first value
+        first = {k: raw_value(values[k][idx[0]], units[k], k in integer) for k in fast}
+        base_rows = [
+            {"case_id": int(ids[j]), **{columns[k]: float(values[k][j]) for k in spec.keys}} for j in idx
+        ]
+        try:
+            case = _parse_cached(payload.raw_json, json.dumps({**overrides, **first}, sort_keys=True), payload.case_path)
+            resource = payload.resources.get(kernel.resource_key(case))
+            if resource is None:
+                resource = kernel.prepare(case)
+            out = kernel.evaluate(case, resource, {k: values[k][idx] for k in fast})
+        except InputError as exc:
+            for r in base_rows:
+                r.update(status="invalid", message=str(exc))
+            out = None
+        except Exception as exc:  # one bad group must not stop the sweep
+            for r in base_rows:
+                r.update(status="error", message=f"{type(exc).__name__}: {exc}")
+            out = None
+        if out is not None:
+            status = out.pop("_status", None)
+            message = out.pop("_message", None)
+            for n, r in enumerate(base_rows):
+                r["status"] = "ok" if status is None else str(status[n])
+                r["message"] = "" if message is None else str(message[n])
+                for col, arr in out.items():
+                    v = arr[n] if len(arr) == len(base_rows) else arr[0]
+                    r[col] = v.item() if hasattr(v, "item") else v
+        for j, r in zip(idx, base_rows):
+            rows[j] = r
+    return rows  # type: ignore[return-value]
+
+
+# --------------------------------------------------------------------------------------
+# client side
+
+
+def _case_digest(path: Path) -> str:
+    return hashlib.sha256(path.read_bytes()).hexdigest()[:16]
+
+
+def _validate_spec(case: Case, spec: SweepSpec, kernel: Kernel) -> None:
+    """Every grid value and every sampler's central value must make a valid case (exit 2)."""
+    units, integer = spec.units(), spec.integer_keys()
+    checks: list[tuple[str, float, str]] = []
+    for a in spec.axes:
+        vals = a.values if len(a.values) <= 64 else (a.values[0], a.values[len(a.values) // 2], a.values[-1])
+        checks += [(a.key, v, "--vary") for v in vals]
+    for s in spec.samplers:
+        checks.append((s.key, s.params[1] if s.dist == "triangular" else s.params[0], "--sample"))
+    for key, v, opt in checks:
+        try:
+            if key in kernel.fast_keys:
+                kernel.check_fast(key, np.array([v]))
+            else:
+                parse_case(apply_overrides(case.raw, {key: raw_value(v, units[key], key in integer)}), case.path)
+        except InputError as exc:
+            shown = f"{v:g} {units[key]}".strip()
+            raise InputError(exc.field, f"{exc.message} (value {shown} from {opt} {key})") from None
+
+
+def _resource_cases(case: Case, spec: SweepSpec, kernel: Kernel, pending: np.ndarray, draws) -> dict:
+    """One validated case per distinct resource key among the pending cases."""
+    geo = [k for k in spec.keys if kernel.affects_resource(k)]
+    if not geo:
+        return {kernel.resource_key(case): case}
+    units, integer = spec.units(), spec.integer_keys()
+    vals = spec.values(pending, draws)
+    seen: dict = {}
+    combos = {tuple(float(vals[k][j]) for k in geo) for j in range(len(pending))}
+    for combo in sorted(combos):
+        overrides = {k: raw_value(v, units[k], k in integer) for k, v in zip(geo, combo)}
+        try:
+            c = parse_case(apply_overrides(case.raw, overrides), case.path)
+        except InputError:
+            continue  # those cases will be reported invalid
+        seen.setdefault(kernel.resource_key(c), c)
+    return seen
+
+
+def _batches(ids: np.ndarray, size: int) -> list[np.ndarray]:
+    return [ids[i : i + size] for i in range(0, len(ids), size)]
+
+
+def prepare_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict) -> bool:
+    """Check/prepare the output folder; returns True for a fresh start."""
+    res = results_path(out, fmt)
+    man = out / MANIFEST
+    if out.exists() and not out.is_dir():
+        raise InputError("--out", f"{str(out)!r} exists and is not a folder")
+    has_results = res.exists() or man.exists()
+    if resume:
+        if not has_results:
+            return True
+        if not man.exists():
+            raise InputError("--resume", f"{str(out)!r} has results but no {MANIFEST}; cannot tell which sweep they belong to")
+        old = json.loads(man.read_text())
+        if old.get("fingerprint") != manifest["fingerprint"]:
+            raise InputError(
+                "--resume",
+                f"{str(out)!r} holds a different sweep (case file or --vary/--sample changed); use another --out or --force",
+            )
+        if old.get("format") != fmt:
+            raise InputError("--format", f"the sweep in {str(out)!r} was written as {old.get('format')}")
+        return False
+    if has_results and not force:
+        raise InputError("--out", f"{str(out)!r} already holds sweep results; pass --resume to continue or --force to start over")
+    if force:
+        for p in (results_path(out, "csv"), results_path(out, "parquet"), man):
+            if p.is_dir():
+                shutil.rmtree(p)
+            elif p.exists():
+                p.unlink()
+    return True
+
+
+def run_sweep(
+    case_path: str | os.PathLike,
+    spec: SweepSpec,
+    out: str | os.PathLike,
+    *,
+    fmt: str = "csv",
+    analysis: str | None = None,
+    resume: bool = False,
+    force: bool = False,
+    scheduler: str | None = None,
+    workers: int = 2,
+    batch_size: int | None = None,
+    cache_dir: str | os.PathLike | None = None,
+    progress: bool = True,
+    kernel: Kernel | None = None,
+    on_batch: Callable[[int], None] | None = None,
+) -> SweepSummary:
+    """Run (or resume) a sweep; see :mod:`semianalytic.sweep`.  Bad input raises InputError
+    before anything is written."""
+    t0 = time.perf_counter()
+    case_path = Path(case_path)
+    case = load_case(case_path)
+    kernel = kernel or select_kernel(case, analysis, cache_dir=cache_dir)
+    spec = kernel.complete_spec(case, spec)
+    _validate_spec(case, spec, kernel)
+    out = Path(out)
+    manifest = {
+        "case": str(case_path),
+        "case_sha256_16": _case_digest(case_path),
+        "analysis": kernel.name,
+        "format": fmt,
+        "spec": spec.to_json(),
+    }
+    manifest["fingerprint"] = hashlib.sha256(
+        json.dumps({k: manifest[k] for k in ("case_sha256_16", "analysis", "spec")}, sort_keys=True).encode()
+    ).hexdigest()[:16]
+    fresh = prepare_output(out, fmt, resume, force, manifest)
+    columns = list(BASE_COLUMNS) + list(spec.columns.values()) + list(kernel.columns)
+    store = ResultStore(out, fmt, columns)
+    done = set() if fresh else store.finished_ids()
+    all_ids = np.arange(spec.n_cases, dtype=np.int64)
+    pending = all_ids[~np.isin(all_ids, np.fromiter(done, dtype=np.int64, count=len(done)))] if done else all_ids
+    out.mkdir(parents=True, exist_ok=True)
+    atomic_write_json(out / MANIFEST, manifest)
+    summary = SweepSummary(out, store.path, spec.n_cases, len(done), len(pending))
+    draws = spec.draws() if spec.samplers else {}
+    store.open(fresh)
+    client = cluster = None
+    try:
+        if len(pending) == 0:
+            summary.seconds_total = time.perf_counter() - t0
+            return summary
+        # shared resources (coefficient tables), one per geometry
+        t_prep = time.perf_counter()
+        rcases = _resource_cases(case, spec, kernel, pending, draws)
+        sched = (scheduler or "local").strip()
+        if sched == "inline":
+            resources = {k: kernel.prepare(c) for k, c in rcases.items()}
+            summary.scheduler, summary.workers = "inline", 1
+        else:
+            from dask.distributed import Client, LocalCluster
+
+            if sched == "local":
+                cluster = LocalCluster(
+                    n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                    silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+                )
+                client = Client(cluster)
+            else:
+                try:
+                    client = Client(sched, timeout="10s")
+                except (OSError, TimeoutError, ValueError) as exc:
+                    raise InputError("--scheduler", f"cannot connect to the dask scheduler {sched!r}: {exc}") from None
+            summary.scheduler = sched
+            summary.workers = len(client.scheduler_info().get("workers", {})) or workers
+            futures = {k: client.submit(kernel.prepare, c, pure=False) for k, c in rcases.items()}
+            resources = {k: f.result() for k, f in futures.items()}
+        summary.seconds_prepare = time.perf_counter() - t_prep
+
+        payload = Payload(json.dumps(case.raw), str(case_path), spec, kernel, draws, resources)
+        nw = max(1, summary.workers)
+        size = batch_size or int(min(2000, max(20, math.ceil(len(pending) / (8 * nw)))))
+        batches = _batches(pending, size)
+        t_cases = time.perf_counter()
+        bar = _progress(len(pending), progress)
+        try:
+            if client is None:
+                for b in batches:
+                    rows = evaluate_batch(payload, b)
+                    _record(store, rows, summary, bar, on_batch)
+            else:
+                from dask.distributed import as_completed
+
+                [pay] = client.scatter([payload], broadcast=True)
+                futs = [client.submit(evaluate_batch, pay, b, pure=False) for b in batches]
+                for fut in as_completed(futs):
+                    _record(store, fut.result(), summary, bar, on_batch)
+                    fut.release()
+        finally:
+            summary.seconds_cases = time.perf_counter() - t_cases
+            if bar is not None:
+                bar.close()
+    finally:
+        store.close()
+        if client is not None:
+            client.close()
+        if cluster is not None:
+            cluster.close()
+        summary.seconds_total = time.perf_counter() - t0
+    return summary
+
+
+def _record(store: ResultStore, rows: list[dict], summary: SweepSummary, bar, on_batch) -> None:
+    store.append(rows)
+    for r in rows:
+        s = r.get("status")
+        if s == "ok":
+            summary.n_ok += 1
+        elif s == "invalid":
+            summary.n_invalid += 1
+        else:
+            summary.n_error += 1
+    if bar is not None:
+        bar.update(len(rows))
+    if on_batch is not None:
+        on_batch(len(rows))
+
+
+def _progress(total: int, enabled: bool):
+    if not enabled:
+        return None
+    from tqdm import tqdm
+
+    return tqdm(total=total, unit="case", file=sys.stderr, dynamic_ncols=True, mininterval=0.5)

@@ -1,0 +1,198 @@
+"""What a sweep computes for each case: thin adapters onto the models (no physics here).
+
+A kernel names its output columns (SI units in the names), the case keys it evaluates
+vectorised without re-validating the case (``fast_keys``: the striking velocity), and the
+shared resource it needs (the coefficient table of the projectile's nose, keyed by the
+geometry and the BEM options).
+
+- ``penetration`` (Part I): final depth of the rigid projectile for each striking velocity
+  (eq. (11), through :func:`semianalytic.penetration.motion.final_depth`), the critical impact
+  velocity U_sC (eqs. (33)/(36)) and whether the projectile yields (U_s >= U_sC).  With
+  ``full=True`` also the quasi-rigid and elastic depths, case by case, through the
+  penetration module's own evaluation (slower).
+- ``cavity`` (Part II): the cavity-expansion solution of a ``[material]``.
+"""
+
+from __future__ import annotations
+
+import json
+from dataclasses import dataclass, field
+from typing import Any, Mapping
+
+import numpy as np
+
+from semianalytic.case import Case
+from semianalytic.errors import InputError
+from semianalytic.sweep.spec import VELOCITY_KEY, Axis, SweepSpec
+
+# keys whose value changes the coefficient table (the nose geometry and the numerics)
+_GEOMETRY_PREFIXES = (
+    "projectile.nose",
+    "projectile.crh",
+    "projectile.diameter",
+    "projectile.half_angle",
+    "projectile.corner_radius",
+    "projectile.points",
+    "bem.",
+    "coefficients.depths",
+    "coefficients.max_depth_nose_lengths",
+)
+
+
+def geometry_key(case: Case) -> str:
+    """A content key of everything the coefficient table depends on."""
+    p = case.require("projectile")
+    nose = {k: getattr(p, k) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius")}
+    nose["points"] = p.points_si() if p.points else None
+    opts = {
+        "order": case.bem.order,
+        "refinement": case.bem.refinement,
+        "depths": case.coefficients.depths,
+        "max_depth_nose_lengths": case.coefficients.max_depth_nose_lengths,
+    }
+    return json.dumps({"nose": nose, "options": opts}, sort_keys=True, default=repr)
+
+
+def coefficient_table_for(case: Case, cache_dir=None, progress: bool = False):
+    """The (cached) A, B, C table of the case's nose, in the B reading the case selects."""
+    from semianalytic.coefficients.table import cached_coefficient_table
+    from semianalytic.geometry import nose_from_section
+
+    nose = nose_from_section(case.require("projectile"))
+    kwargs = dict(
+        order=case.bem.order,
+        refinement=case.bem.refinement,
+        n_depths=case.coefficients.depths,
+        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
+        progress=progress,
+    )
+    if cache_dir is not None:
+        kwargs["cache_dir"] = cache_dir
+    table = cached_coefficient_table(nose, **kwargs)
+    return table.with_reading(case.coefficients.reading)
+
+
+def _check_velocities(values: np.ndarray) -> None:
+    bad = ~(np.isfinite(values) & (values > 0))
+    if bad.any():
+        raise InputError("impact.striking_velocities", f"must be positive; got {float(values[bad][0]):g} m/s")
+
+
+@dataclass(frozen=True)
+class PenetrationKernel:
+    """Part I penetration for many striking velocities (see the module docstring)."""
+
+    cache_dir: str | None = None
+    coefficients: Any = None  # a fixed DragCoefficients (e.g. ConstantCoefficients) instead of the BEM table
+    full: bool = False
+    name: str = "penetration"
+    fast_keys: frozenset = frozenset({VELOCITY_KEY})
+
+    @property
+    def columns(self) -> tuple[str, ...]:
+        cols = ("depth_rigid_m", "critical_velocity_m_s", "yields")
+        if self.full:
+            cols += ("depth_quasi_rigid_m", "depth_elastic_m", "depth_elastic_exact_rod_m")
+        return cols
+
+    def complete_spec(self, case: Case, spec: SweepSpec) -> SweepSpec:
+        """Without a velocity axis, the case's own striking velocities become one (innermost)."""
+        for sec in ("projectile", "target"):
+            case.require(sec)
+        if VELOCITY_KEY in spec.keys:
+            return spec
+        imp = case.require("impact")
+        axis = Axis(VELOCITY_KEY, tuple(imp.striking_velocities), "m/s")
+        return SweepSpec(spec.axes + (axis,), spec.samplers, spec.n_samples, spec.seed)
+
+    def check_fast(self, key: str, values: np.ndarray) -> None:
+        _check_velocities(np.asarray(values, float))
+
+    def affects_resource(self, key: str) -> bool:
+        return self.coefficients is None and key.startswith(_GEOMETRY_PREFIXES)
+
+    def resource_key(self, case: Case):
+        return "fixed" if self.coefficients is not None else geometry_key(case)
+
+    def prepare(self, case: Case):
+        if self.coefficients is not None:
+            return self.coefficients
+        return coefficient_table_for(case, self.cache_dir)
+
+    def evaluate(self, case: Case, coefficients, fast: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        from semianalytic.penetration import sweep_support
+
+        U = np.asarray(fast[VELOCITY_KEY], float)
+        status = np.full(U.shape, None, dtype=object)
+        message = np.full(U.shape, "", dtype=object)
+        bad = ~(np.isfinite(U) & (U > 0))
+        status[bad] = "invalid"
+        message[bad] = "impact.striking_velocities: must be positive"
+        res = sweep_support(case, coefficients, np.where(bad, 1.0, U), full=self.full)
+        out = {c: np.asarray(res[c]) for c in self.columns}
+        for c in out:
+            if out[c].dtype.kind == "f":
+                out[c] = np.where(bad, np.nan, out[c])
+        out["_status"] = np.where(status == None, "ok", status)  # noqa: E711
+        out["_message"] = message
+        return out
+
+
+@dataclass(frozen=True)
+class CavityKernel:
+    """Part II: the brittle cavity-expansion solution of the case's ``[material]``."""
+
+    name: str = "cavity"
+    fast_keys: frozenset = frozenset()
+    columns: tuple[str, ...] = (
+        "cavity_pressure_Pa", "sigma_star_Pa", "theta_star", "theta_k", "a_over_b", "c_over_b",
+    )
+
+    def complete_spec(self, case: Case, spec: SweepSpec) -> SweepSpec:
+        case.require("material")
+        return spec
+
+    def check_fast(self, key, values):  # no fast keys
+        pass
+
+    def affects_resource(self, key: str) -> bool:
+        return False
+
+    def resource_key(self, case: Case):
+        return None
+
+    def prepare(self, case: Case):
+        return None
+
+    def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
+        from semianalytic.cavity import BrittleMaterial, solve_cavity
+
+        r = solve_cavity(BrittleMaterial.from_section(case.require("material")))
+        return {
+            "cavity_pressure_Pa": np.array([r.cavity_pressure]),
+            "sigma_star_Pa": np.array([r.sigma_star]),
+            "theta_star": np.array([r.theta_star]),
+            "theta_k": np.array([r.theta_k]),
+            "a_over_b": np.array([r.a_over_b]),
+            "c_over_b": np.array([r.c_over_b]),
+        }
+
+
+KERNELS = ("penetration", "cavity")
+Kernel = PenetrationKernel | CavityKernel
+
+
+def select_kernel(case: Case, analysis: str | None = None, cache_dir=None, full: bool = False) -> Kernel:
+    """The kernel named by ``analysis``, or the one the case's sections call for."""
+    if analysis is None:
+        if case.projectile is not None:
+            analysis = "penetration"
+        elif case.section("material") is not None:
+            analysis = "cavity"
+        else:
+            raise InputError("case", "nothing to sweep: the case has neither a [projectile] nor a [material] section")
+    if analysis == "penetration":
+        return PenetrationKernel(cache_dir=None if cache_dir is None else str(cache_dir), full=full)
+    if analysis == "cavity":
+        return CavityKernel()
+    raise InputError("--analysis", f"must be one of {', '.join(KERNELS)}; got {analysis!r}")
