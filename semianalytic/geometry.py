@@ -13,6 +13,7 @@ Closed bodies (sphere, spheroid, table) are centred on the origin.
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 from functools import cached_property
@@ -135,9 +136,14 @@ class SplineCurve:
 Segment = Line | Arc | EllipseArc | SplineCurve
 
 
+@functools.cache
+def _leggauss(n: int):
+    return np.polynomial.legendre.leggauss(n)
+
+
 def _gauss_integrate(segment: Segment, f, n: int = 48) -> float:
     """Integrate ``f(x, r, dx, dr)`` dt over a segment with composite Gauss-Legendre."""
-    u, w = np.polynomial.legendre.leggauss(n)
+    u, w = _leggauss(n)
     edges = (
         np.asarray(segment.knots)
         if isinstance(segment, SplineCurve)

@@ -1,0 +1,482 @@
+"""The exterior Neumann problem for the velocity potential (Part I, eqs. (6)-(7), (20)-(22)).
+
+Formulation: *direct* (Green's representation) rather than the paper's simple layer (20)-(21).
+For a closed surface S with the normal n pointing out of the body into the fluid, the
+potential in the fluid is
+
+    phi(x) = integral_S [phi(y) dG/dn_y - G(x, y) g(y)] dS_y,      g = dphi/dn = -n_x,  (*)
+
+and on the surface (at smooth points, where the collocation nodes are)
+
+    phi(x)/2 - integral_S phi dG/dn_y dS_y = - integral_S G g dS_y.                   (**)
+
+Equation (**) is of the second kind and uniquely solvable for the exterior Neumann problem;
+it yields phi on the surface directly, which is what A, B and the pressure (9) need.
+
+Half-space (Part I, eqs. (21)-(22), Fig. 3): the target x >= 0 with the free surface x = 0
+(dphi/dn = 0 there) is replaced by the whole space around the body S and its mirror image
+S', with phi even in x.  Only the nodes on S are unknowns; the columns of the mirror nodes
+are folded onto their images (the kernel K(x, x1) + K(x, -x1) of the paper's reduced
+equation).  The Neumann datum on the image equals that of the original point, so the net
+flux is 2C != 0 and phi decays like a monopole (errata item 2f).
+
+Discretisation: panels with p Gauss nodes each (Nystrom collocation), exact geometry, the
+logarithmic singularity of the ring kernels integrated with product rules, nearly singular
+pairs with dyadically graded rules; assembly vectorised over all pairs.
+"""
+
+from __future__ import annotations
+
+import functools
+import math
+from dataclasses import dataclass
+from functools import cached_property
+
+import numpy as np
+import scipy.linalg
+
+from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_split
+from semianalytic.bem.panels import PanelSet
+from semianalytic.bem.quadrature import (
+    differentiation_matrix,
+    dyadic_rule,
+    gauss_legendre,
+    gauss_log,
+    lagrange_matrix,
+)
+
+N_SELF = 10  # points per half-panel in the self rules (plain and log)
+N_NEAR = 10  # Gauss points per dyadic piece in the near rules
+NEAR_FACTOR = 1.3  # a panel is "near" a target closer than this many panel lengths to its centre
+MAX_LEVELS = 48
+IMAGE_MARGIN = 4.0  # innermost self piece <= (distance to the axis image)/IMAGE_MARGIN
+
+
+# ------------------------------------------------------------------------------------
+# near pairs
+
+
+@functools.cache
+def _samples(order: int) -> np.ndarray:
+    return np.linspace(-1.0, 1.0, 4 * order + 1)
+
+
+def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray):
+    """Parameter u* of the point of panel ``pan`` nearest to (xq, rq), and the distance in
+    the panel's parameter, du = distance / |dy/du| at u*.
+
+    Sampled, then refined by Newton's method where the nearest sample is interior (an end
+    of the panel, the usual case for neighbouring panels, is taken as it is)."""
+    samples = _samples(ps.order)
+    x, r, xu, ru = ps.evaluate(pan[:, None], samples[None, :])
+    d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
+    j = np.argmin(d2, axis=1)
+    rows = np.arange(len(pan))
+    u = samples[j]
+    du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
+    inner = np.nonzero((j > 0) & (j < len(samples) - 1))[0]
+    if inner.size:
+        ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
+        for _ in range(3):  # Newton on (y(u) - x) . y'(u) = 0
+            x, r, xu, ru, xuu, ruu = ps.evaluate(pi, ui, second=True)
+            ex, er = x - xi, r - ri
+            f = ex * xu + er * ru
+            fp = xu * xu + ru * ru + ex * xuu + er * ruu
+            step = np.where(fp > 0, f / np.where(fp > 0, fp, 1.0), 0.0)
+            ui = np.clip(ui - step, -1.0, 1.0)
+        x, r, xu, ru = ps.evaluate(pi, ui)
+        u[inner] = ui
+        du[inner] = np.hypot(x - xi, r - ri) / np.hypot(xu, ru)
+    return u, du
+
+
+def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.ndarray | None = None):
+    """(target, panel) pairs needing graded quadrature, with the panel point u* nearest to
+    the target and its distance in the panel's parameter.
+
+    The image of the target in the axis, (x, -r), counts as well: the ring kernels,
+    continued analytically through the axis, are singular there, which matters for
+    panels touching the axis and targets close to it.
+    """
+    cx, cr = ps.centers
+    reach = NEAR_FACTOR * ps.lengths[None, :]
+    near = np.hypot(xt[:, None] - cx[None, :], rt[:, None] - cr[None, :]) < reach
+    near_img = np.hypot(xt[:, None] - cx[None, :], rt[:, None] + cr[None, :]) < reach
+    if exclude_panel is not None:
+        rows = np.arange(len(xt))
+        near[rows, exclude_panel] = False
+        near_img[rows, exclude_panel] = False
+    tgt, pan = np.nonzero(near | near_img)
+    if tgt.size == 0:
+        return tgt, pan, np.empty(0), np.empty(0)
+    u, du = closest_points(ps, pan, xt[tgt], rt[tgt])
+    img = np.nonzero(near_img[tgt, pan])[0]
+    if img.size:
+        u_img, du_img = closest_points(ps, pan[img], xt[tgt[img]], -rt[tgt[img]])
+        use = du_img < du[img]
+        u[img[use]] = u_img[use]
+        du[img[use]] = du_img[use]
+    return tgt, pan, u, du
+
+
+def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
+    """Dyadic levels so that the innermost piece of a side is no longer than du."""
+    with np.errstate(divide="ignore", invalid="ignore"):
+        lev = np.ceil(np.log2(side / du))
+    lev = np.where(side <= 0, 0, np.where(np.isfinite(lev), lev, MAX_LEVELS))
+    return np.clip(lev, 0, MAX_LEVELS).astype(int)
+
+
+def near_rules(ustar: np.ndarray, du: np.ndarray):
+    """Yield (selection, u, w): graded rules on [-1, 1] split at u*, grouped by level counts.
+
+    ``u`` and ``w`` are (n, Q) arrays, or shared (Q,) arrays when the nearest point is an
+    end of the panel for the whole group."""
+    left, right = 1.0 + ustar, 1.0 - ustar
+    lev_l, lev_r = _levels(left, du), _levels(right, du)
+    # nearest point at an end of the panel (adjacent panels): one-sided rule, shared nodes
+    end = np.where(left <= 0, -1, np.where(right <= 0, 1, 0))
+    key = (lev_l * (MAX_LEVELS + 1) + lev_r) * 3 + end + 1
+    for k in np.unique(key):
+        sel = np.nonzero(key == k)[0]
+        e = int(k % 3) - 1
+        levs = k // 3
+        if e == -1:
+            s, w = dyadic_rule(int(levs % (MAX_LEVELS + 1)), N_NEAR)
+            yield sel, -1.0 + 2.0 * s, 2.0 * w
+        elif e == 1:
+            s, w = dyadic_rule(int(levs // (MAX_LEVELS + 1)), N_NEAR)
+            yield sel, 1.0 - 2.0 * s, 2.0 * w
+        else:
+            sl, wl = dyadic_rule(int(levs // (MAX_LEVELS + 1)), N_NEAR)
+            sr, wr = dyadic_rule(int(levs % (MAX_LEVELS + 1)), N_NEAR)
+            us, L, Rr = ustar[sel, None], left[sel, None], right[sel, None]
+            u = np.concatenate([us - L * sl, us + Rr * sr], axis=1)
+            w = np.concatenate([L * wl, Rr * wr], axis=1)
+            yield sel, u, w
+
+
+# ------------------------------------------------------------------------------------
+# assembly of (**)
+
+
+def _flat_nodes(ps: PanelSet):
+    g = ps.nodes
+    return g.x.ravel(), g.r.ravel(), g.tr.ravel(), -g.tx.ravel(), g.w.ravel()
+
+
+def assemble(ps: PanelSet) -> tuple[np.ndarray, np.ndarray]:
+    """Matrices (Smat, Dmat) of the single and double layer at the primary nodes.
+
+    Columns of mirror nodes are already folded onto their images, so both are
+    (N, N) with N = n_primary * p, and (**) reads (I/2 - Dmat) phi = -Smat g.
+    """
+    p = ps.order
+    X, R, NX, NR, W = _flat_nodes(ps)
+    N = ps.n_primary * p
+    xt, rt = X[:N], R[:N]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        S, D = single_double(xt[:, None], rt[:, None], X[None, :], R[None, :], NX[None, :], NR[None, :])
+    S *= W[None, :]
+    D *= W[None, :]
+    gauss_u, _ = gauss_legendre(p)
+    own_panel = np.arange(N) // p
+
+    # self panels: product integration of the logarithm
+    q = np.arange(N) % p
+    S_self, D_self = _self_block(ps, xt, rt, own_panel, q, gauss_u)
+    cols = own_panel[:, None] * p + np.arange(p)[None, :]
+    rows = np.arange(N)[:, None]
+    S[rows, cols] = S_self
+    D[rows, cols] = D_self
+
+    # nearly singular panels: dyadically graded rules
+    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
+    if tgt.size:
+        Sn, Dn = _near_blocks(ps, xt[tgt], rt[tgt], pan, ustar, du, gauss_u, want="layers")
+        cols = pan[:, None] * p + np.arange(p)[None, :]
+        S[tgt[:, None], cols] = Sn
+        D[tgt[:, None], cols] = Dn
+
+    mirror = ps.mirror_node_index()
+    if mirror.size:
+        S = S[:, :N] + S[:, mirror]
+        D = D[:, :N] + D[:, mirror]
+    return S, D
+
+
+@functools.cache
+def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
+    """Self rules for the p nodes of a panel, graded dyadically towards the node.
+
+    For node u_q, each side [u_q, end] of length h is cut into pieces
+    [0, 2^-L h], [2^-L h, 2^-(L-1) h], ..., [h/2, h] (L = 0: one piece).  The innermost
+    piece carries the log split (Gauss-Legendre nodes for the smooth part with weights w
+    and wl = -ln(piece length) w, and -ln(s) Gauss nodes for the logarithm); the outer
+    pieces integrate the full kernel.  Returns arrays indexed by q, and the Lagrange
+    matrices of each node set.
+    """
+    uq_all, _ = gauss_legendre(p)
+    g, gw = gauss_legendre(n)
+    g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
+    t01, tw01 = gauss_log(n)
+    out = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
+    for uq in uq_all:
+        su, sw, swl, lu, lw, fu, fw = ([] for _ in range(7))
+        for h, sign, lev in ((1.0 - uq, 1.0, lev_right), (1.0 + uq, -1.0, lev_left)):
+            inner = h * 2.0**-lev
+            su.append(uq + sign * inner * g01)
+            sw.append(inner * gw01)
+            swl.append(-math.log(inner) * inner * gw01)
+            lu.append(uq + sign * inner * t01)
+            lw.append(inner * tw01)
+            for k in range(lev, 0, -1):
+                a = h * 2.0**-k
+                fu.append(uq + sign * (a + a * g01))
+                fw.append(a * gw01)
+        for key, parts in zip(out, (su, sw, swl, lu, lw, fu, fw)):
+            out[key].append(np.concatenate(parts) if parts else np.empty(0))
+    table = {k: np.array(v) for k, v in out.items()}
+    for k in ("su", "lu", "fu"):
+        table["L" + k] = lagrange_matrix(uq_all, table[k])
+    return table
+
+
+def _self_block(ps, xt, rt, panel, q, gauss_u):
+    """Integrals of the kernels times l_j over each target's own panel (log singular).
+
+    Where the target is close to the axis its image (x, -r) makes the kernels nearly
+    singular too; the rule is then graded towards the target so that the innermost
+    piece stays IMAGE_MARGIN times shorter than the distance to the image."""
+    N, p = len(xt), ps.order
+    uq = gauss_u[q]
+    lev_r = np.zeros(N, dtype=int)
+    lev_l = np.zeros(N, dtype=int)
+    cx, cr = ps.centers
+    close = np.nonzero(np.hypot(xt - cx[panel], rt + cr[panel]) < (IMAGE_MARGIN + 1) * ps.lengths[panel])[0]
+    if close.size:
+        # one rule for all targets near the axis (the most graded one): few groups, fast
+        _, du_img = closest_points(ps, panel[close], xt[close], -rt[close])
+        lev_r[close] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN).max()
+        lev_l[close] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN).max()
+    S_blk = np.empty((N, p))
+    D_blk = np.empty((N, p))
+    key = lev_r * (MAX_LEVELS + 1) + lev_l
+    for k in np.unique(key):
+        sel = np.nonzero(key == k)[0]
+        t = _self_rule_table(p, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
+        qs = q[sel]
+        pan = panel[sel, None]
+        X, R, U = xt[sel, None], rt[sel, None], uq[sel, None]
+        # innermost pieces: smooth part K + ln|u - u_q| Q, plus Q against the log weight
+        su = t["su"][qs]
+        x, r, xu, ru = ps.evaluate(pan, su)
+        J = np.hypot(xu, ru)
+        S, D, QS, QD = single_double_split(X, R, x, r, ru / J, -xu / J)
+        lnu = np.log(np.abs(su - U))
+        sw, swl = t["sw"][qs], t["swl"][qs]
+        Lg = t["Lsu"][qs]
+        Sb = np.einsum("nq,nqj->nj", (sw * (S + lnu * QS) + swl * QS) * J, Lg)
+        Db = np.einsum("nq,nqj->nj", (sw * (D + lnu * QD) + swl * QD) * J, Lg)
+        x, r, xu, ru = ps.evaluate(pan, t["lu"][qs])
+        J = np.hypot(xu, ru)
+        _, _, QS, QD = single_double_split(X, R, x, r, ru / J, -xu / J)
+        lwJ = t["lw"][qs] * J
+        Lg = t["Llu"][qs]
+        Sb += np.einsum("nq,nqj->nj", lwJ * QS, Lg)
+        Db += np.einsum("nq,nqj->nj", lwJ * QD, Lg)
+        if t["fu"].shape[1]:
+            x, r, xu, ru = ps.evaluate(pan, t["fu"][qs])
+            J = np.hypot(xu, ru)
+            S, D = single_double(X, R, x, r, ru / J, -xu / J)
+            fwJ = t["fw"][qs] * J
+            Lg = t["Lfu"][qs]
+            Sb += np.einsum("nq,nqj->nj", fwJ * S, Lg)
+            Db += np.einsum("nq,nqj->nj", fwJ * D, Lg)
+        S_blk[sel] = Sb
+        D_blk[sel] = Db
+    return S_blk, D_blk
+
+
+def _near_blocks(ps, xt, rt, pan, ustar, du, gauss_u, want):
+    """Integrals of kernel * l_j over the panels ``pan`` for targets (xt, rt).
+
+    want="layers": (S, D) blocks; want="field": (S, D, Sx, Sr, Wx, Wr) blocks.
+    """
+    p = ps.order
+    n_out = 2 if want == "layers" else 6
+    out = [np.zeros((len(pan), p)) for _ in range(n_out)]
+    for sel, u, w in near_rules(ustar, du):
+        shared = u.ndim == 1
+        x, r, xu, ru = ps.evaluate(pan[sel, None], u[None, :] if shared else u)
+        J = np.hypot(xu, ru)
+        wJ = w * J
+        Lg = lagrange_matrix(gauss_u, u)
+        X, Rr = xt[sel, None], rt[sel, None]
+        kernels = list(single_double(X, Rr, x, r, ru / J, -xu / J))
+        if want == "field":
+            kernels += list(gradient_kernels(X, Rr, x, r))
+        for k, ker in enumerate(kernels):
+            out[k][sel] = (wJ * ker) @ Lg if shared else np.einsum("nq,nqj->nj", wJ * ker, Lg)
+    return out
+
+
+# ------------------------------------------------------------------------------------
+# solution
+
+
+@dataclass(frozen=True)
+class SurfaceNodes:
+    """Surface data at the unknowns (primary surface only), flat arrays.
+
+    weight: the surface element 2 pi r ds of each node's quadrature weight [m^2];
+    g = dphi/dn (= -n_x on the projectile, 0 on shank and hole); grad2 = |grad phi|^2.
+    """
+
+    x: np.ndarray
+    r: np.ndarray
+    nx: np.ndarray
+    nr: np.ndarray
+    weight: np.ndarray
+    phi: np.ndarray
+    dphi_ds: np.ndarray
+    g: np.ndarray
+
+    @property
+    def grad2(self) -> np.ndarray:
+        return self.dphi_ds**2 + self.g**2
+
+    @property
+    def dphi_dx(self) -> np.ndarray:
+        """x-derivative of phi on the surface: tangential plus normal parts."""
+        tx, tr = -self.nr, self.nx
+        return self.dphi_ds * tx + self.g * self.nx
+
+
+@dataclass(frozen=True)
+class SurfaceSolution:
+    """phi on a body (or on a penetrating nose and its free-surface image) and the field.
+
+    ``kind`` is "body" (closed body in unbounded fluid) or "halfspace" (target x >= 0,
+    tip at x = depth).  Unit speed: multiply phi by u(t) for Phi of Part I, eq. (5).
+    """
+
+    panels: PanelSet
+    phi_nodes: np.ndarray  # (n_primary, p)
+    g_nodes: np.ndarray  # (n_primary, p)
+    kind: str
+    depth: float | None = None
+    volume: float | None = None
+
+    @property
+    def unknowns(self) -> int:
+        return self.phi_nodes.size
+
+    @cached_property
+    def nodes(self) -> SurfaceNodes:
+        ps = self.panels
+        n = ps.n_primary
+        g = ps.nodes
+        J = g.J[:n]
+        dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
+        return SurfaceNodes(
+            x=g.x[:n].ravel(),
+            r=g.r[:n].ravel(),
+            nx=g.tr[:n].ravel(),
+            nr=-g.tx[:n].ravel(),
+            weight=(2 * math.pi * g.r[:n] * g.w[:n]).ravel(),
+            phi=self.phi_nodes.ravel(),
+            dphi_ds=dphi_ds.ravel(),
+            g=self.g_nodes.ravel(),
+        )
+
+    @property
+    def A(self) -> float:
+        """A = integral of phi n_x dS over the (primary) surface: Part I, eq. (12) [m^3]."""
+        s = self.nodes
+        return float(np.sum(s.weight * s.phi * s.nx))
+
+    @property
+    def C(self) -> float:
+        """C = integral of n_x dS: Part I, eq. (12) [m^2] (the projected contact area)."""
+        s = self.nodes
+        return float(np.sum(s.weight * s.nx))
+
+    @property
+    def added_mass_coefficient(self) -> float:
+        """Added mass over rho V (closed bodies only)."""
+        if self.volume is None:
+            raise ValueError("added mass coefficient is defined for closed bodies")
+        return self.A / self.volume
+
+    @property
+    def phi_tip(self) -> float:
+        """phi at the front pole (the nose tip): the first panel's interpolant at u = -1."""
+        u, _ = gauss_legendre(self.panels.order)
+        return float(lagrange_matrix(u, np.array([-1.0]))[0] @ self.phi_nodes[0])
+
+    # --- field ------------------------------------------------------------------------
+
+    @cached_property
+    def _sources(self):
+        """Densities on all panels (mirror images included): phi, g and dphi/ds."""
+        ps = self.panels
+        phi, g = self.phi_nodes, self.g_nodes
+        if ps.n_panels > ps.n_primary:
+            phi = np.concatenate([phi, phi[::-1, ::-1]])
+            g = np.concatenate([g, g[::-1, ::-1]])
+        omega = (phi @ differentiation_matrix(ps.order).T) / ps.nodes.J
+        return phi, g, omega
+
+    def _field(self, points, gradient: bool):
+        pts = np.atleast_2d(np.asarray(points, dtype=float))
+        if pts.shape[-1] != 2:
+            raise ValueError("points must have shape (M, 2): (x, r)")
+        xt, rt = pts[:, 0], np.abs(pts[:, 1])
+        ps = self.panels
+        p = ps.order
+        phi, g, omega = (a.ravel() for a in self._sources)
+        X, R, NX, NR, W = _flat_nodes(ps)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            if gradient:
+                Sx, Sr, Wx, Wr = gradient_kernels(xt[:, None], rt[:, None], X[None, :], R[None, :])
+                gx = (Wx * omega - Sx * g) * W
+                gr = (Wr * omega - Sr * g) * W
+            else:
+                S, D = single_double(xt[:, None], rt[:, None], X[None, :], R[None, :], NX[None, :], NR[None, :])
+                val = (D * phi - S * g) * W
+        tgt, pan, ustar, du = near_pairs(ps, xt, rt)
+        if tgt.size:
+            blocks = _near_blocks(ps, xt[tgt], rt[tgt], pan, ustar, du, gauss_legendre(p)[0], want="field")
+            cols = pan[:, None] * p + np.arange(p)[None, :]
+            if gradient:
+                _, _, bSx, bSr, bWx, bWr = blocks
+                gx[tgt[:, None], cols] = bWx * omega[cols] - bSx * g[cols]
+                gr[tgt[:, None], cols] = bWr * omega[cols] - bSr * g[cols]
+            else:
+                bS, bD = blocks[:2]
+                val[tgt[:, None], cols] = bD * phi[cols] - bS * g[cols]
+        if gradient:
+            out = np.column_stack([gx.sum(axis=1), gr.sum(axis=1)])
+            out[:, 1] *= np.sign(np.where(pts[:, 1] < 0, -1.0, 1.0))
+            return out
+        return val.sum(axis=1)
+
+    def potential(self, points) -> np.ndarray:
+        """phi at field points (M, 2) of (x, r) in the fluid (Part I, eq. (20) / (*))."""
+        return self._field(points, gradient=False)
+
+    def gradient(self, points) -> np.ndarray:
+        """(dphi/dx, dphi/dr) at field points; the velocity is v = -u grad(phi): Part I, eqs. (8), (23)."""
+        return self._field(points, gradient=True)
+
+
+def solve_panels(ps: PanelSet, kind: str, *, depth: float | None = None, volume: float | None = None) -> SurfaceSolution:
+    """Assemble and solve (**) for unit motion in +x (g = -n_x)."""
+    S, D = assemble(ps)
+    N = S.shape[0]
+    g = -ps.nodes.tr[: ps.n_primary].ravel()
+    A = 0.5 * np.eye(N) - D
+    phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
+    shape = (ps.n_primary, ps.order)
+    return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), kind, depth=depth, volume=volume)
