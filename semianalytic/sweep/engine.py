@@ -155,6 +155,21 @@ def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
     return rows  # type: ignore[return-value]
 
 
+def warm_up() -> bool:
+    """Import the models and build the unit registry in a worker before the clock starts."""
+    import importlib
+
+    from semianalytic.units import registry
+
+    registry()
+    for m in ("semianalytic.case", "semianalytic.penetration", "semianalytic.cavity"):
+        try:
+            importlib.import_module(m)
+        except ImportError:
+            pass
+    return True
+
+
 # --------------------------------------------------------------------------------------
 # client side
 
@@ -313,6 +328,7 @@ def run_sweep(
                     raise InputError("--scheduler", f"cannot connect to the dask scheduler {sched!r}: {exc}") from None
             summary.scheduler = sched
             summary.workers = len(client.scheduler_info().get("workers", {})) or workers
+            client.run(warm_up)
             futures = {k: client.submit(kernel.prepare, c, pure=False) for k, c in rcases.items()}
             resources = {k: f.result() for k, f in futures.items()}
         summary.seconds_prepare = time.perf_counter() - t_prep

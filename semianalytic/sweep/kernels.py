@@ -167,7 +167,8 @@ class CavityKernel:
     def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
         from semianalytic.cavity import BrittleMaterial, solve_cavity
 
-        r = solve_cavity(BrittleMaterial.from_section(case.require("material")))
+        sec = case.require("material")
+        r = solve_cavity(BrittleMaterial.from_section(sec), sec.solver, warn=False)
         return {
             "cavity_pressure_Pa": np.array([r.cavity_pressure]),
             "sigma_star_Pa": np.array([r.sigma_star]),
