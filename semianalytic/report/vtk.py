@@ -337,12 +337,14 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
     half = vol.clip(normal=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0))
     p = pv.Plotter(off_screen=True, window_size=list(window))
     p.set_background("white")
-    p.add_mesh(half, scalars="speed", cmap="viridis", show_scalar_bar=True,
-               scalar_bar_args={"title": "|v| [m/s]", "color": "black", "vertical": True,
+    speed_all = np.asarray(vol.point_data["speed"])
+    top = float(np.nanpercentile(speed_all, 98)) if speed_all.size else 1.0
+    p.add_mesh(half, scalars="speed", cmap="viridis", show_scalar_bar=True, clim=[0.0, max(top, 1e-30)],
+               scalar_bar_args={"title": "speed |v| [m/s]", "color": "black", "vertical": True,
                                 "position_x": 0.86, "position_y": 0.15, "height": 0.7})
     mer = pv.read(str(meridian_path))
     if mer.n_points:
-        step = max(1, mer.n_points // 250)
+        step = max(1, mer.n_points // 300)
         pts = np.asarray(mer.points)[::step]
         vel = np.asarray(mer.point_data["velocity"])[::step]
         pts = np.vstack([pts, pts * [1.0, -1.0, 1.0]])
@@ -360,7 +362,8 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
     if title:
         p.add_text(title, font_size=10, color="black")
     p.view_xy()
-    p.camera.zoom(1.25)
+    p.reset_camera(bounds=vol.bounds)
+    p.camera.zoom(1.1)
     png_path = Path(png_path)
     png_path.parent.mkdir(parents=True, exist_ok=True)
     p.screenshot(str(png_path))
