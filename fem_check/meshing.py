@@ -12,7 +12,8 @@ Two domains (Part I, section 1.2 and Fig. 1; sign conventions of errata item 1b)
   source, errata item 2f).
 
 Boundary tags: ``body`` (Neumann -n_x), ``wall`` (hole and shank, 0), ``free`` (x = 0, 0),
-``axis`` (r = 0, natural), ``far`` (Robin far field).  Elements are graded towards the
+``axis`` (r = 0, natural), ``far`` (Robin far field).  A third domain, ``annulus_domain``, is
+the quarter annulus around a spherical cavity for the elastic problems of Part II.  Elements are graded towards the
 nose tip, the nose-shank junction and the free-surface corner or waterline.  Quadratic
 meshes (``order=2``) carry curved (isoparametric) boundary edges; every node of a curved
 boundary is moved onto the exact meridian curve of :mod:`semianalytic.geometry`.
@@ -41,7 +42,7 @@ from skfem import MeshTri1, MeshTri2
 from semianalytic.errors import InputError
 from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, SplineCurve
 
-MESH_FORMAT_VERSION = 3  # bump when the domain construction changes (invalidates the cache)
+MESH_FORMAT_VERSION = 4  # bump when the domain construction changes (invalidates the cache)
 
 # ------------------------------------------------------------------------------------
 # curve pieces
@@ -166,12 +167,14 @@ class Domain:
     length_scale: float
     refine_points: tuple[tuple[float, float], ...]
     info: dict = field(default_factory=dict, compare=False)
+    interfaces: tuple[tuple[str, Piece], ...] = ()  # curves embedded in the domain (material interfaces)
 
     def key(self, options: MeshOptions) -> str:
         blob = {
             "version": MESH_FORMAT_VERSION,
             "kind": self.kind,
             "loop": [(tag, p.describe()) for tag, p in self.loop],
+            "interfaces": [(tag, p.describe()) for tag, p in self.interfaces],
             "far": [self.far_center, self.far_radius],
             "scale": self.length_scale,
             "refine": self.refine_points,
@@ -260,6 +263,30 @@ def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
     return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info)
 
 
+def annulus_domain(a: float, outer: float, options: MeshOptions, interface: float | None = None) -> Domain:
+    """Quarter annulus a <= R <= outer in the meridian plane (x >= 0, r >= 0) around a spherical
+    cavity of radius a (Part II, Fig. 1): tags ``cavity`` (R = a), ``far`` (R = outer),
+    ``axis`` (r = 0) and ``sym`` (x = 0, symmetry plane); optional embedded arc ``interface``
+    at R = ``interface`` (the crack front r = c of Part II), splitting axis and plane there."""
+    if not 0 < a < outer:
+        raise InputError("cavity.radius", f"need 0 < a < outer radius; got a={a!r}, outer={outer!r}")
+    radii = [a] + ([float(interface)] if interface is not None else []) + [outer]
+    if interface is not None and not a < interface < outer:
+        raise InputError("cavity.interface", f"must lie between a and the outer radius; got {interface!r}")
+    pieces: list[tuple[str, Piece]] = []
+    for r0, r1 in zip(radii[:-1], radii[1:]):
+        pieces.append(("axis", _line((r0, 0.0), (r1, 0.0))))
+    pieces.append(("far", _far_arc((0.0, 0.0), outer, 0.0, 0.5 * math.pi)))
+    for r0, r1 in zip(radii[::-1][:-1], radii[::-1][1:]):
+        pieces.append(("sym", _line((0.0, r0), (0.0, r1))))
+    pieces.append(("cavity", _far_arc((0.0, 0.0), a, 0.5 * math.pi, 0.0)))
+    interfaces = ()
+    if interface is not None:
+        interfaces = (("interface", _far_arc((0.0, 0.0), float(interface), 0.0, 0.5 * math.pi)),)
+    return Domain("annulus", tuple(pieces), (0.0, 0.0), outer, 2.0 * a, (), {"a": a, "outer": outer, "interface": interface},
+                  interfaces)
+
+
 # ------------------------------------------------------------------------------------
 # gmsh
 
@@ -309,44 +336,52 @@ def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
             point_tags[key] = tag
             return tag
 
+        def curve(piece: Piece) -> int:
+            a, b = point(piece.start), point(piece.end)
+            if piece.straight:
+                return geo.addLine(a, b)
+            if isinstance(piece.segment, Arc) and piece.shift == 0.0 and abs(piece.t1 - piece.t0) < 0.99 * math.pi:
+                cx, cr = piece.segment.center
+                return geo.addCircleArc(a, geo.addPoint(cx, cr, 0.0, h), b)
+            ts = np.linspace(piece.t0, piece.t1, 97)[1:-1]
+            xs, rs = piece.point(ts)
+            inner = [geo.addPoint(float(x), float(r), 0.0, h) for x, r in zip(xs, rs)]
+            return geo.addSpline([a, *inner, b])
+
         curves: list[int] = []
         groups: dict[str, list[int]] = {}
         for i, (tag, piece) in enumerate(domain.loop):
-            a, b = point(piece.start), point(piece.end)
-            if piece.straight:
-                c = geo.addLine(a, b)
-            elif tag == "far":
-                cx, cr = piece.segment.center
-                ctag = geo.addPoint(cx, cr, 0.0, h)
-                c = geo.addCircleArc(a, ctag, b)
-            else:
-                ts = np.linspace(piece.t0, piece.t1, 97)[1:-1]
-                xs, rs = piece.point(ts)
-                inner = [geo.addPoint(float(x), float(r), 0.0, h) for x, r in zip(xs, rs)]
-                c = geo.addSpline([a, *inner, b])
-            curves.append(c)
-            groups.setdefault(f"{tag}#{i}", []).append(c)
+            curves.append(curve(piece))
+            groups.setdefault(f"{tag}#{i}", []).append(curves[-1])
+        embedded = []
+        for j, (tag, piece) in enumerate(domain.interfaces):
+            embedded.append(curve(piece))
+            groups.setdefault(f"{tag}#{len(domain.loop) + j}", []).append(embedded[-1])
         loop = geo.addCurveLoop(curves)
         surf = geo.addPlaneSurface([loop])
         geo.synchronize()
+        if embedded:
+            gmsh.model.mesh.embed(1, embedded, 2, surf)
         for name, tags in groups.items():
             gmsh.model.addPhysicalGroup(1, tags, name=name)
         gmsh.model.addPhysicalGroup(2, [surf], name="fluid")
 
         # size field: h d on the body, h d corner at the singular points, growing like h (d + g s)
         fm = gmsh.model.mesh.field
-        body_curves = [c for c, (tag, _) in zip(curves, domain.loop) if tag == "body"]
+        body_curves = [c for c, (tag, _) in zip(curves, domain.loop) if tag in ("body", "cavity")]
         f1 = fm.add("Distance")
         fm.setNumbers(f1, "CurvesList", body_curves)
         fm.setNumber(f1, "Sampling", 400)
-        corner_pts = [point(p) for p in domain.refine_points]
-        f2 = fm.add("Distance")
-        fm.setNumbers(f2, "PointsList", corner_pts)
         hc = h * options.corner
         g = options.h * options.growth
         hmax = 0.25 * domain.far_radius
         f3 = fm.add("MathEval")
-        fm.setString(f3, "F", f"Min({hmax}, Min({h} + {g}*F{f1}, {hc} + {g}*F{f2}))")
+        if domain.refine_points:
+            f2 = fm.add("Distance")
+            fm.setNumbers(f2, "PointsList", [point(p) for p in domain.refine_points])
+            fm.setString(f3, "F", f"Min({hmax}, Min({h} + {g}*F{f1}, {hc} + {g}*F{f2}))")
+        else:
+            fm.setString(f3, "F", f"Min({hmax}, {h} + {g}*F{f1})")
         fm.setAsBackgroundMesh(f3)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)
@@ -419,8 +454,8 @@ def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):
         mesh = MeshTri2(np.ascontiguousarray(p), np.ascontiguousarray(tri.T))
     # boundary facets from the physical line groups
     bf = mesh.boundary_facets()
-    fv = np.sort(mesh.facets[:, bf], axis=0)
-    lookup = {(int(a), int(b)): int(f) for a, b, f in zip(fv[0], fv[1], bf)}
+    fv = np.sort(mesh.facets, axis=0)
+    lookup = {(int(a), int(b)): f for f, (a, b) in enumerate(zip(fv[0].tolist(), fv[1].tolist()))}
     phys = msh.cell_data_dict["gmsh:physical"][ltype]
     names = {int(v[0]): k for k, v in msh.field_data.items() if v[1] == 1}
     lines = cells[ltype][:, :2]
@@ -431,8 +466,9 @@ def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):
         pieces.setdefault(idx, []).append(lookup[key])
     pieces_arr = {k: np.array(v, dtype=np.int64) for k, v in pieces.items()}
     boundaries: dict[str, list] = {}
+    curves = domain.loop + domain.interfaces
     for idx, facets in pieces_arr.items():
-        boundaries.setdefault(domain.loop[idx][0], []).append(facets)
+        boundaries.setdefault(curves[idx][0], []).append(facets)
     boundaries_arr = {k: np.concatenate(v) for k, v in boundaries.items()}
     missing = set(bf) - set(np.concatenate(list(boundaries_arr.values())).tolist())
     if missing:
@@ -443,8 +479,9 @@ def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):
 def _snap_curved(dm: DomainMesh) -> DomainMesh:
     """Move every node of a curved boundary piece onto the exact curve."""
     doflocs = dm.mesh.doflocs.copy()
+    curves = dm.domain.loop + dm.domain.interfaces
     for idx, facets in dm.pieces.items():
-        tag, piece = dm.domain.loop[idx]
+        tag, piece = curves[idx]
         if piece.straight:
             continue
         nodes = dm.facet_nodes(facets)

@@ -117,7 +117,8 @@ class PotentialSolution:
         """Quadrature-point data on a boundary: x, r, nx, nr (body normal n = -nu, into the fluid),
         weight (dS including 2 pi r), phi, dphi_ds (along t = (-n_r, n_x)) and grad2 = |grad phi|^2.
 
-        The gradient is rebuilt from the exact Neumann datum dphi/dn = -n_x and the tangential
+        The gradient is rebuilt from the exact Neumann datum (dphi/dn = -n_x on the body, 0 on the
+        free surface, the hole wall and the shank) and the tangential
         derivative of the FEM trace, which is more accurate than the FEM normal derivative.
         """
         facets = self.dm.boundaries[tag]
@@ -129,7 +130,7 @@ class PotentialSolution:
         tx, tr = -nr, nx
         gx, gr = ph.grad
         dphi_ds = tx * gx + tr * gr
-        dn = -nx  # exact Neumann datum
+        dn = -nx if tag == "body" else np.zeros_like(nx)  # exact Neumann datum (Part I, eq. (7))
         grad2 = dn * dn + dphi_ds * dphi_ds
         dphi_dx = dn * nx + dphi_ds * tx
         weight = 2 * math.pi * r * fb.dx

@@ -1,0 +1,201 @@
+"""Drag coefficients A, B, C (Part I, eq. (12)) and added masses from FEM potentials.
+
+Half-space (nose at depth P, target frame, errata item 1b):
+
+* A = int phi n_x dS and C = int n_x dS over the wetted nose (Part I, eq. (12)).
+* B (Part I, eqs. (9), (12)) in the three readings of errata item 2a, from three
+  surface integrals over the wetted nose and one derivative in P:
+
+      G = int |grad phi|^2 n_x dS,   H = int (dphi/dx) n_x dS,   Q = int (D phi/D P) n_x dS,
+
+  where D/DP follows a point fixed on the projectile.  Q comes from dA/dP: differentiating
+  A(P) = int phi n_x dS over the wetted part of the body gives
+  dA/dP = Q + 2 pi phi_w r_w |dr/dx|_w, the last term (waterline, only while P < L_h) from the
+  growth of the wetted surface.  dA/dP itself is a central difference of A between solves at
+  P - eps and P + eps on the *same* mesh topology, the nodes moved with the body (a shape
+  finite difference: no remeshing noise).  Since phi'_P at a fixed target point is
+  D phi/D P - dphi/dx:
+
+      B_body      = G + 2 Q                       (default; errata 2a "body")
+      B_literal   = G + 2 (Q - H)                 (phi'_P at a fixed target point, as I-(9))
+      B_bernoulli = -G + 2 (Q - H)                (Lagrange-Cauchy with the corrected sign)
+
+  and errata 2a's identity B_bernoulli = dA/dP is then checked, not assumed.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+import time
+from dataclasses import dataclass
+
+import numpy as np
+import scipy.sparse.linalg as spla
+from skfem import Basis, BilinearForm
+from skfem.helpers import dot, grad
+
+from fem_check.meshing import DomainMesh, MeshOptions, body_domain, build_mesh, halfspace_domain
+from fem_check.potential import PotentialSolution, element_for, solve_potential
+from semianalytic.geometry import Meridian, Nose
+
+
+@BilinearForm
+def _laplace(u, v, w):
+    return dot(grad(u), grad(v))
+
+
+def _boundary_motion(dm: DomainMesh, eps: float) -> tuple[np.ndarray, np.ndarray]:
+    """Boundary geometry nodes and their positions for the nose moved from P to P + eps."""
+    dom = dm.domain
+    info = dom.info
+    P, Lh, Rf = info["depth"], info["nose_length"], dom.far_radius
+    pos = dm.mesh.doflocs
+    nodes_all, new_all = [], []
+    shallow = P < Lh * (1 - 1e-9)
+    if shallow:
+        from fem_check.meshing import _nose_waterline
+
+        nose = info["nose"]
+        k, tw = _nose_waterline(nose, P + eps)
+        if k != info["waterline_segment"]:
+            raise RuntimeError("the depth step crosses a joint of the nose profile; use a smaller step")
+        rw, rw_new = info["waterline_radius"], float(nose.segments[k].point(tw)[1])
+    for idx, facets in dm.pieces.items():
+        tag = dom.loop[idx][0]
+        nodes = dm.facet_nodes(facets)
+        x, r = pos[0, nodes].copy(), pos[1, nodes].copy()
+        if tag == "axis":
+            x = P + eps + (x - P) * (Rf - P - eps) / (Rf - P)
+        elif tag == "free" and shallow:
+            r = rw_new + (r - rw) * (Rf - rw_new) / (Rf - rw)
+        elif tag == "wall":
+            x = x * (P + eps - Lh) / (P - Lh)
+        elif tag == "body":
+            x = x + eps
+            if shallow:
+                w = np.abs(pos[0, nodes]) < 1e-12 * Rf
+                x[w], r[w] = 0.0, rw_new
+        nodes_all.append(nodes)
+        new_all.append(np.vstack([x, r]))
+    nodes = np.concatenate(nodes_all)
+    new = np.hstack(new_all)
+    # nodes shared by two pieces must get one position: keep the first (they agree at joints)
+    nodes, first = np.unique(nodes, return_index=True)
+    return nodes, new[:, first]
+
+
+def moved_mesh(dm: DomainMesh, eps: float, _cache: dict | None = None) -> DomainMesh:
+    """The mesh of depth P + eps with the topology of ``dm`` (harmonic extension of the boundary motion)."""
+    nodes, new = _boundary_motion(dm, eps)
+    basis = Basis(dm.mesh, element_for(dm.order))
+    if not np.allclose(basis.doflocs, dm.mesh.doflocs):
+        raise RuntimeError("geometry nodes and FEM dofs are numbered differently")
+    disp_b = new - dm.mesh.doflocs[:, nodes]
+    N = basis.N
+    interior = np.setdiff1d(np.arange(N), nodes)
+    K = _laplace.assemble(basis).tocsr()
+    lu = spla.splu(K[interior][:, interior].tocsc())
+    Kib = K[interior][:, nodes]
+    doflocs = dm.mesh.doflocs.copy()
+    doflocs[:, nodes] = new
+    for c in range(2):
+        doflocs[c, interior] += lu.solve(-(Kib @ disp_b[c]))
+    info = dict(dm.domain.info, depth=dm.domain.info["depth"] + eps)
+    moved = dm.with_doflocs(doflocs)
+    return dataclasses.replace(moved, domain=dataclasses.replace(dm.domain, info=info))
+
+
+@dataclass(frozen=True)
+class HalfspaceCoefficients:
+    """FEM coefficients at one depth (SI: m, m^3, m^2)."""
+
+    depth: float
+    A: float
+    C: float
+    B_body: float
+    B_literal: float
+    B_bernoulli: float
+    dA_dP: float
+    phi_tip: float
+    G: float  # int |grad phi|^2 n_x dS
+    H: float  # int dphi/dx n_x dS
+    Q: float  # int D phi/DP n_x dS
+    free_energy_flux: float  # -int_free |grad phi|^2 dS (equals G + 2H by the Maxwell-stress identity)
+    n_dofs: int
+    n_elements: int
+    seconds: float
+
+    def B(self, reading: str = "body") -> float:
+        return {"body": self.B_body, "literal": self.B_literal, "bernoulli": self.B_bernoulli}[reading]
+
+
+def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh:
+    dom = halfspace_domain(nose, depth, options)
+    dm = build_mesh(dom, options)
+    info = dict(dom.info, nose=nose)
+    return dataclasses.replace(dm, domain=dataclasses.replace(dom, info=info))
+
+
+def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None = None,
+                           step: float = 1e-3, far_field: str = "monopole") -> HalfspaceCoefficients:
+    """A, B (three readings), C, dA/dP and phi_tip of Part I, eq. (12) by FEM at depth P.
+
+    ``step``: the depth step of the shape finite difference, as a fraction of L_h.
+    """
+    options = options or MeshOptions()
+    t0 = time.perf_counter()
+    dm = halfspace_mesh(nose, depth, options)
+    sol = solve_potential(dm, far_field)
+    eps = step * nose.length
+    Ap = solve_potential(moved_mesh(dm, eps), far_field).A
+    Am = solve_potential(moved_mesh(dm, -eps), far_field).A
+    dA = (Ap - Am) / (2 * eps)
+    s = sol.surface("body")
+    G = float(np.sum(s["weight"] * s["grad2"] * s["nx"]))
+    H = float(np.sum(s["weight"] * s["dphi_dx"] * s["nx"]))
+    waterline = 0.0
+    info = dm.domain.info
+    if depth < nose.length * (1 - 1e-9):
+        seg = nose.segments[info["waterline_segment"]]
+        dx, dr = (float(v) for v in seg.derivative(info["waterline_t"]))
+        rw = info["waterline_radius"]
+        phi_w = sol.node_value((0.0, rw))
+        waterline = 2 * math.pi * phi_w * rw * abs(dr) / abs(dx)
+    Q = dA - waterline
+    free = sol.surface("free")
+    flux = -float(np.sum(free["weight"] * free["grad2"]))
+    return HalfspaceCoefficients(
+        depth=depth, A=sol.A, C=sol.C, B_body=G + 2 * Q, B_literal=G + 2 * (Q - H),
+        B_bernoulli=-G + 2 * (Q - H), dA_dP=dA, phi_tip=sol.node_value((depth, 0.0)),
+        G=G, H=H, Q=Q, free_energy_flux=flux, n_dofs=sol.n_dofs, n_elements=int(dm.mesh.t.shape[1]),
+        seconds=time.perf_counter() - t0,
+    )
+
+
+@dataclass(frozen=True)
+class AddedMass:
+    """FEM added mass of a closed body in unbounded fluid."""
+
+    A: float  # m^3 (added mass / rho)
+    volume: float  # m^3
+    n_dofs: int
+    n_elements: int
+    seconds: float  # solve only (mesh from cache or not)
+    mesh_seconds: float
+
+    @property
+    def coefficient(self) -> float:
+        """Added-mass coefficient A / V."""
+        return self.A / self.volume
+
+
+def body_added_mass(meridian: Meridian, options: MeshOptions | None = None, far_field: str = "dipole",
+                    use_cache: bool = True) -> AddedMass:
+    """Added mass of a closed body (Part I, eq. (12) for A with the unbounded-fluid problem)."""
+    options = options or MeshOptions()
+    t0 = time.perf_counter()
+    dm = build_mesh(body_domain(meridian, options), options, use_cache=use_cache)
+    t1 = time.perf_counter()
+    sol: PotentialSolution = solve_potential(dm, far_field)
+    return AddedMass(sol.A, meridian.volume(), sol.n_dofs, int(dm.mesh.t.shape[1]), time.perf_counter() - t1, t1 - t0)
