@@ -1,0 +1,112 @@
+"""Penetration sweeps: velocity-by-material grids on a dask LocalCluster and inline.
+
+With constant drag coefficients (the stand-in of Part IV eqs. (2)-(3)), eq. (11) has the
+closed-form final depth  P = (m + rho A)/(rho B) ln(1 + rho B U^2 / (2 C R_t)),  and R_t of
+eq. (16) is a closed form too; both are written out here, independent of the code under
+test.  One test runs on a real two-worker LocalCluster.
+"""
+
+from __future__ import annotations
+
+import math
+from pathlib import Path
+
+import numpy as np
+import pandas as pd
+import pytest
+
+from semianalytic.coefficients import ConstantCoefficients
+from semianalytic.sweep.engine import run_sweep
+from semianalytic.sweep.kernels import PenetrationKernel
+from semianalytic.sweep.spec import build_spec
+
+D = 7.11e-3
+COEF = ConstantCoefficients.from_normalised(1.0e-3, 0.11, 1.0, D)  # the paper's quoted ogive values
+CASE = """
+title = "ogive into aluminium, sweep test"
+[projectile]
+nose = "ogive"
+crh = 3.0
+diameter = "7.11 mm"
+shank_length = "59.3 mm"
+mass = "20.9 g"
+youngs_modulus = "210 GPa"
+poisson_ratio = 0.29
+yield_stress = "1.5 GPa"
+[target]
+density = "2710 kg/m^3"
+[target.resistance]
+model = "elastic-plastic"
+yield_stress = "400 MPa"
+youngs_modulus = "68.9 GPa"
+poisson_ratio = 0.33
+[impact]
+striking_velocities = ["1 km/s"]
+"""
+
+
+def _closed_form(U, Y, E=68.9e9, nu=0.33, rho=2710.0, m=20.9e-3):
+    R = 2.0 / 3.0 * Y * (1.0 + np.log(E / (3.0 * Y * (1.0 - nu))))  # Part I eq. (16)
+    return (m + rho * COEF.A_m3) / (rho * COEF.B_m2) * np.log1p(rho * COEF.B_m2 * U**2 / (2.0 * COEF.C_m2 * R))
+
+
+@pytest.fixture()
+def case_file(tmp_path):
+    p = tmp_path / "case.toml"
+    p.write_text(CASE)
+    return p
+
+
+def _check(df):
+    assert (df.status == "ok").all(), df[df.status != "ok"].message.head()
+    ref = _closed_form(df["impact.striking_velocity_m_s"].to_numpy(), df["target.resistance.yield_stress_Pa"].to_numpy())
+    # the ODE in P is integrated to rtol 1e-12; 1e-8 leaves room for the unit round trip and the root find
+    np.testing.assert_allclose(df.depth_rigid_m.to_numpy(), ref, rtol=1e-8)
+
+
+def test_velocity_by_material_inline(case_file, tmp_path):
+    spec = build_spec(["target.resistance.yield_stress=300:500:50 MPa", "impact.striking_velocity=500:1500:250 m/s"])
+    kernel = PenetrationKernel(coefficients=COEF)
+    s = run_sweep(case_file, spec, tmp_path / "sw", scheduler="inline", progress=False, kernel=kernel, batch_size=7)
+    assert s.n_ok == 25
+    _check(pd.read_csv(tmp_path / "sw" / "results.csv"))
+
+
+def test_velocity_by_material_on_a_local_cluster(case_file, tmp_path):
+    spec = build_spec(["target.resistance.yield_stress=300:500:25 MPa", "impact.striking_velocity=400:1600:100 m/s"])
+    kernel = PenetrationKernel(coefficients=COEF, full=True)
+    s = run_sweep(case_file, spec, tmp_path / "sw", workers=2, progress=False, kernel=kernel, batch_size=13)
+    assert s.scheduler == "local" and s.workers == 2
+    assert s.n_ok == 9 * 13
+    df = pd.read_csv(tmp_path / "sw" / "results.csv")
+    _check(df)
+    # the elastic projectile never penetrates deeper than the rigid one (Part I eq. (30))
+    assert (df.depth_elastic_m <= df.depth_rigid_m * (1 + 1e-12)).all()
+    # U_sC depends on the material only; yields <=> U_s >= U_sC
+    assert (df.yields == (df["impact.striking_velocity_m_s"] >= df.critical_velocity_m_s)).all()
+
+
+def test_case_velocities_become_an_axis_and_bad_draws_are_rows(case_file, tmp_path):
+    # without a velocity axis the case's own velocity is used; Monte-Carlo draws that make
+    # an invalid case (nu >= 0.5) are reported as invalid rows and the sweep goes on
+    spec = build_spec([], ["target.resistance.poisson_ratio=uniform(0.3, 0.7)"], 40, seed=5)
+    s = run_sweep(case_file, spec, tmp_path / "sw", scheduler="inline", progress=False,
+                  kernel=PenetrationKernel(coefficients=COEF))
+    df = pd.read_csv(tmp_path / "sw" / "results.csv")
+    nu = df["target.resistance.poisson_ratio"]
+    assert ((df.status == "invalid") == (nu >= 0.5)).all()
+    bad = df[df.status == "invalid"].message
+    assert bad.str.startswith("target.resistance").all() and bad.str.contains("poisson_ratio").all()
+    assert (df["impact.striking_velocity_m_s"] == 1000.0).all()
+    assert s.n_ok + s.n_invalid == 40 and s.n_ok > 0 and s.n_invalid > 0
+
+
+def test_invalid_grid_value_is_bad_input(case_file, tmp_path):
+    from semianalytic.errors import InputError
+
+    spec = build_spec(["target.resistance.yield_stress=400 MPa,40 GPa"])  # E < 3 Y (1 - nu) for eq. (16)
+    with pytest.raises(InputError) as err:
+        run_sweep(case_file, spec, tmp_path / "sw", scheduler="inline", progress=False,
+                  kernel=PenetrationKernel(coefficients=COEF))
+    assert err.value.field.startswith("target.resistance")
+    assert not (tmp_path / "sw").exists()
