@@ -45,6 +45,11 @@ class Line:
         one = np.ones_like(t)
         return ((self.p1[0] - self.p0[0]) * one, (self.p1[1] - self.p0[1]) * one)
 
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t), free of cancellation for small dt."""
+        dt = np.asarray(dt, dtype=float)
+        return ((self.p1[0] - self.p0[0]) * dt, (self.p1[1] - self.p0[1]) * dt)
+
     def second_derivative(self, t):
         z = np.zeros_like(np.asarray(t, dtype=float))
         return (z, z)
@@ -66,6 +71,13 @@ class Arc:
     def derivative(self, t):
         t = np.asarray(t, dtype=float)
         return (-self.radius * np.sin(t), self.radius * np.cos(t))
+
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t) by the half-angle formulas (no cancellation)."""
+        dt = np.asarray(dt, dtype=float)
+        s2 = 2.0 * self.radius * np.sin(0.5 * dt)
+        mid = t + 0.5 * dt
+        return (-s2 * np.sin(mid), s2 * np.cos(mid))
 
     def second_derivative(self, t):
         t = np.asarray(t, dtype=float)
@@ -89,6 +101,13 @@ class EllipseArc:
     def derivative(self, t):
         t = np.asarray(t, dtype=float)
         return (-self.a * np.sin(t), self.b * np.cos(t))
+
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t) by the half-angle formulas (no cancellation)."""
+        dt = np.asarray(dt, dtype=float)
+        s2 = 2.0 * np.sin(0.5 * dt)
+        mid = t + 0.5 * dt
+        return (-self.a * s2 * np.sin(mid), self.b * s2 * np.cos(mid))
 
     def second_derivative(self, t):
         t = np.asarray(t, dtype=float)
@@ -127,6 +146,12 @@ class SplineCurve:
     def derivative(self, t):
         _, sx, sr = self._splines
         return (sx(t, 1), sr(t, 1))
+
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t) (by difference: splines are not graded finely)."""
+        x0, r0 = self.point(t)
+        x1, r1 = self.point(np.asarray(t) + np.asarray(dt))
+        return (x1 - x0, r1 - r0)
 
     def second_derivative(self, t):
         _, sx, sr = self._splines

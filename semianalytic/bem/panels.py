@@ -1,14 +1,19 @@
 """Panels on a meridian: layouts (with grading) and node geometry.
 
-A panel is a parameter interval [ta, tb] of one analytic segment of the meridian, mapped
-from the reference interval u in [-1, 1].  Geometry is always evaluated on the exact curve
-(no interpolation of the shape).  A panel may be *mirrored* in the plane x = 0 (the
-image body S' of Part I, eqs. (21)-(22), Fig. 3): its x is negated and its parameter
-runs backwards so that the closed chain S + S' keeps one orientation.
+A panel is a parameter interval of one analytic segment of the meridian, mapped from the
+reference interval u in [-1, 1].  Geometry is always evaluated on the exact curve (no
+interpolation of the shape), and *relative to an anchor*: each panel stores the exact
+coordinates of the nearer end of its segment (a nose tip, a corner, the free-surface cut)
+and its parameter offsets from it, so that panels graded down to 1e-9 of the body size
+keep full relative precision.
 
-Layouts grade panels geometrically towards points where the solution is singular
-(conical tips, corners, the edge where a nose crosses the free surface) and grow them
-geometrically along a long shank, so that accuracy is uniform with few unknowns.
+A panel may be *mirrored* in the plane x = 0 (the image body S' of Part I, eqs. (21)-(22),
+Fig. 3): its x is negated and its parameter runs backwards so that the closed chain S + S'
+keeps one orientation.
+
+Layouts grade panels geometrically towards points where the solution is singular (conical
+tips, corners, the edge where a nose crosses the free surface) and grow them geometrically
+along a long shank, so that accuracy is uniform with few unknowns.
 """
 
 from __future__ import annotations
@@ -21,7 +26,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from semianalytic.bem.quadrature import gauss_legendre
-from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, Segment, SplineCurve
+from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc
 
 GRADING_RATIO = 0.2  # size ratio between successive graded panels (hp-type grading)
 
@@ -30,16 +35,22 @@ GRADING_RATIO = 0.2  # size ratio between successive graded panels (hp-type grad
 class PanelSet:
     """Panels over one or more segments.
 
-    ``segment_index[k]``, ``ta[k]``, ``tb[k]`` locate panel k; ``sign[k]`` is +1, or -1
-    for a mirrored panel (x -> -x); ``offset`` shifts x before mirroring (the target
-    frame puts the tip of a nose at x = P).  The first ``n_primary`` panels are the
-    physical surface; the rest (if any) are the mirror images, in reverse order.
+    Panel k lies on ``segments[segment_index[k]]`` between parameters
+    ``base[k] + da[k]`` and ``base[k] + db[k]``; ``(anchor_x[k], anchor_r[k])`` is the exact
+    point at parameter ``base[k]``.  ``sign[k]`` is +1, or -1 for a mirrored panel.
+    Coordinates are returned in a computational frame whose origin is at x = ``offset``
+    (the tip of a penetrating nose): add ``offset`` for target-frame abscissae.  The first
+    ``n_primary`` panels are the physical surface; the rest are their mirror images, in
+    reverse order.
     """
 
     segments: tuple[Segment, ...]
     segment_index: np.ndarray
-    ta: np.ndarray
-    tb: np.ndarray
+    base: np.ndarray
+    anchor_x: np.ndarray
+    anchor_r: np.ndarray
+    da: np.ndarray
+    db: np.ndarray
     sign: np.ndarray
     offset: float
     order: int
@@ -47,7 +58,7 @@ class PanelSet:
 
     @property
     def n_panels(self) -> int:
-        return len(self.ta)
+        return len(self.da)
 
     def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False):
         """Points and derivatives d/du at reference coordinates ``u`` of panels ``panel``.
@@ -63,17 +74,18 @@ class PanelSet:
             if not mask.any():
                 continue
             pk = panel[mask]
-            ta, tb, sg = self.ta[pk], self.tb[pk], self.sign[pk]
-            half = 0.5 * (tb - ta)
-            t = ta + half * (u[mask] + 1.0)
-            px, pr = seg.point(t)
-            dx, dr = seg.derivative(t)
-            out[0][mask] = sg * (px + self.offset)
-            out[1][mask] = pr
+            base, da, db, sg = self.base[pk], self.da[pk], self.db[pk], self.sign[pk]
+            half = 0.5 * (db - da)
+            dt = da + half * (u[mask] + 1.0)
+            ex, er = seg.displacement(base, dt)
+            dx, dr = seg.derivative(base + dt)
+            # computational frame: x_b for primary panels, -x_b - 2 offset for mirrored ones
+            out[0][mask] = sg * (self.anchor_x[pk] + ex) + (sg - 1.0) * self.offset
+            out[1][mask] = self.anchor_r[pk] + er
             out[2][mask] = sg * dx * half
             out[3][mask] = dr * half
             if second:
-                ddx, ddr = seg.second_derivative(t)
+                ddx, ddr = seg.second_derivative(base + dt)
                 out[4][mask] = sg * ddx * half * half
                 out[5][mask] = ddr * half * half
         return tuple(out)
@@ -132,16 +144,97 @@ class NodeGeometry:
 
 
 # ------------------------------------------------------------------------------------
-# breakpoints
+# pieces: one segment between two parameters, with panels anchored at either end
 
 
-def _graded(t0: float, t1: float, n: int, grade0: int, grade1: int, ratio: float = GRADING_RATIO) -> np.ndarray:
-    """n uniform panels on [t0, t1]; the first/last subdivided geometrically ``grade*`` times."""
-    edges = np.linspace(t0, t1, n + 1)
-    h = edges[1] - edges[0]
-    head = [t0 + h * ratio**k for k in range(grade0, 0, -1)] if grade0 else []
-    tail = [t1 - h * ratio**k for k in range(1, grade1 + 1)] if grade1 else []
-    return np.concatenate([[t0], head, edges[1:-1], tail[::-1], [t1]])
+@dataclass(frozen=True)
+class Piece:
+    """Panels on ``segment`` between parameters t0 and t1 (exact end points p0, p1).
+
+    ``panels`` rows are (anchor, a, b): anchor 0 measures the offsets a < b from t0 in units
+    of (t1 - t0), anchor 1 from t1 (a < b <= 0).  Offsets are kept normalised so that the
+    piece can be stretched to a new end parameter without changing its topology.
+    """
+
+    segment: Segment
+    t0: float
+    t1: float
+    p0: tuple[float, float]
+    p1: tuple[float, float]
+    panels: np.ndarray  # (n, 3)
+
+    def stretched(self, t1: float, p1: tuple[float, float]) -> "Piece":
+        return Piece(self.segment, self.t0, t1, self.p0, p1, self.panels)
+
+
+def graded_panels(n: int, grade0: int, grade1: int, ratio: float = GRADING_RATIO) -> np.ndarray:
+    """n uniform panels on [0, 1]; the first/last subdivided geometrically ``grade*`` times.
+
+    Returns rows (anchor, a, b) as in :class:`Piece`: graded panels are anchored at the
+    end they crowd, so their offsets are exact.
+    """
+    h = 1.0 / n
+    rows = []
+    if grade0:
+        edges = [0.0] + [h * ratio**k for k in range(grade0, 0, -1)] + [h]
+        rows += [(0, a, b) for a, b in zip(edges[:-1], edges[1:])]
+    else:
+        rows.append((0, 0.0, h))
+    for k in range(1, n - 1):
+        a, b = k * h, (k + 1) * h
+        rows.append((0, a, b) if a + b <= 1.0 else (1, a - 1.0, b - 1.0))
+    if n > 1:
+        if grade1:
+            edges = [-h] + [-h * ratio**k for k in range(1, grade1 + 1)] + [0.0]
+            rows += [(1, a, b) for a, b in zip(edges[:-1], edges[1:])]
+        else:
+            rows.append((1, -h, 0.0))
+    elif grade1:  # a single panel graded at its end too
+        rows.pop()
+        if grade0:
+            raise ValueError("use n >= 2 to grade both ends")
+        edges = [-1.0] + [-ratio**k for k in range(1, grade1 + 1)] + [0.0]
+        rows += [(1, a, b) for a, b in zip(edges[:-1], edges[1:])]
+    return np.array(rows, dtype=float)
+
+
+def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float = 0.0, mirror: bool = False) -> PanelSet:
+    """Assemble pieces (and optionally their mirror images) into a :class:`PanelSet`."""
+    segs, idx, base, ax, ar, da, db = [], [], [], [], [], [], []
+    for piece in pieces:
+        segs.append(piece.segment)
+        span = piece.t1 - piece.t0
+        for anchor, a, b in piece.panels:
+            idx.append(len(segs) - 1)
+            if anchor == 0:
+                base.append(piece.t0)
+                ax.append(piece.p0[0])
+                ar.append(piece.p0[1])
+            else:
+                base.append(piece.t1)
+                ax.append(piece.p1[0])
+                ar.append(piece.p1[1])
+            da.append(a * span)
+            db.append(b * span)
+    arrays = [np.array(v, dtype=float) for v in (base, ax, ar, da, db)]
+    idx = np.array(idx)
+    n = len(idx)
+    if mirror:
+        # reversed order, reversed parameter direction
+        idx = np.concatenate([idx, idx[::-1]])
+        base, ax, ar, da, db = arrays
+        arrays = [
+            np.concatenate([base, base[::-1]]),
+            np.concatenate([ax, ax[::-1]]),
+            np.concatenate([ar, ar[::-1]]),
+            np.concatenate([da, db[::-1]]),
+            np.concatenate([db, da[::-1]]),
+        ]
+        sign = np.concatenate([np.ones(n), -np.ones(n)])
+    else:
+        sign = np.ones(n)
+    base, ax, ar, da, db = arrays
+    return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n)
 
 
 def _segment_arc_length(seg: Segment, ta: float, tb: float) -> float:
@@ -153,6 +246,11 @@ def _segment_arc_length(seg: Segment, ta: float, tb: float) -> float:
 
 def _count(arc: float, scale: float, refinement: float, per_scale: float, minimum: int = 2) -> int:
     return max(minimum, int(math.ceil(refinement * per_scale * arc / scale)))
+
+
+def _point(seg: Segment, t: float) -> tuple[float, float]:
+    x, r = seg.point(t)
+    return float(x), float(r)
 
 
 # ------------------------------------------------------------------------------------
@@ -175,7 +273,7 @@ def body_panels(meridian: Meridian, options: LayoutOptions = LayoutOptions()) ->
     corners = meridian.corners()
     tip0, tip1 = meridian.axis_angles()
     scale = max(float(np.max(np.abs(s.point(np.linspace(s.t0, s.t1, 33))[1]))) for s in segs)
-    idx, ta, tb = [], [], []
+    pieces = []
     for k, seg in enumerate(segs):
         arc = _segment_arc_length(seg, seg.t0, seg.t1)
         n = _count(arc, scale, options.refinement, 1.6)
@@ -186,21 +284,13 @@ def body_panels(meridian: Meridian, options: LayoutOptions = LayoutOptions()) ->
             n = max(n, len(seg.knots) - 1)
         g0 = options.levels if (k == 0 and tip0 > 1e-6) or (k > 0 and corners[k - 1]) else 0
         g1 = options.levels if (k == len(segs) - 1 and tip1 > 1e-6) or (k < len(segs) - 1 and corners[k]) else 0
-        edges = _graded(seg.t0, seg.t1, n, g0, g1)
-        idx += [k] * (len(edges) - 1)
-        ta += list(edges[:-1])
-        tb += list(edges[1:])
-    n = len(ta)
-    return PanelSet(
-        segments=tuple(segs),
-        segment_index=np.array(idx),
-        ta=np.array(ta),
-        tb=np.array(tb),
-        sign=np.ones(n),
-        offset=0.0,
-        order=options.order,
-        n_primary=n,
-    )
+        p0, p1 = _point(seg, seg.t0), _point(seg, seg.t1)
+        if k == 0:
+            p0 = (p0[0], 0.0)  # on the axis exactly
+        if k == len(segs) - 1:
+            p1 = (p1[0], 0.0)
+        pieces.append(Piece(seg, seg.t0, seg.t1, p0, p1, graded_panels(max(n, 2), g0, g1)))
+    return panel_set(pieces, options.order)
 
 
 def param_at_x(seg: Segment, x: float) -> float:
@@ -217,78 +307,61 @@ def param_at_x(seg: Segment, x: float) -> float:
 
 @dataclass(frozen=True)
 class HalfspaceLayout:
-    """Breakpoints of the submerged surface of a nose at depth P (body frame).
+    """Panels of the submerged surface of a nose at depth P (body frame), as pieces.
 
-    ``pieces`` are (segment, normalised breakpoints in [0, 1], t_start, t_end): the last
-    piece ends at the free surface.  Re-evaluating the same layout at a nearby depth with
-    :meth:`at_depth` keeps the panel topology and moves only the last piece's end (the
-    frozen topology that differentiation in P needs).
+    The last piece ends at the free surface x_b = -P.  Re-evaluating the layout at a
+    nearby depth with :meth:`at_depth` keeps the panel topology and stretches only the
+    last piece (the frozen topology that differentiation in P needs).
     """
 
     nose: Nose
     depth: float
-    pieces: tuple[tuple[Segment, np.ndarray, float, float], ...]
+    pieces: tuple[Piece, ...]
     options: LayoutOptions
+    shank: bool  # the last piece is the cylinder r = d/2 from the shoulder to x = 0
 
     def at_depth(self, depth: float) -> "HalfspaceLayout":
-        *head, (seg, tau, t0, _) = self.pieces
-        if isinstance(seg, Line) and seg.p0[0] == -self.nose.length and seg.p1[1] == seg.p0[1]:
-            if depth <= self.nose.length:
+        *head, last = self.pieces
+        R, Lh = self.nose.radius, self.nose.length
+        if self.shank:
+            if not depth > Lh:
                 raise ValueError("depth moved across the nose-shank junction; use a smaller step")
-            new_last = (Line(seg.p0, (-depth, seg.p0[1])), tau, 0.0, 1.0)
+            seg = Line((-Lh, R), (-depth, R))
+            new = Piece(seg, 0.0, 1.0, (-Lh, R), (-depth, R), last.panels)
         else:
-            if depth > self.nose.length:
+            if not depth < Lh:
                 raise ValueError("depth moved across the nose-shank junction; use a smaller step")
-            new_last = (seg, tau, t0, param_at_x(seg, -depth))
-        return HalfspaceLayout(self.nose, depth, (*head, new_last), self.options)
+            t1 = param_at_x(last.segment, -depth)
+            new = last.stretched(t1, (-depth, float(last.segment.point(t1)[1])))
+        return HalfspaceLayout(self.nose, depth, (*head, new), self.options, self.shank)
 
     def panels(self) -> PanelSet:
-        """Primary panels (target frame, tip at x = P) followed by their mirror images."""
-        segs, idx, ta, tb = [], [], [], []
-        for seg, tau, t0, t1 in self.pieces:
-            edges = t0 + (t1 - t0) * tau
-            segs.append(seg)
-            idx += [len(segs) - 1] * (len(edges) - 1)
-            ta += list(edges[:-1])
-            tb += list(edges[1:])
-        idx, ta, tb = np.array(idx), np.array(ta), np.array(tb)
-        n = len(ta)
-        return PanelSet(
-            segments=tuple(segs),
-            segment_index=np.concatenate([idx, idx[::-1]]),
-            ta=np.concatenate([ta, tb[::-1]]),
-            tb=np.concatenate([tb, ta[::-1]]),
-            sign=np.concatenate([np.ones(n), -np.ones(n)]),
-            offset=self.depth,
-            order=self.options.order,
-            n_primary=n,
-        )
+        """Primary panels (tip at x = P in the target frame) followed by their mirror images."""
+        return panel_set(self.pieces, self.options.order, offset=self.depth, mirror=True)
 
 
 def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOptions()) -> HalfspaceLayout:
     """Layout of the submerged nose (and shank, and entry-hole wall) at depth P > 0.
 
-    For P <= L_h the nose is cut by the free surface x = 0, where the surface and its
-    mirror image meet at an edge: panels are graded towards it.  For P > L_h the shank
-    and the hole wall form one cylinder r = d/2 from the shoulder to x = 0 (n_x = 0 there,
-    so A, B, C depend only on the nose and P: errata item 1b); its panels grow
-    geometrically away from the shoulder, and it meets its mirror image smoothly.
+    For P < L_h the nose is cut by the free surface x = 0, where the surface and its mirror
+    image meet at an edge: panels are graded towards it.  For P > L_h the shank and the
+    hole wall form one cylinder r = d/2 from the shoulder to x = 0 (n_x = 0 there, so A, B,
+    C depend only on the nose and P: errata item 1b); its panels grow geometrically away
+    from the shoulder, and it meets its mirror image smoothly.
     """
     if not depth > 0:
         raise ValueError("depth must be positive")
     R, Lh = nose.radius, nose.length
     lev, ref = options.levels, options.refinement
     segs = nose.segments
-    submerged = min(depth, Lh)
-    # local length scale of the submerged nose part
-    scale = max(min(R, submerged if depth < Lh else R), 1e-300)
-    pieces = []
-    # conical tip (ogive psi > 1/2, cone, table): grade towards it
+    cut_on_nose = depth < Lh
+    scale = R if not cut_on_nose else max(min(R, depth), 1e-300)
     tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
     turning = Meridian(segs, closed=False).corners() if len(segs) > 1 else []
+    pieces = []
     for k, seg in enumerate(segs):
         x_end = float(seg.point(seg.t1)[0])
-        cut_here = depth < Lh and -depth >= x_end - 1e-15 * max(Lh, R)
+        cut_here = cut_on_nose and -depth >= x_end - 1e-15 * max(Lh, R)
         t1 = param_at_x(seg, -depth) if cut_here else seg.t1
         arc = _segment_arc_length(seg, seg.t0, t1)
         if arc <= 0:
@@ -296,43 +369,53 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         n = _count(arc, scale, ref, 1.6)
         if isinstance(seg, SplineCurve):
             n = max(n, int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) + 1)
-        g0 = lev if (k == 0 and tip_conical) or (k > 0 and turning[k - 1]) else 0
-        if k > 0 and not turning[k - 1]:
-            g0 = 2  # curvature jump between tangent segments: mild grading
+        if k == 0:
+            g0 = lev if tip_conical else 0
+        else:
+            g0 = lev if turning[k - 1] else 2  # 2: curvature jump between tangent segments
         if cut_here:
             g1 = lev
         elif k < len(segs) - 1:
             g1 = lev if turning[k] else 2
         else:
-            # shoulder: corner if the nose does not meet the shank tangentially
-            dx, dr = (float(v) for v in seg.derivative(seg.t1))
-            g1 = lev if abs(dr) > 1e-9 * math.hypot(dx, dr) else 2
-        edges = _graded(seg.t0, t1, n, g0, g1)
-        pieces.append((seg, (edges - seg.t0) / (t1 - seg.t0), seg.t0, t1))
+            g1 = lev if _shoulder_is_corner(nose) else 2
+        p0 = (0.0, 0.0) if k == 0 else _point(seg, seg.t0)
+        if cut_here:
+            p1 = (-depth, float(seg.point(t1)[1]))
+        elif k == len(segs) - 1:
+            p1 = (-Lh, R)
+        else:
+            p1 = _point(seg, seg.t1)
+        pieces.append(Piece(seg, seg.t0, t1, p0, p1, graded_panels(n, g0, g1)))
         if cut_here:
             break
-    if depth > Lh:
-        length = depth - Lh
-        shoulder_corner = pieces[-1][1].size and _shoulder_is_corner(nose)
-        h0 = R / max(ref, 1e-9) * 0.8
-        grade = options.levels if shoulder_corner else 2
-        edges = [0.0]
-        # graded start at the shoulder, then geometric growth by a factor 2
-        h = min(h0, 0.5 * length)
-        for k in range(grade, 0, -1):
-            edges.append(h * GRADING_RATIO**k)
-        pos = h
-        while pos < length:
-            edges.append(pos)
-            h *= 2.0 if ref <= 1 else 2.0 ** (1.0 / ref)
-            pos += h
-        if length - edges[-1] < 0.5 * (edges[-1] - edges[-2]) and len(edges) > 2:
-            edges[-1] = length
-        else:
-            edges.append(length)
-        tau = np.array(edges) / length
-        pieces.append((Line((-Lh, R), (-depth, R)), tau, 0.0, 1.0))
-    return HalfspaceLayout(nose, depth, tuple(pieces), options)
+    shank = depth > Lh
+    if shank:
+        pieces.append(_shank_piece(nose, depth, options))
+    return HalfspaceLayout(nose, depth, tuple(pieces), options, shank=shank)
+
+
+def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
+    """Cylinder from the shoulder (-L_h, R) to the free surface (-P, R): graded at the
+    shoulder, then panels growing by a factor 2 (less with refinement) towards x = 0."""
+    R, Lh = nose.radius, nose.length
+    length = depth - Lh
+    grade = options.levels if _shoulder_is_corner(nose) else 2
+    growth = 2.0 ** (1.0 / max(options.refinement, 1.0))
+    h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
+    edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]
+    pos = h
+    while pos < length:
+        edges.append(pos)
+        h *= growth
+        pos += h
+    if len(edges) > 2 and length - edges[-1] < 0.5 * (edges[-1] - edges[-2]):
+        edges[-1] = length
+    else:
+        edges.append(length)
+    tau = np.array(edges) / length
+    rows = [(0, a, b) if a + b <= 1.0 else (1, a - 1.0, b - 1.0) for a, b in zip(tau[:-1], tau[1:])]
+    return Piece(Line((-Lh, R), (-depth, R)), 0.0, 1.0, (-Lh, R), (-depth, R), np.array(rows, dtype=float))
 
 
 def _shoulder_is_corner(nose: Nose) -> bool:

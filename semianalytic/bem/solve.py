@@ -380,7 +380,7 @@ class SurfaceSolution:
         J = g.J[:n]
         dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
         return SurfaceNodes(
-            x=g.x[:n].ravel(),
+            x=g.x[:n].ravel() + ps.offset,
             r=g.r[:n].ravel(),
             nx=g.tr[:n].ravel(),
             nr=-g.tx[:n].ravel(),
@@ -432,7 +432,7 @@ class SurfaceSolution:
         pts = np.atleast_2d(np.asarray(points, dtype=float))
         if pts.shape[-1] != 2:
             raise ValueError("points must have shape (M, 2): (x, r)")
-        xt, rt = pts[:, 0], np.abs(pts[:, 1])
+        xt, rt = pts[:, 0] - self.panels.offset, np.abs(pts[:, 1])
         ps = self.panels
         p = ps.order
         phi, g, omega = (a.ravel() for a in self._sources)
@@ -471,11 +471,28 @@ class SurfaceSolution:
         return self._field(points, gradient=True)
 
 
-def solve_panels(ps: PanelSet, kind: str, *, depth: float | None = None, volume: float | None = None) -> SurfaceSolution:
-    """Assemble and solve (**) for unit motion in +x (g = -n_x)."""
+def solve_panels(
+    ps: PanelSet,
+    kind: str,
+    *,
+    depth: float | None = None,
+    volume: float | None = None,
+    neumann=None,
+) -> SurfaceSolution:
+    """Assemble and solve (**).
+
+    ``neumann(x, r, nx, nr) -> g`` gives dphi/dn at the primary nodes; the default is
+    unit motion in +x, g = -n_x (Part I, eq. (7)).
+    """
     S, D = assemble(ps)
     N = S.shape[0]
-    g = -ps.nodes.tr[: ps.n_primary].ravel()
+    geo = ps.nodes
+    n = ps.n_primary
+    if neumann is None:
+        g = -geo.tr[:n].ravel()
+    else:
+        x = geo.x[:n].ravel() + ps.offset
+        g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
     A = 0.5 * np.eye(N) - D
     phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
     shape = (ps.n_primary, ps.order)
