@@ -134,14 +134,14 @@ def test_killed_sweep_process_resumes(tmp_path):
     """SIGKILL a running sweep (no clean-up at all), then --resume: nothing written is lost."""
     out = tmp_path / "sw"
     args = [sys.executable, "-m", "semianalytic", "sweep", str(AD995), "--out", str(out), "--scheduler", "inline",
-            "--batch-size", "4", "--no-progress", "--vary", "material.poisson_ratio=0.18:0.27:0.0005",
+            "--batch-size", "4", "--no-progress", "--vary", "material.poisson_ratio=0.18:0.27:0.001",
             "--sample", "material.compressive_strength=normal(2.62 GPa, 0.05 GPa)", "--samples", "3"]
     proc = subprocess.Popen(args, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
     res = out / "results.csv"
     t0 = time.time()
     try:
         while time.time() - t0 < 90:
-            if res.exists() and res.read_bytes().count(b"\n") > 40:
+            if res.exists() and res.read_bytes().count(b"\n") > 20:
                 break
             if proc.poll() is not None:
                 break
@@ -158,7 +158,7 @@ def test_killed_sweep_process_resumes(tmp_path):
     rc = main(args[3:] + ["--resume"])
     assert rc == 0
     df = pd.read_csv(res)
-    n = 181 * 3
+    n = 91 * 3
     assert sorted(df.case_id) == list(range(n))
     # the rows written before the kill are kept unchanged
     merged = before.merge(df, on="case_id", suffixes=("_a", "_b"))
