@@ -100,9 +100,11 @@ def velocity_at_time(t, u_s, R, rho_t, rho_p, L_p):
     """
     a = speed_scale(R, rho_t)
     t = np.asarray(t, dtype=float)
-    gamma = np.minimum(a * rho_t * t / (2.0 * L_p * rho_p), math.atan(u_s / a))
+    gamma_stop = math.atan(u_s / a)
+    gamma = np.minimum(a * rho_t * t / (2.0 * L_p * rho_p), gamma_stop)
     tg = np.tan(gamma)
-    return np.maximum(a * (u_s - a * tg) / (a + u_s * tg), 0.0)[()]
+    u = np.maximum(a * (u_s - a * tg) / (a + u_s * tg), 0.0)
+    return np.where(gamma >= gamma_stop, 0.0, u)[()]
 
 
 def depth_at_velocity(u, u_s, R, rho_t, rho_p, L_p):
