@@ -146,7 +146,7 @@ class TargetSection(Section):
     """``[target]``: the half-space target.  ``resistance`` is validated by the penetration model."""
 
     density: Density
-    resistance: dict[str, Any] | None = None
+    resistance: importlib.import_module("semianalytic.penetration.resistance").ResistanceField | None = None
 
 
 class ImpactSection(Section):

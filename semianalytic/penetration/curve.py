@@ -1,0 +1,294 @@
+"""All projectile models of Part I for many striking velocities at once.
+
+For each striking velocity U_s: the rigid projectile (eq. (11), u(0) = U_s), the quasi-rigid
+one (eq. (11) from eq. (26)), the elastic projectile with the paper's W2 (eqs. (29), (30'))
+and with the exact-rod vibration energy (errata item 5), and the critical impact velocity
+U_sC (eqs. (33)/(36)) with the flag U_s >= U_sC (the projectile yields: outside the model).
+
+Everything follows from ONE integration of eq. (11) with the depth P as the independent
+variable (:func:`~semianalytic.penetration.motion.depth_profile`): u^2(P) for any start
+velocity, the final depth G(P_f) = U_0^2, and the time t(P) = int dP/u, computed on the
+mapped grid P = P_f s (2 - s), s in [0, 1], on which dt/ds = 2 P_f (1 - s)/u stays finite at
+the stop (u ~ sqrt(P_f - P)).  The elastic stop s* (m ubar^2 = 2W) is found by bisection and
+P = int_0^s* u dP/ds ds by Gauss quadrature on s = s* (1 - (1 - tau)^2) (u ~ sqrt(s* - s)).
+:func:`semianalytic.penetration.elastic.solve_elastic` (time domain) is the independent check.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_simpson
+from scipy.interpolate import CubicSpline
+
+from semianalytic.errors import InputError
+from semianalytic.penetration import critical as crit
+from semianalytic.penetration.elastic import (
+    W1_MODELS,
+    lateral_energy,
+    oscillation_energy,
+    quasi_rigid_start,
+    start_force_coefficients,
+)
+from semianalytic.penetration.motion import DepthProfile, deep_coefficients, depth_profile
+from semianalytic.penetration.rod import Rod
+
+__all__ = ["PenetrationSetup", "penetration_curve", "sweep_support", "paper_coefficients"]
+
+
+# The deep-penetration coefficients the paper quotes (section 2 and Appendix; errata item 2):
+# (Abar [m], Bbar, Cbar).  Used only as the explicitly named option "paper".
+PAPER_COEFFICIENTS = {
+    "sphere": (1.5e-3, 0.58, 1.00),
+    ("ogive", 3.0): (1.0e-3, 0.11, 1.00),
+}
+
+
+def paper_coefficients(projectile_section):
+    """ConstantCoefficients from the paper's quoted Abar, Bbar, Cbar (sphere; ogive psi = 3)."""
+    from semianalytic.coefficients import ConstantCoefficients
+
+    p = projectile_section
+    key = "sphere" if p.nose == "sphere" or (p.nose == "ogive" and p.crh == 0.5) else (p.nose, p.crh)
+    if key not in PAPER_COEFFICIENTS:
+        raise InputError(
+            "projectile.nose",
+            "the paper quotes coefficients only for the spherical nose and the psi = 3 ogive; use the BEM table",
+        )
+    return ConstantCoefficients.from_normalised(*PAPER_COEFFICIENTS[key], p.diameter)
+
+
+@dataclass(frozen=True)
+class PenetrationSetup:
+    """Inputs of the Part I projectile models (SI).
+
+    coefficients  DragCoefficients (BEM table or constants); mass m [kg];
+    target_density rho [kg/m^3]; resistance_pa R_t [Pa];
+    rod           the projectile as the cylinder of eq. (24) (L, d, E_p, rho_p), or None;
+    poisson_ratio nu_p (for W1); yield_stress Y_p [Pa] (dynamic) or None; phi buckling factor.
+    """
+
+    coefficients: object
+    mass: float
+    target_density: float
+    resistance_pa: float
+    rod: Rod | None = None
+    poisson_ratio: float | None = None
+    yield_stress: float | None = None
+    phi: float = 1.0
+
+    @classmethod
+    def from_case(cls, case, coefficients, *, mass: float | None = None, require_material: bool = True):
+        """From a case's [projectile] and [target] (+ [target.resistance]); ``mass`` overrides."""
+        from semianalytic.geometry import projectile_from_section
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        psec = case.require("projectile")
+        tsec = case.require("target")
+        projectile = projectile_from_section(psec)
+        m = float(mass if mass is not None else projectile.mass)
+        R = float(resistance_from_case(case).pressure(psec.diameter))
+        if not R > 0:
+            raise InputError("target.resistance", f"the resistance R_t must be positive; got {R:g} Pa")
+        missing = [k for k in ("youngs_modulus", "yield_stress") if getattr(psec, k) is None]
+        if missing and require_material:
+            raise InputError(
+                f"projectile.{missing[0]}",
+                "missing: the elastic projectile and the critical velocity need youngs_modulus and yield_stress "
+                "(e.g. '210 GPa', '1.5 GPa')",
+            )
+        rod = None
+        phi = 1.0
+        if psec.youngs_modulus is not None:
+            rho_p = psec.density if psec.density is not None else m / projectile.volume()
+            rod = Rod(projectile.length, psec.diameter, psec.youngs_modulus, rho_p)
+            if psec.yield_stress is not None:
+                lam = crit.slenderness(projectile.length, psec.diameter)
+                phi = crit.buckling_factor(psec.buckling, lam, psec.youngs_modulus, psec.yield_stress, psec.buckling_table)
+        return cls(coefficients, m, float(tsec.density), R, rod, psec.poisson_ratio, psec.yield_stress, float(phi))
+
+    def critical_inputs(self) -> crit.CriticalInputs:
+        A, B, C = deep_coefficients(self.coefficients)
+        r = self.rod
+        return crit.CriticalInputs(r.youngs_modulus, r.density, self.mass, r.diameter, A, B, C, self.target_density, self.resistance_pa)
+
+    def critical_velocity(self) -> float:
+        """U_sC of eqs. (33)/(36) with the deep-limit coefficients (NaN without Y_p or E_p)."""
+        if self.rod is None or self.yield_stress is None:
+            return math.nan
+        return crit.critical_velocity(self.yield_stress, self.critical_inputs(), self.phi)
+
+
+# --------------------------------------------------------------------------------------
+
+
+def _rows_eval(spline: CubicSpline, X: np.ndarray) -> np.ndarray:
+    """Evaluate a CubicSpline built with axis=1 on data (n, J) at row-wise points X (n, K)."""
+    x = spline.x
+    c = spline.c  # (4, J-1, n)
+    j = np.clip(np.searchsorted(x, X, side="right") - 1, 0, len(x) - 2)
+    dx = X - x[j]
+    rows = np.arange(X.shape[0])[:, None]
+    return ((c[0, j, rows] * dx + c[1, j, rows]) * dx + c[2, j, rows]) * dx + c[3, j, rows]
+
+
+_TX, _TW = np.polynomial.legendre.leggauss(8)
+
+
+@dataclass(frozen=True, eq=False)
+class _Stops:
+    """Per start velocity: final depth, time grid t(s) on the mapped grid, its spline."""
+
+    U0: np.ndarray
+    P_f: np.ndarray
+    s: np.ndarray
+    t: np.ndarray  # (n, J+1)
+    spline: CubicSpline
+
+    @property
+    def stop_time(self) -> np.ndarray:
+        return self.t[:, -1]
+
+
+def _stops(prof: DepthProfile, U0: np.ndarray, n_grid: int) -> _Stops:
+    U0 = np.asarray(U0, float)
+    P_f = prof.final_depth(U0)
+    s = np.linspace(0.0, 1.0, n_grid + 1)
+    P = P_f[:, None] * (s * (2.0 - s))[None, :]
+    u2 = prof.speed2(U0[:, None], P)
+    u = np.sqrt(np.maximum(u2, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        dt = 2.0 * P_f[:, None] * (1.0 - s)[None, :] / u
+        # at s = 1: u = sqrt(e^-F G' P_f) (1 - s)  =>  dt/ds = 2 sqrt(P_f e^F / G'(P_f))
+        F_end = prof.F(P_f)
+        dt[:, -1] = 2.0 * np.sqrt(P_f * np.exp(F_end) / prof.dG(P_f))
+    dt[P_f == 0] = 0.0
+    t = cumulative_simpson(dt, x=s, axis=1, initial=0.0)
+    return _Stops(U0, P_f, s, t, CubicSpline(s, t, axis=1))
+
+
+def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2: str, w1: str):
+    """Depth and stop time of the elastic projectile (eq. (30)) for each row of ``st``."""
+    m, rod = setup.mass, setup.rod
+    nu = setup.poisson_ratio if setup.poisson_ratio is not None else 0.0
+    sig = np.asarray(sigma0, float)[:, None]
+    Pf = st.P_f[:, None]
+
+    def g(S, T=None):  # (ubar^2 - 2W/m, ubar^2) at mapped coordinate S (rows)
+        P = Pf * S * (2.0 - S)
+        T = _rows_eval(st.spline, S) if T is None else T
+        W = oscillation_energy(w2, rod, sig, T) + lateral_energy(
+            w1, P, sigma0=sig, resistance_pa=setup.resistance_pa, rod=rod, poisson_ratio=nu
+        )
+        ub2 = prof.speed2(st.U0[:, None], P)
+        return ub2 - 2.0 * W / m, ub2
+
+    vals, _ = g(np.broadcast_to(st.s, st.t.shape), st.t)
+    vals[:, -1] = np.minimum(vals[:, -1], 0.0)
+    n = len(st.U0)
+    j = np.argmax(vals[:, 1:] <= 0.0, axis=1) + 1
+    # Illinois (modified regula falsi) on the bracketing grid cell, all rows at once
+    rows = np.arange(n)
+    a, b = st.s[j - 1].copy(), st.s[j].copy()
+    fa, fb = vals[rows, j - 1].copy(), vals[rows, j].copy()
+    for _ in range(100):
+        with np.errstate(invalid="ignore", divide="ignore"):
+            x = b - fb * (b - a) / (fb - fa)
+        x = np.where(np.isfinite(x) & (x > np.minimum(a, b)) & (x < np.maximum(a, b)), x, 0.5 * (a + b))
+        fx = g(x[:, None])[0][:, 0]
+        flip = fx * fb < 0
+        a, fa = np.where(flip, b, a), np.where(flip, fb, 0.5 * fa)
+        b, fb = x, fx
+        if np.all((np.abs(b - a) <= 4e-16) | (fx == 0)):
+            break
+    s_star = b
+    # P = int u dt = int_0^s* (u/ubar) dPbar/ds ds on s = s* (1 - (1 - tau)^2), Gauss in tau
+    panels = 64
+    edges = np.linspace(0.0, 1.0, panels + 1)
+    tau = (edges[:-1, None] + 0.5 * (edges[1:] - edges[:-1])[:, None] * (_TX + 1.0)[None, :]).ravel()
+    wts = (0.5 * (edges[1:] - edges[:-1])[:, None] * _TW[None, :]).ravel()
+    S = s_star[:, None] * (1.0 - (1.0 - tau[None, :]) ** 2)
+    dS = 2.0 * s_star[:, None] * (1.0 - tau[None, :])
+    gv, ub2 = g(S)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = np.where(gv > 0, np.sqrt(np.maximum(gv, 0.0) / ub2), 0.0)  # u / ubar, eq. (30)
+    depth = np.sum(wts[None, :] * ratio * (2.0 * Pf * (1.0 - S)) * dS, axis=1)
+    t_star = _rows_eval(st.spline, s_star[:, None])[:, 0]
+    zero = st.P_f == 0
+    depth[zero], t_star[zero] = 0.0, 0.0
+    return depth, t_star
+
+
+def penetration_curve(
+    setup: PenetrationSetup,
+    striking_velocities,
+    *,
+    w1: str = "neglect",
+    elastic: bool = True,
+    rtol: float = 1e-12,
+    n_grid: int = 512,
+) -> dict[str, np.ndarray]:
+    """Every Part I projectile model for each striking velocity (arrays, SI; keys carry units).
+
+    Keys: striking_velocity_m_s, depth_rigid_m, time_rigid_s, start_velocity_m_s (eq. (26)),
+    axial_stress_Pa (sigma_0), depth_quasi_rigid_m, time_quasi_rigid_s, depth_elastic_m and
+    stop_time_elastic_s (paper's W2, eq. (29)), depth_elastic_exact_rod_m and
+    stop_time_elastic_exact_rod_s (errata item 5), critical_velocity_m_s (eq. (33)), yields.
+    Without a projectile material (setup.rod None) or with ``elastic=False`` only the rigid
+    keys are filled (the rest NaN).
+    """
+    if w1 not in W1_MODELS:
+        raise InputError("w1", f"must be one of {', '.join(W1_MODELS)}; got {w1!r}")
+    U = np.atleast_1d(np.asarray(striking_velocities, float))
+    if U.size == 0 or np.any(~np.isfinite(U)) or np.any(U <= 0):
+        raise InputError("impact.striking_velocities", "must be positive (m/s)")
+    prof = depth_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa, float(U.max()), rtol=rtol)
+    rigid = _stops(prof, U, n_grid)
+    nan = np.full(U.shape, np.nan)
+    out = {
+        "striking_velocity_m_s": U,
+        "depth_rigid_m": rigid.P_f,
+        "time_rigid_s": rigid.stop_time,
+        "start_velocity_m_s": nan.copy(),
+        "axial_stress_Pa": nan.copy(),
+        "depth_quasi_rigid_m": nan.copy(),
+        "time_quasi_rigid_s": nan.copy(),
+        "depth_elastic_m": nan.copy(),
+        "stop_time_elastic_s": nan.copy(),
+        "depth_elastic_exact_rod_m": nan.copy(),
+        "stop_time_elastic_exact_rod_s": nan.copy(),
+    }
+    U_sC = setup.critical_velocity()
+    out["critical_velocity_m_s"] = np.full(U.shape, U_sC)
+    out["yields"] = (U >= U_sC) if np.isfinite(U_sC) else np.zeros(U.shape, bool)
+    if setup.rod is None or not elastic:
+        return out
+    alpha, beta = start_force_coefficients(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa)
+    U0, sigma0 = quasi_rigid_start(U, setup.rod.c0, setup.rod.youngs_modulus, alpha, beta)
+    U0, sigma0 = np.atleast_1d(U0), np.atleast_1d(sigma0)
+    qr = _stops(prof, U0, n_grid)
+    out.update(
+        start_velocity_m_s=U0,
+        axial_stress_Pa=sigma0,
+        depth_quasi_rigid_m=qr.P_f,
+        time_quasi_rigid_s=qr.stop_time,
+    )
+    for w2, key in (("paper", "elastic"), ("exact-rod", "elastic_exact_rod")):
+        depth, t_star = _elastic(prof, qr, sigma0, setup, w2, w1)
+        out[f"depth_{key}_m"] = depth
+        out[f"stop_time_{key}_s"] = t_star
+    return out
+
+
+def sweep_support(case, coefficients, striking_velocities, full: bool = False) -> dict[str, np.ndarray]:
+    """The sweep kernel's columns (semianalytic.sweep.kernels.PenetrationKernel): depth_rigid_m,
+    critical_velocity_m_s, yields, and with ``full`` also depth_quasi_rigid_m, depth_elastic_m,
+    depth_elastic_exact_rod_m.  Without projectile material constants: NaN / False."""
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=full)
+    res = penetration_curve(setup, striking_velocities, elastic=full)
+    keys = ["depth_rigid_m", "critical_velocity_m_s", "yields"]
+    if full:
+        keys += ["depth_quasi_rigid_m", "depth_elastic_m", "depth_elastic_exact_rod_m"]
+    return {k: res[k] for k in keys}

@@ -1,0 +1,382 @@
+"""Equation of motion of a rigid projectile, Part I, eq. (11):
+
+    (m + rho A(P)) du/dt = -B(P) rho u^2 / 2 - C(P) R_t,   dP/dt = u,   P(0) = 0, u(0) = U_0,
+
+with A [m^3], B, C [m^2] from any :class:`~semianalytic.coefficients.DragCoefficients`
+(the BEM table of the projectile's nose, or the constant stand-in), m [kg], the target
+density rho [kg/m^3] and resistance R_t [Pa].  The braking force is
+N = -m du/dt = m (B rho u^2/2 + C R_t) / (m + rho A) (> 0), as after Part I, eq. (31).
+
+Three evaluations, each a check on the others:
+
+* :func:`solve_motion`: time histories with an adaptive Runge-Kutta integrator (DOP853) and
+  a terminal event at u = 0 (the paper used Euler's method; section 3).
+* :func:`final_depth` / :func:`depth_profile`: P as the independent variable.  With
+  w = u^2, eq. (11) is linear, (m + rho A) dw/dP = -(rho B w + 2 C R_t), so
+  w(P) = exp(-F(P)) [U_0^2 - G(P)] with F = int rho B/(m + rho A) dP and
+  G = int 2 C R_t exp(F)/(m + rho A) dP.  One integration serves every U_0; the final depth
+  solves G(P_f) = U_0^2 (vectorised).
+* :class:`ConstantCoefficientSolution`: the closed form for constant A, B, C, Part IV,
+  eqs. (2)-(3), with the corrections of errata items 22-24.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass, field
+
+import numpy as np
+from scipy.integrate import solve_ivp
+
+__all__ = [
+    "MotionResult",
+    "solve_motion",
+    "braking_force",
+    "DepthProfile",
+    "depth_profile",
+    "final_depth",
+    "ConstantCoefficientSolution",
+    "deep_coefficients",
+]
+
+
+def _check_inputs(mass, target_density, resistance_pa):
+    for name, value in (("mass", mass), ("target_density", target_density), ("resistance_pa", resistance_pa)):
+        if not (np.isfinite(value) and value > 0):
+            raise ValueError(f"{name} must be positive and finite; got {value!r}")
+
+
+def deep_coefficients(coefficients) -> tuple[float, float, float]:
+    """(A, B, C) in the deep-penetration limit: ``coefficients.deep_limit()`` when the object
+    has one (the BEM table), else the values at a depth of 10^4 diameters."""
+    deep = getattr(coefficients, "deep_limit", None)
+    if callable(deep):
+        A, B, C = deep()
+        return float(A), float(B), float(C)
+    P = 1e4 * float(coefficients.diameter)
+    return float(coefficients.A(P)), float(coefficients.B(P)), float(coefficients.C(P))
+
+
+def braking_force(coefficients, mass, target_density, resistance_pa, P, u):
+    """N = m (B rho u^2/2 + C R_t) / (m + rho A) [N], the force compressing the projectile
+    (Part I, text after eq. (31)); vectorised in P and u."""
+    P = np.asarray(P, float)
+    u = np.asarray(u, float)
+    A, B, C = coefficients.A(P), coefficients.B(P), coefficients.C(P)
+    rho = target_density
+    return mass * (0.5 * rho * B * u * u + C * resistance_pa) / (mass + rho * A)
+
+
+# --------------------------------------------------------------------------------------
+# closed form (constant coefficients)
+
+
+@dataclass(frozen=True)
+class ConstantCoefficientSolution:
+    """Closed-form solution of Part I, eq. (11) for constant A, B, C (Part IV, eqs. (2)-(3)).
+
+    With M = m + rho A, k = rho B / (2 M) and a^2 = 2 C R_t / (rho B), eq. (11) reads
+    du/dt = -k (u^2 + a^2) (Part IV, eq. (1) with rho_p L_p -> M / B, rho_t -> rho), hence
+      u(t) = a (U_0 - a tan g) / (a + U_0 tan g),  g = a k t        (IV-(2), errata item 22)
+      P(u) = ln((a^2 + U_0^2) / (a^2 + u^2)) / (2k)                 (IV-(3), errata item 23)
+      P(t) = ln(cos g + (U_0/a) sin g) / k                          (errata item 24)
+      T = arctan(U_0/a) / (a k),  P_f = ln(1 + U_0^2/a^2) / (2k).
+    B = 0 is the limit of uniform deceleration C R_t / M.
+    """
+
+    A: float
+    B: float
+    C: float
+    mass: float
+    target_density: float
+    resistance_pa: float
+    U0: float
+
+    @property
+    def M(self) -> float:
+        return self.mass + self.target_density * self.A
+
+    @property
+    def k(self) -> float:
+        return self.target_density * self.B / (2.0 * self.M)
+
+    @property
+    def a(self) -> float:
+        return math.sqrt(2.0 * self.C * self.resistance_pa / (self.target_density * self.B)) if self.B > 0 else math.inf
+
+    @property
+    def deceleration0(self) -> float:
+        return self.C * self.resistance_pa / self.M
+
+    @property
+    def penetration_time(self) -> float:
+        if self.B == 0:
+            return self.U0 / self.deceleration0
+        return math.atan(self.U0 / self.a) / (self.a * self.k)
+
+    @property
+    def final_depth(self) -> float:
+        if self.B == 0:
+            return self.U0**2 / (2.0 * self.deceleration0)
+        return math.log1p((self.U0 / self.a) ** 2) / (2.0 * self.k)
+
+    def velocity(self, t):
+        t = np.minimum(np.asarray(t, float), self.penetration_time)
+        if self.B == 0:
+            return self.U0 - self.deceleration0 * t
+        a, U = self.a, self.U0
+        tg = np.tan(a * self.k * t)
+        return a * (U - a * tg) / (a + U * tg)
+
+    def depth(self, t):
+        t = np.minimum(np.asarray(t, float), self.penetration_time)
+        if self.B == 0:
+            return self.U0 * t - 0.5 * self.deceleration0 * t * t
+        g = self.a * self.k * t
+        return np.log(np.cos(g) + self.U0 / self.a * np.sin(g)) / self.k
+
+    def depth_at_velocity(self, u):
+        u = np.asarray(u, float)
+        if self.B == 0:
+            return (self.U0**2 - u * u) / (2.0 * self.deceleration0)
+        a2 = self.a**2
+        return np.log((a2 + self.U0**2) / (a2 + u * u)) / (2.0 * self.k)
+
+
+# --------------------------------------------------------------------------------------
+# time histories (solve_ivp with an event at u = 0)
+
+
+@dataclass(frozen=True, eq=False)
+class MotionResult:
+    """Solution of Part I, eq. (11) in time, at the integrator's steps (SI units).
+
+    t [s], P [m], u [m/s], du_dt [m/s^2] (< 0 while braking), force N = -m du/dt [N]
+    (> 0 braking); final_depth [m] and penetration_time [s] at the event u = 0.
+    ``at(t)`` evaluates (P, u) anywhere in [0, penetration_time] (dense output).
+    """
+
+    t: np.ndarray
+    P: np.ndarray
+    u: np.ndarray
+    du_dt: np.ndarray
+    force: np.ndarray
+    final_depth: float
+    penetration_time: float
+    mass: float
+    U0: float
+    _dense: object = field(default=None, repr=False)
+
+    @property
+    def deceleration(self) -> np.ndarray:
+        """-du/dt [m/s^2]."""
+        return -self.du_dt
+
+    def at(self, t):
+        """(P(t), u(t)) from the integrator's dense output; t is clipped to [0, penetration_time]."""
+        t = np.clip(np.asarray(t, float), 0.0, self.penetration_time)
+        if self._dense is None:  # U0 = 0: nothing moves
+            return np.zeros_like(t), np.zeros_like(t)
+        y = self._dense(t)
+        return y[0], y[1]
+
+    def sample(self, n: int = 200) -> dict[str, np.ndarray]:
+        """Uniformly spaced samples t, P, u (n points from 0 to the stop)."""
+        t = np.linspace(0.0, self.penetration_time, n)
+        P, u = self.at(t)
+        return {"t": t, "P": P, "u": u}
+
+
+def solve_motion(
+    coefficients,
+    mass: float,
+    target_density: float,
+    resistance_pa: float,
+    U0: float,
+    *,
+    rtol: float = 1e-10,
+    atol=None,
+    t_max: float | None = None,
+    method: str = "DOP853",
+) -> MotionResult:
+    """Integrate Part I, eq. (11) from u(0) = U0 until u = 0 (adaptive, event-terminated).
+
+    ``atol`` defaults to ``rtol`` times (diameter, U0) for (P, u).  ``t_max`` defaults to ten
+    times the stopping time of the deep-limit closed form plus 100 diameters / U0.
+    """
+    _check_inputs(mass, target_density, resistance_pa)
+    if not (np.isfinite(U0) and U0 >= 0):
+        raise ValueError(f"U0 must be finite and non-negative; got {U0!r}")
+    rho, R, m = float(target_density), float(resistance_pa), float(mass)
+    d = float(coefficients.diameter)
+    if U0 == 0:
+        z = np.zeros(1)
+        C0 = float(coefficients.C(0.0))
+        A0 = float(coefficients.A(0.0))
+        dec = C0 * R / (m + rho * A0)
+        return MotionResult(z, z, z, -dec * np.ones(1), m * dec * np.ones(1), 0.0, 0.0, m, 0.0)
+
+    cA, cB, cC = coefficients.A, coefficients.B, coefficients.C
+
+    def rhs(t, y):
+        P, u = y
+        A, B, C = float(cA(P)), float(cB(P)), float(cC(P))
+        return (u, -(0.5 * rho * B * u * u + C * R) / (m + rho * A))
+
+    def stop(t, y):
+        return y[1]
+
+    stop.terminal = True
+    stop.direction = -1
+
+    if t_max is None:
+        A8, B8, C8 = deep_coefficients(coefficients)
+        t_max = 10.0 * ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U0).penetration_time + 100.0 * d / U0
+    if atol is None:
+        atol = rtol * np.array([d, U0])
+    sol = solve_ivp(rhs, (0.0, t_max), [0.0, U0], method=method, rtol=rtol, atol=atol, events=stop, dense_output=True)
+    if sol.status != 1 or not len(sol.t_events[0]):
+        raise RuntimeError(f"eq. (11) did not reach u = 0 before t = {t_max:g} s ({sol.message})")
+    t_end = float(sol.t_events[0][0])
+    t = sol.t.copy()
+    P, u = sol.y[0].copy(), sol.y[1].copy()
+    t[-1], P[-1], u[-1] = t_end, float(sol.y_events[0][0][0]), 0.0
+    A, B, C = cA(P), cB(P), cC(P)
+    du_dt = -(0.5 * rho * B * u * u + C * R) / (m + rho * A)
+    return MotionResult(
+        t=t, P=P, u=u, du_dt=du_dt, force=-m * du_dt, final_depth=float(P[-1]), penetration_time=t_end,
+        mass=m, U0=float(U0), _dense=sol.sol,
+    )
+
+
+# --------------------------------------------------------------------------------------
+# P as the independent variable: all striking velocities at once
+
+
+@dataclass(frozen=True, eq=False)
+class DepthProfile:
+    """F(P), G(P) of the linear form of eq. (11) in w = u^2 (see the module docstring),
+    integrated once up to ``P_end`` (where G exceeds U_max^2).  SI units.
+
+    ``speed2(U0, P)`` = u^2 at depth P for start velocity U0 (broadcasting);
+    ``final_depth(U0)`` solves G(P_f) = U0^2; ``dG(P)`` = G'(P) exactly from the coefficients.
+    """
+
+    coefficients: object
+    mass: float
+    target_density: float
+    resistance_pa: float
+    U_max: float
+    P_end: float
+    _sol: object = field(repr=False)
+    _P_steps: np.ndarray = field(repr=False)
+    _G_steps: np.ndarray = field(repr=False)
+    # ``final_depth`` brackets each root between two integrator steps (G increases)
+
+    def M(self, P):
+        return self.mass + self.target_density * np.asarray(self.coefficients.A(P), float)
+
+    def _eval(self, P):
+        """(F, G) at P of any shape (the dense output takes 1-D arrays)."""
+        P = np.asarray(P, float)
+        y = self._sol(P.ravel())
+        return y[0].reshape(P.shape), y[1].reshape(P.shape)
+
+    def F(self, P):
+        return self._eval(P)[0]
+
+    def G(self, P):
+        return self._eval(P)[1]
+
+    def dG(self, P):
+        """G'(P) = 2 C R_t exp(F) / (m + rho A)."""
+        P = np.asarray(P, float)
+        F = self.F(P)
+        return 2.0 * np.asarray(self.coefficients.C(P), float) * self.resistance_pa * np.exp(F) / self.M(P)
+
+    def speed2(self, U0, P):
+        """u^2 = exp(-F(P)) (U0^2 - G(P)) (>= 0 before the stop)."""
+        F, G = self._eval(P)
+        return np.exp(-F) * (np.asarray(U0, float) ** 2 - G)
+
+    def final_depth(self, U0):
+        """P_f with G(P_f) = U0^2, vectorised (safeguarded Newton in the integrator's step)."""
+        U0 = np.asarray(U0, float)
+        if np.any(U0 > self.U_max * (1 + 1e-12)) or np.any(U0 < 0):
+            raise ValueError("U0 must lie in [0, U_max] of the profile")
+        g = U0.ravel() ** 2
+        Ps, Gs = self._P_steps, self._G_steps
+        k = np.clip(np.searchsorted(Gs, g, side="left"), 1, len(Gs) - 1)
+        lo, hi = Ps[k - 1].copy(), Ps[k].copy()
+        Glo, Ghi = Gs[k - 1], Gs[k]
+        with np.errstate(invalid="ignore", divide="ignore"):
+            frac = np.where(Ghi > Glo, (g - Glo) / (Ghi - Glo), 0.5)
+        P = lo + np.clip(frac, 0.0, 1.0) * (hi - lo)
+        C, A = self.coefficients.C, self.coefficients.A
+        for _ in range(50):
+            F, G = self._eval(P)
+            r = G - g
+            lo = np.where(r < 0, P, lo)
+            hi = np.where(r >= 0, P, hi)
+            dG = 2.0 * np.asarray(C(P), float) * self.resistance_pa * np.exp(F) / (
+                self.mass + self.target_density * np.asarray(A(P), float)
+            )
+            with np.errstate(invalid="ignore", divide="ignore"):
+                Pn = P - r / dG
+            bad = ~np.isfinite(Pn) | (Pn < lo) | (Pn > hi)
+            Pn = np.where(bad, 0.5 * (lo + hi), Pn)
+            done = (np.abs(Pn - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
+            P = Pn
+            if np.all(done):
+                break
+        P = np.where(g == 0, 0.0, P)
+        return P.reshape(U0.shape)[()]
+
+
+def depth_profile(
+    coefficients, mass: float, target_density: float, resistance_pa: float, U_max: float, *, rtol: float = 1e-12
+) -> DepthProfile:
+    """Integrate F and G of the w = u^2 form of Part I, eq. (11) in P until G > U_max^2."""
+    _check_inputs(mass, target_density, resistance_pa)
+    if not (np.isfinite(U_max) and U_max > 0):
+        raise ValueError(f"U_max must be positive; got {U_max!r}")
+    rho, R, m = float(target_density), float(resistance_pa), float(mass)
+    d = float(coefficients.diameter)
+    cA, cB, cC = coefficients.A, coefficients.B, coefficients.C
+    g_end = U_max**2 * (1.0 + 1e-6)
+
+    def rhs(P, y):
+        A, B, C = float(cA(P)), float(cB(P)), float(cC(P))
+        M = m + rho * A
+        return (rho * B / M, 2.0 * C * R * math.exp(y[0]) / M)
+
+    def past(P, y):
+        return y[1] - g_end
+
+    past.terminal = True
+    past.direction = 1
+    A8, B8, C8 = deep_coefficients(coefficients)
+    P_guess = 2.0 * ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U_max).final_depth + 200.0 * d
+    sol = solve_ivp(
+        rhs, (0.0, P_guess), [0.0, 0.0], method="DOP853", rtol=rtol, atol=[rtol * 1e-3, rtol * 1e-3 * U_max**2],
+        events=past, dense_output=True,
+    )
+    if sol.status != 1:
+        raise RuntimeError(f"eq. (11) in P: G did not reach U_max^2 before P = {P_guess:g} m ({sol.message})")
+    P_end = float(sol.t_events[0][0])
+    Ps = sol.t.copy()
+    Gs = sol.y[1].copy()
+    Ps[-1], Gs[-1] = P_end, float(sol.y_events[0][0][1])
+    return DepthProfile(coefficients, m, rho, R, float(U_max), P_end, sol.sol, Ps, np.maximum.accumulate(Gs))
+
+
+def final_depth(coefficients, mass: float, target_density: float, resistance_pa: float, U0, *, rtol: float = 1e-12):
+    """Final depth [m] of Part I, eq. (11) for every U0 [m/s] (array in, array out), from one
+    integration in P (see the module docstring).  U0 = 0 gives 0."""
+    U0 = np.asarray(U0, float)
+    if np.any(~np.isfinite(U0)) or np.any(U0 < 0):
+        raise ValueError("U0 must be finite and non-negative")
+    if U0.size == 0 or np.max(U0) == 0:
+        return np.zeros_like(U0)[()]
+    prof = depth_profile(coefficients, mass, target_density, resistance_pa, float(np.max(U0)), rtol=rtol)
+    return prof.final_depth(U0)

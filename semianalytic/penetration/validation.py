@@ -1,0 +1,170 @@
+"""Validation of the Part I projectile models against measured depths of penetration.
+
+For each shot of a case's ``[data]`` CSV (rows kept by ``select``), with the shot's own
+mass when the data give it: the depth predicted by the rigid, quasi-rigid, elastic (paper's
+W2) and elastic (exact-rod W2) projectiles of Part I, by Forrestal's cavity-expansion
+formula and by the Chen & Li formula (:mod:`.peers`); then the relative error
+(predicted - measured)/measured of each model, and per model its mean, mean absolute,
+maximum absolute and root-mean-square value.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from semianalytic.errors import InputError
+from semianalytic.penetration import peers
+from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+__all__ = ["MODEL_LABELS", "Shot", "load_shots", "peer_inputs", "predict_shots", "error_statistics"]
+
+# column key -> label (the Part I models first, then the peers)
+MODEL_LABELS = {
+    "rigid": "rigid, eq. (11)",
+    "quasi_rigid": "quasi-rigid, eqs. (11)+(26)",
+    "elastic": "elastic, paper's W2 (29), (30')",
+    "elastic_exact_rod": "elastic, exact-rod W2 (errata 5)",
+    "forrestal": "Forrestal (cavity expansion)",
+    "chen_li": "Chen & Li (2002)",
+}
+
+
+@dataclass(frozen=True)
+class Shot:
+    """One experiment: id, striking velocity [m/s], measured depth [m], mass [kg] or None."""
+
+    id: str
+    velocity: float
+    depth: float
+    mass: float | None
+    row: dict
+
+
+def _unit_scale(unit: str, kind: str, field: str) -> float:
+    from semianalytic.units import parse_quantity
+
+    return parse_quantity(f"1 {unit}", kind, field)
+
+
+def load_shots(case) -> list[Shot]:
+    """The shots of the case's ``[data]`` CSV in SI units (rows with a depth, kept by ``select``)."""
+    import pandas as pd
+
+    data = case.require("data")
+    if data.file is None:
+        return []
+    base = Path(case.path).parent if case.path is not None else Path.cwd()
+    path = (base / data.file).resolve()
+    if not path.is_file():
+        raise InputError("data.file", f"{str(path)!r} does not exist")
+    try:
+        df = pd.read_csv(path, comment="#", dtype=str, keep_default_na=False)
+    except Exception as exc:  # noqa: BLE001 - any parse failure is bad input
+        raise InputError("data.file", f"cannot read {path.name} as CSV: {exc}") from None
+    columns = {k: getattr(data, k) for k in ("velocity_column", "depth_column", "mass_column", "id_column")}
+    columns.update({f"select.{c}": c for c in data.select})
+    for key, col in columns.items():
+        if col is not None and col not in df.columns:
+            raise InputError(f"data.{key}", f"column {col!r} is not in {path.name} (columns: {', '.join(df.columns)})")
+    for col, allowed in data.select.items():
+        df = df[df[col].isin(allowed)]
+    v_scale = _unit_scale(data.velocity_unit, "velocity", "data.velocity_unit")
+    d_scale = _unit_scale(data.depth_unit, "length", "data.depth_unit")
+    m_scale = _unit_scale(data.mass_unit, "mass", "data.mass_unit")
+    shots = []
+    for i, row in df.iterrows():
+        if row[data.depth_column].strip() == "":
+            continue  # no depth printed (e.g. only a channel length)
+        try:
+            V = float(row[data.velocity_column]) * v_scale
+            P = float(row[data.depth_column]) * d_scale
+            m = float(row[data.mass_column]) * m_scale if data.mass_column else None
+        except ValueError:
+            raise InputError("data.file", f"row {i + 1} of {path.name} has a non-numeric value") from None
+        if not (V > 0 and P > 0 and (m is None or m > 0)):
+            raise InputError("data.file", f"row {i + 1} of {path.name}: velocity, depth and mass must be positive")
+        shot_id = str(row[data.id_column]) if data.id_column else str(i + 1)
+        shots.append(Shot(shot_id, V, P, m, dict(row)))
+    return shots
+
+
+def peer_inputs(case, setup: PenetrationSetup):
+    """(Forrestal CavityLaw, Chen-Li (static resistance, B)) for a case.
+
+    Forrestal: the data authors' constants from ``[data]`` if given, else the same static
+    resistance as Part I (A Y = R_t) with the incompressible dynamic term B = 3/2.
+    Chen & Li: always on the Part I inputs, A Y = R_t and B = 3/2 (two-term law).
+    """
+    data = case.section("data")
+    if data is not None and data.cavity_A is not None:
+        if data.cavity_C is None:
+            law = peers.CavityLaw.two_term(data.cavity_yield_stress, data.cavity_A, data.cavity_B)
+        else:
+            law = peers.CavityLaw(data.cavity_yield_stress, data.cavity_A, data.cavity_B, data.cavity_C)
+    else:
+        law = peers.CavityLaw.two_term(setup.resistance_pa, 1.0, 1.5)
+    return law, (setup.resistance_pa, 1.5)
+
+
+def peer_depths(case, setup: PenetrationSetup, U, mass=None) -> dict[str, np.ndarray]:
+    """Forrestal and Chen-Li depths [m] for striking velocities U (same projectile as ``setup``)."""
+    from semianalytic.geometry import nose_from_section
+
+    nose = nose_from_section(case.require("projectile"))
+    N1, N2 = peers.nose_factors(nose)
+    m = setup.mass if mass is None else mass
+    law, (static, B) = peer_inputs(case, setup)
+    d = nose.diameter
+    return {
+        "forrestal": np.atleast_1d(peers.forrestal_depth(m, d, setup.target_density, law, U, N1, N2)),
+        "chen_li": np.atleast_1d(peers.chen_li_depth(m, d, setup.target_density, static, B, N2, U)),
+    }
+
+
+def predict_shots(case, coefficients, shots: list[Shot], *, w1: str = "neglect") -> list[dict]:
+    """Per shot: measured and predicted depths [m] of every model in :data:`MODEL_LABELS`,
+    plus U_sC [m/s] and the yield flag (U_s >= U_sC: outside the model's validity)."""
+    rows = []
+    base = PenetrationSetup.from_case(case, coefficients)
+    for shot in shots:
+        setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
+        res = penetration_curve(setup, [shot.velocity], w1=w1)
+        pe = peer_depths(case, setup, [shot.velocity])
+        row = {
+            "shot": shot.id,
+            "velocity_m_s": shot.velocity,
+            "mass_kg": setup.mass,
+            "measured_m": shot.depth,
+            "rigid": float(res["depth_rigid_m"][0]),
+            "quasi_rigid": float(res["depth_quasi_rigid_m"][0]),
+            "elastic": float(res["depth_elastic_m"][0]),
+            "elastic_exact_rod": float(res["depth_elastic_exact_rod_m"][0]),
+            "forrestal": float(pe["forrestal"][0]),
+            "chen_li": float(pe["chen_li"][0]),
+            "critical_velocity_m_s": float(res["critical_velocity_m_s"][0]),
+            "yields": bool(res["yields"][0]),
+            "case": case.title,
+        }
+        rows.append(row)
+    return rows
+
+
+def error_statistics(rows: list[dict], models=tuple(MODEL_LABELS)) -> dict[str, dict[str, float]]:
+    """Per model: n, mean (signed), mean |.|, max |.| and rms of (predicted - measured)/measured."""
+    out = {}
+    for key in models:
+        e = np.array([(r[key] - r["measured_m"]) / r["measured_m"] for r in rows], float)
+        if e.size == 0:
+            continue
+        out[key] = {
+            "n": int(e.size),
+            "mean": float(np.mean(e)),
+            "mean_abs": float(np.mean(np.abs(e))),
+            "max_abs": float(np.max(np.abs(e))),
+            "rms": float(math.sqrt(np.mean(e * e))),
+        }
+    return out
