@@ -8,7 +8,7 @@ A source ring of radius r1 at axial position x1 acts on a target (x, r).  With
 the azimuthal integrals of the free-space Green function G = 1/(4 pi R) and of its
 derivatives reduce to the complete elliptic integrals K(m), E(m) (the paper's a, b = 2 r r1
 and m = 2b/(a + b); errata items 1 and 1a).  The parameter 1 - m is formed directly from
-the geometry (numerical notes) and K is evaluated with ``ellipkm1``.
+the geometry (numerical notes) and K, E are evaluated as functions of it (``ellip_ke``).
 
 Every kernel here includes the ring circumference factor r1 (it is the integral over the
 ring per unit meridian arc length); multiply by the arc-length element ds1.
@@ -27,7 +27,46 @@ from __future__ import annotations
 import math
 
 import numpy as np
-from scipy.special import ellipe, ellipk, ellipkm1
+from scipy.special import ellipe, ellipk
+
+# Complete elliptic integrals as functions of the complementary parameter q = 1 - m,
+# K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q): the Cephes approximations
+# (S. L. Moshier; the same as scipy.special.ellipkm1 / ellipe, accurate to ~1e-16 on
+# [0, 1]).  Evaluating them here shares ln(q) between K and E and takes q directly.
+_PK = np.array([1.37982864606273237150e-4, 2.28025724005875567385e-3, 7.97404013220415179367e-3,
+                9.85821379021226008714e-3, 6.87489687449949877925e-3, 6.18901033637687613229e-3,
+                8.79078273952743772254e-3, 1.49380448916805252718e-2, 3.08851465246711995998e-2,
+                9.65735902811690126535e-2, 1.38629436111989062502e0])
+_QK = np.array([2.94078955048598507511e-5, 9.14184723865917226571e-4, 5.94058303753167793257e-3,
+                1.54850516649762399335e-2, 2.39089602715924892727e-2, 3.01204715227604046988e-2,
+                3.73774314173823228969e-2, 4.88280347570998239232e-2, 7.03124996963957469739e-2,
+                1.24999999999870820058e-1, 4.99999999999999999821e-1])
+_PE = np.array([1.53552577301013293365e-4, 2.50888492163602060990e-3, 8.68786816565889628429e-3,
+                1.07350949056076193403e-2, 7.77395492516787092951e-3, 7.58395289413514708519e-3,
+                1.15688436810574127319e-2, 2.18317996015557253103e-2, 5.68051945617860553470e-2,
+                4.43147180560990850618e-1, 1.00000000000000000299e0])
+_QE = np.array([3.27954898576485872656e-5, 1.00962792679356715133e-3, 6.50609489976927491433e-3,
+                1.68862163993311317300e-2, 2.61769742454493659583e-2, 3.34833904888224918614e-2,
+                4.27180926518931511717e-2, 5.85936634471101055642e-2, 9.37499997197644278445e-2,
+                2.49999999999888314361e-1])
+
+
+def _polevl(x, coef):
+    """sum coef[k] x^(n-k) (highest power first), Horner's scheme in place."""
+    out = np.full_like(x, coef[0])
+    for c in coef[1:]:
+        out *= x
+        out += c
+    return out
+
+
+def ellip_ke(q):
+    """K(1 - q) and E(1 - q) for the complementary parameter q in [0, 1]."""
+    q = np.asarray(q, dtype=float)
+    lnq = np.log(q)
+    K = _polevl(q, _PK) - lnq * _polevl(q, _QK)
+    E = _polevl(q, _PE) - lnq * q * _polevl(q, _QE)
+    return K, E
 
 _TWO_OVER_PI = 2.0 / math.pi
 
@@ -49,8 +88,7 @@ def single_double(x, r, x1, r1, nx1, nr1):
     """
     dx, d2, D = _geometry(x, r, x1, r1)
     m1 = d2 / D
-    K = ellipkm1(m1)
-    E = ellipe(1.0 - m1)
+    K, E = ellip_ke(m1)
     inv = 1.0 / (math.pi * np.sqrt(D))
     bracket = r1 * (dx * nx1 + (r - r1) * nr1) + 0.5 * nr1 * d2
     S = r1 * K * inv
@@ -77,8 +115,7 @@ def single_double_split(x, r, x1, r1, nx1, nr1):
     """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2."""
     dx, d2, D = _geometry(x, r, x1, r1)
     m1 = d2 / D
-    K = ellipkm1(m1)
-    E = ellipe(1.0 - m1)
+    K, E = ellip_ke(m1)
     Kc = _horner(m1, _K_SERIES)  # K(1 - m), truncated
     KcmEc = _horner(m1, _KME_Q_SERIES)  # K(1 - m) - E(1 - m), truncated
     inv = 1.0 / (math.pi * np.sqrt(D))
@@ -126,8 +163,7 @@ def gradient_kernels(x, r, x1, r1):
     dx, d2, D = _geometry(x, r, x1, r1)
     m1 = d2 / D
     m = 4.0 * r * r1 / D
-    K = ellipkm1(m1)
-    E = ellipe(1.0 - m1)
+    K, E = ellip_ke(m1)
     h = k_minus_e_over_m(m)  # (K - E)/m
     sD = np.sqrt(D)
     E_d2 = E / d2

@@ -52,6 +52,19 @@ MAX_LEVELS = 48
 IMAGE_MARGIN = 4.0  # innermost self piece <= (distance to the axis image)/IMAGE_MARGIN
 
 
+@functools.cache
+def _threadpools():
+    from threadpoolctl import ThreadpoolController
+
+    return ThreadpoolController()
+
+
+def _single_threaded_blas():
+    """Small dense solves run far faster on one BLAS thread on a loaded 2-core machine
+    (numerical notes); the limit is lifted again on exit."""
+    return _threadpools().limit(limits=1, user_api="blas")
+
+
 # ------------------------------------------------------------------------------------
 # near pairs
 
@@ -494,6 +507,7 @@ def solve_panels(
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
     A = 0.5 * np.eye(N) - D
-    phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
+    with _single_threaded_blas():
+        phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
     shape = (ps.n_primary, ps.order)
     return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), kind, depth=depth, volume=volume)
