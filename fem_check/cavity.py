@@ -126,7 +126,7 @@ def solve_radial(r_in: float, traction: float, E: float, nu: float, outer: float
     sr = np.where(cracked_q, E * du, (lam + 2 * mu) * du + 2 * lam * val / r)
     sp = np.where(cracked_q, 0.0, lam * du + 2 * (lam + mu) * val / r)
     order = np.argsort(r.ravel())
-    return RadialSolution(r.ravel()[order], val.ravel()[order], sr.ravel()[order], sp.ravel()[order], basis.N,
+    return RadialSolution(r.ravel()[order], val.ravel()[order], sr.ravel()[order], sp.ravel()[order], int(basis.N),
                           time.perf_counter() - t0, nodes, u[basis.nodal_dofs[0]])
 
 
@@ -235,5 +235,272 @@ def solve_axisymmetric(a: float, traction: float, E: float, nu: float, outer: fl
     uR = nx * ui.value[0] + nr * ui.value[1]
     upsi = -nr * ui.value[0] + nx * ui.value[1]
     return AxisymmetricSolution(x.ravel(), rho.ravel(), R.ravel(), uR.ravel(), upsi.ravel(), sRR.ravel(),
-                                stt.ravel(), spsi.ravel(), sRpsi.ravel(), basis.N, mesh.t.shape[1],
+                                stt.ravel(), spsi.ravel(), sRpsi.ravel(), int(basis.N), int(mesh.t.shape[1]),
                                 time.perf_counter() - t0)
+
+
+# ------------------------------------------------------------------------------------
+# comparisons and the command `cavity`
+
+# AD995 alumina of Part II's example (cases/cavity_ad995.toml; errata item 19: Y_s = 2.62 GPa)
+DEFAULT_MATERIAL = dict(youngs_modulus=373.14e9, poisson_ratio=0.232, tensile_strength=0.262e9,
+                        compressive_strength=2.62e9, bulk_modulus=231.8e9, initial_porosity=0.0)
+
+
+def _maxrel(fem, exact, scale=None) -> float:
+    scale = float(np.max(np.abs(exact))) if scale is None else float(scale)
+    return float(np.max(np.abs(np.asarray(fem) - np.asarray(exact))) / scale)
+
+
+def lame_errors_1d(E: float, nu: float, pressure: float, n_elements: int, a: float = 1.0, outer: float = 20.0) -> dict:
+    """1D FEM of the pressurised cavity against Lame's solution (errors relative to u(a) and p)."""
+    from semianalytic.cavity.zones import lame_cavity
+
+    s = solve_radial(a, -pressure, E, nu, outer * a, n_elements)
+    u, sr, sp = lame_cavity(s.r, a, pressure, E, nu)
+    return {"n_elements": n_elements, "n_dofs": s.n_dofs, "u": _maxrel(s.u, u), "sigma_r": _maxrel(s.sigma_r, sr, pressure),
+            "sigma_phi": _maxrel(s.sigma_phi, sp, pressure), "seconds": s.seconds, "_sol": s}
+
+
+def lame_errors_2d(E: float, nu: float, pressure: float, h: float, degree: int, a: float = 1.0, outer: float = 10.0) -> dict:
+    """2D axisymmetric FEM of the pressurised cavity against Lame's solution (relative to u(a) and p).
+
+    sigma_theta is the out-of-plane hoop stress, sigma_psi the in-plane one: both must equal
+    Lame's sigma_phi; the shear sigma_Rpsi and the tangential displacement must vanish."""
+    from semianalytic.cavity.zones import lame_cavity
+
+    s = solve_axisymmetric(a, -pressure, E, nu, outer * a, MeshOptions(h=h, growth=2.0), degree=degree)
+    u, sr, sp = lame_cavity(s.R, a, pressure, E, nu)
+    ua = float(lame_cavity(a, a, pressure, E, nu)[0])
+    return {"h_over_d": h, "degree": degree, "n_dofs": s.n_dofs, "n_elements": s.n_elements,
+            "u": _maxrel(s.u_R, u, ua), "u_tangential": _maxrel(s.u_psi, 0 * u, ua),
+            "sigma_r": _maxrel(s.sigma_RR, sr, pressure), "sigma_phi": _maxrel(s.sigma_theta, sp, pressure),
+            "sigma_psi": _maxrel(s.sigma_psi, sp, pressure), "shear": _maxrel(s.sigma_Rpsi, 0 * sp, pressure),
+            "seconds": s.seconds}
+
+
+def zone_errors(material, sigma_star: float, n_elements: int = 400, b: float = 1.0, outer_over_c: float = 10.0,
+                axisymmetric_h: float | None = None) -> dict:
+    """FEM of the cracked (b < r < c) and elastic (r > c) zones loaded by sigma_r(b) = sigma*
+    against Part II, eqs. (5), (11), (12); c from eq. (13).
+
+    Each quantity is measured relative to its own largest value: u, sigma_r (|sigma*|) and, in the
+    elastic zone, sigma_phi (sigma_f).  Also returned: the boundary conditions the FEM was not
+    given, sigma_phi(c + 0) = sigma_f (eq. (4)) and sigma_r(c) = -2 sigma_f (eq. (8)), and u(b)
+    against eq. (14) (errata item 10)."""
+    from semianalytic.cavity.zones import crack_front_ratio, cracked_zone, elastic_zone, front_strains
+
+    E, nu, sf = material.youngs_modulus, material.poisson_ratio, material.tensile_strength
+    c = b * float(crack_front_ratio(sigma_star, sf))
+
+    def exact(r):
+        ue, sre, spe = elastic_zone(r, c, material)
+        uc, src = cracked_zone(r, b, c, sigma_star, material)
+        inner = r < c
+        return np.where(inner, uc, ue), np.where(inner, src, sre), np.where(inner, 0.0 * r, spe)
+
+    s = solve_radial(b, sigma_star, E, nu, outer_over_c * c, n_elements, cracked_until=c)
+    u, sr, sp = exact(s.r)
+    outer_zone = s.r > c
+    # one-sided values at r = c from the quadrature points next to the front, carried to r = c
+    # with the local radial dependence (r^-2 in the cracked zone, r^-3 in the elastic zone)
+    ic = int(np.argmin(np.abs(s.nodes - c)))
+    k_out = int(np.argmax(s.r > c))
+    k_in = k_out - 1
+    sp_c_plus = float(s.sigma_phi[k_out]) * (s.r[k_out] / c) ** 3
+    sr_c_plus = float(s.sigma_r[k_out]) * (s.r[k_out] / c) ** 3
+    sr_c_minus = float(s.sigma_r[k_in]) * (s.r[k_in] / c) ** 2
+    u_b = float(s.u_nodes[0])
+    u_b_14 = float(front_strains(sigma_star, material)["e_phi"]) * b
+    out = {
+        "c_over_b": c / b, "n_elements": n_elements, "n_dofs": s.n_dofs, "seconds": s.seconds,
+        "u": _maxrel(s.u, u), "sigma_r": _maxrel(s.sigma_r, sr, abs(sigma_star)),
+        "sigma_phi_elastic": _maxrel(s.sigma_phi[outer_zone], sp[outer_zone], sf),
+        # relative deviations (FEM / expected - 1) of conditions the FEM was not given
+        "eq4_sigma_phi_c_plus": sp_c_plus / sf - 1,
+        "eq8_sigma_r_c_minus": sr_c_minus / (-2 * sf) - 1,
+        "sigma_r_c_plus": sr_c_plus / (-2 * sf) - 1,
+        "eq14_u_b": u_b / u_b_14 - 1, "eq6_u_c": float(s.u_nodes[ic]) / ((1 + nu) * sf * c / E) - 1,
+        "_sol": s, "_exact": exact, "_c": c,
+    }
+    if axisymmetric_h is not None:
+        s2 = solve_axisymmetric(b, sigma_star, E, nu, 4 * c, MeshOptions(h=axisymmetric_h, growth=2.0), cracked_until=c, degree=4)
+        u2, sr2, sp2 = exact(s2.R)
+        out["axisymmetric"] = {"h_over_d": axisymmetric_h, "n_dofs": s2.n_dofs, "u": _maxrel(s2.u_R, u2),
+                               "sigma_r": _maxrel(s2.sigma_RR, sr2, abs(sigma_star)),
+                               "sigma_phi_elastic": _maxrel(s2.sigma_theta[s2.R > c], sp2[s2.R > c], sf),
+                               "regularisation": CRACK_REGULARISATION, "seconds": s2.seconds}
+    return out
+
+
+def material_from_args(case_path: str | None):
+    from semianalytic.case import load_case
+    from semianalytic.cavity import BrittleMaterial
+
+    if case_path is None:
+        return BrittleMaterial(**DEFAULT_MATERIAL), "AD995 alumina (Part II example, Y_s = 2.62 GPa, errata 19)"
+    case = load_case(case_path)
+    return BrittleMaterial.from_section(case.require("material")), case.title
+
+
+def cavity_study(material, quick: bool = False) -> dict:
+    """All cavity comparisons: Lame 1D and 2D, the Part II zones; with convergence tables unless ``quick``."""
+    from semianalytic.cavity import solve_cavity
+
+    res = solve_cavity(material)
+    sigma_star = float(res.sigma_star)
+    p = -sigma_star  # cavity pressure of the Lame check: |sigma*| (any value would do: linear)
+    E, nu = material.youngs_modulus, material.poisson_ratio
+    out: dict = {"sigma_star_Pa": sigma_star, "lame_pressure_Pa": p}
+    ns = [400] if quick else [50, 100, 200, 400, 800]
+    out["lame_1d"] = [lame_errors_1d(E, nu, p, n) for n in ns]
+    hs = [0.05] if quick else [0.2, 0.1, 0.05]
+    degrees = [4] if quick else [2, 4]
+    out["lame_2d"] = [lame_errors_2d(E, nu, p, h, deg) for deg in degrees for h in hs]
+    out["zones_1d"] = [zone_errors(material, sigma_star, n) for n in ([400] if quick else [100, 200, 400, 800])]
+    if not quick:
+        out["zones_1d"][-1].update(zone_errors(material, sigma_star, 800, axisymmetric_h=0.05))
+    best = {"lame_1d": out["lame_1d"][-1 if quick else 3], "lame_2d": [r for r in out["lame_2d"] if r["degree"] == 4 and r["h_over_d"] == 0.05][0],
+            "zones_1d": [z for z in out["zones_1d"] if z["n_elements"] == 400][0]}
+    errs = {
+        "lame_1d": max(best["lame_1d"][k] for k in ("u", "sigma_r", "sigma_phi")),
+        "lame_2d": max(best["lame_2d"][k] for k in ("u", "u_tangential", "sigma_r", "sigma_phi", "sigma_psi", "shear")),
+        "zones_1d": max(best["zones_1d"][k] for k in ("u", "sigma_r", "sigma_phi_elastic")),
+    }
+    out["max_rel_error_by_problem"] = errs
+    out["max_rel_error"] = max(errs.values())
+    out["resolution"] = {"lame_1d_elements": best["lame_1d"]["n_elements"], "lame_2d": "P4, h = 0.05 d",
+                         "zones_1d_elements": 400}
+    return out
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from fem_check.report import add_output_arguments
+
+    parser.add_argument("case", nargs="?", help="case TOML with a [material] section (default: AD995 of Part II)")
+    parser.add_argument("--quick", action="store_true", help="only the test resolution (no convergence tables)")
+    add_output_arguments(parser, "fem_cavity")
+
+
+def run(args) -> int:
+    from fem_check.report import Report, emit_json
+
+    material, title = material_from_args(args.case)
+    report = None if args.no_report else Report(Path(args.out), args.name, args.force)
+    if report:
+        report.check()
+    study = cavity_study(material, quick=args.quick)
+    payload = _public(study)
+    payload["material"] = title
+    if report:
+        _write_report(report, title, material, study)
+        payload["report"] = str(report.path)
+    if args.json:
+        emit_json(payload)
+    else:
+        print(f"cavity: max relative error {study['max_rel_error']:.2e} "
+              + ", ".join(f"{k} {v:.1e}" for k, v in study["max_rel_error_by_problem"].items()))
+        if report:
+            print(f"report: {report.path}")
+    return 0
+
+
+def _public(obj):
+    if isinstance(obj, dict):
+        return {k: _public(v) for k, v in obj.items() if not k.startswith("_")}
+    if isinstance(obj, list):
+        return [_public(v) for v in obj]
+    return obj
+
+
+def _write_report(report, title, material, study) -> None:
+    from fem_check.report import fmt, md_table, new_figure, rate
+
+    r = report
+    E, nu, sf = material.youngs_modulus, material.poisson_ratio, material.tensile_strength
+    r.add("# FEM check of the elastic spherical cavity and the Part II zones", "",
+          "Generated by `python -m fem_check cavity`.", "",
+          f"Material: {title}: E = {fmt(E / 1e9)} GPa, nu = {fmt(nu)}, sigma_f = {fmt(sf / 1e9)} GPa; "
+          f"sigma* = {fmt(study['sigma_star_Pa'] / 1e9)} GPa from `semianalytic.cavity.solve_cavity`.", "",
+          "Far field: the exterior elastic field is u = k/r^2, whose traction on r = R is exactly "
+          "sigma_r = -4 mu u / R; imposed as a Robin condition, it replaces the infinite medium with no "
+          "truncation error, so the tables show discretisation errors only.", "",
+          f"**Maximum relative error at the test resolution: {fmt(study['max_rel_error'])}** "
+          f"({', '.join(f'{k} {fmt(v)}' for k, v in study['max_rel_error_by_problem'].items())}).", "",
+          "## Pressurised cavity, 1D (spherical symmetry, weight r^2, P2, geometric mesh on [a, 20a])", "",
+          f"Pressure p = {fmt(study['lame_pressure_Pa'] / 1e9)} GPa. Errors: max over the quadrature points, "
+          "relative to u(a) and p. Expected orders in h: 3 for u, 2 for the stresses (P2).", "")
+    rows = study["lame_1d"]
+    hs = [1.0 / x["n_elements"] for x in rows]
+    ru, rs = rate([x["u"] for x in rows], hs), rate([x["sigma_r"] for x in rows], hs)
+    r.add(md_table(["elements", "dofs", "u", "order", "sigma_r", "order", "sigma_phi", "s"],
+                   [[x["n_elements"], x["n_dofs"], x["u"], a, x["sigma_r"], b, x["sigma_phi"], x["seconds"]]
+                    for x, a, b in zip(rows, ru, rs)]), "")
+    r.add("## Pressurised cavity, 2D axisymmetric (quarter annulus a <= R <= 10a, curved quadratic gmsh mesh)", "",
+          "Errors relative to u(a) and p, max over all quadrature points; sigma_theta is the out-of-plane hoop "
+          "stress, sigma_psi the in-plane one (both Lame's sigma_phi); u_t and the shear must vanish. P2 stresses "
+          "converge at order 2; P4 on the quadratic geometry is used to reach the 1e-4 target.", "")
+    rows = study["lame_2d"]
+    r.add(md_table(["degree", "h/d", "dofs", "u", "u_t", "sigma_r", "sigma_theta", "sigma_psi", "shear", "s"],
+                   [[x["degree"], x["h_over_d"], x["n_dofs"], x["u"], x["u_tangential"], x["sigma_r"], x["sigma_phi"],
+                     x["sigma_psi"], x["shear"], x["seconds"]] for x in rows]), "")
+    for deg in sorted({x["degree"] for x in rows}):
+        sel = [x for x in rows if x["degree"] == deg]
+        orders = rate([x["sigma_r"] for x in sel], [x["h_over_d"] for x in sel])
+        r.add(f"Observed orders of sigma_r for P{deg}: " + ", ".join(fmt(o) for o in orders[1:]) + ".", "")
+    z = study["zones_1d"]
+    zl = z[-1]
+    r.add("## Elastic and cracked zones of Part II (1D, weight r^2)", "",
+          "The cracked zone b < r < c carries radial stress only (sigma_phi = 0, sigma_r = E du/dr: eqs. (9)-(10) "
+          "with errata items 8-9), bonded to the elastic zone r > c; the FEM is given sigma_r(b) = sigma* (eq. (7)) "
+          f"and c from eq. (13) (c/b = {fmt(zl['c_over_b'])}), nothing else. Compared with eqs. (5), (11), (12); each "
+          "quantity relative to its own maximum (sigma_phi of the elastic zone relative to sigma_f).", "",
+          md_table(["elements", "dofs", "u", "order", "sigma_r", "order", "sigma_phi (r > c)"],
+                   [[x["n_elements"], x["n_dofs"], x["u"], a, x["sigma_r"], b, x["sigma_phi_elastic"]]
+                    for x, a, b in zip(z, rate([x["u"] for x in z], [1 / x["n_elements"] for x in z]),
+                                       rate([x["sigma_r"] for x in z], [1 / x["n_elements"] for x in z]))]), "",
+          "Conditions the FEM was not given (finest mesh), as FEM / expected - 1 (sigma_phi = 0 in the cracked "
+          "zone holds by construction there):", "",
+          md_table(["check", "FEM / expected - 1"], [
+              ["sigma_phi(c+0) = sigma_f, eq. (4)", zl["eq4_sigma_phi_c_plus"]],
+              ["sigma_r(c-0) = -2 sigma_f, eq. (8)", zl["eq8_sigma_r_c_minus"]],
+              ["sigma_r(c+0) = -2 sigma_f (continuity)", zl["sigma_r_c_plus"]],
+              ["u(c) = (1+nu) sigma_f c / E, eq. (6)", zl["eq6_u_c"]],
+              ["u(b) of eq. (14) (errata 10)", zl["eq14_u_b"]],
+          ]), "")
+    if "axisymmetric" in zl:
+        ax2 = zl["axisymmetric"]
+        r.add("Exploratory (not a test): the same zones in 2D axisymmetric, P4. The radial-stress-only law of the "
+              "cracked zone has no stiffness against non-radial displacements, so without spherical symmetry the "
+              f"problem is singular; with {fmt(ax2['regularisation'])} of the isotropic stiffness added there, the errors are "
+              f"u {fmt(ax2['u'])}, sigma_r {fmt(ax2['sigma_r'])}, sigma_phi (r > c) {fmt(ax2['sigma_phi_elastic'])} "
+              f"({ax2['n_dofs']} dofs): the near-mechanism makes the 2D cracked zone converge slowly.", "")
+    s = zl["_sol"]
+    u, sr, sp = zl["_exact"](s.r)
+    fig = new_figure()
+    ax = fig.add_subplot(111)
+    step = max(1, len(s.r) // 150)
+    ax.plot(s.r, sr / 1e9, "-", color="C0", label="sigma_r, eqs. (5), (11)")
+    ax.plot(s.r, sp / 1e9, "-", color="C1", label="sigma_phi, eq. (5); 0 for r < c")
+    ax.plot(s.r[::step], s.sigma_r[::step] / 1e9, "o", ms=3, color="C0", label="FEM sigma_r")
+    ax.plot(s.r[::step], s.sigma_phi[::step] / 1e9, "s", ms=3, color="C1", label="FEM sigma_phi")
+    ax.axvline(zl["_c"], color="k", lw=0.5)
+    ax.set_xscale("log")
+    ax.set_xlabel("r / b")
+    ax.set_ylabel("stress [GPa]")
+    ax.legend(fontsize=8)
+    r.figure("zones", fig, "stresses in the cracked and elastic zones: FEM points, Part II lines")
+    fig = new_figure()
+    ax = fig.add_subplot(111)
+    rows = study["lame_1d"]
+    ax.loglog([x["n_elements"] for x in rows], [x["sigma_r"] for x in rows], "o-", label="1D P2 sigma_r")
+    ax.loglog([x["n_elements"] for x in rows], [x["u"] for x in rows], "s-", label="1D P2 u")
+    for deg in sorted({x["degree"] for x in study["lame_2d"]}):
+        sel = [x for x in study["lame_2d"] if x["degree"] == deg]
+        ax.loglog([x["n_dofs"] ** 0.5 for x in sel], [x["sigma_r"] for x in sel], "^-", label=f"2D P{deg} sigma_r (x: sqrt dofs)")
+    ax.axhline(1e-4, color="k", lw=0.5, ls=":")
+    ax.set_xlabel("elements (1D) or sqrt(dofs) (2D)")
+    ax.set_ylabel("max relative error")
+    ax.legend(fontsize=8)
+    r.figure("convergence", fig, "convergence of the cavity FEM against Lame's solution")
+    r.write()

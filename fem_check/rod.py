@@ -168,7 +168,7 @@ def simulate_rod(rod: RodProblem, force: Callable[[np.ndarray], np.ndarray], t_e
         if n in snap_idx:
             strain_snaps.append(element_strain(u))
     return RodHistory(t, Nt, out["uL"], out["vL"], out["u0"], out["E"], out["T"], out["W"], x_mid,
-                      np.array(snaps), np.array(strain_snaps), N, time.perf_counter() - t0)
+                      np.array(snaps), np.array(strain_snaps), int(N), time.perf_counter() - t0)
 
 
 # ------------------------------------------------------------------------------------
