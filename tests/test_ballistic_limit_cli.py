@@ -117,3 +117,22 @@ def test_missing_table_and_bad_csv(tmp_path, capsys):
     bad.write_text("# x\nid,rho_t_g_cm3,h_t_mm,L_p_mm,V_actual_m_s\nA,2.7,eight,26,300\n")
     code, _, err = run_cli(capsys, "fit-constants", bad)
     assert code == 2 and "bad.csv:3:h_t_mm" in err and err.count("\n") == 1
+
+
+def test_report_not_overwritten_without_force(tmp_path, capsys):
+    from semianalytic.ballistic_limit.report import main as report_main
+
+    target = tmp_path / "part4_ballistic_limit.md"
+    target.write_text("old\n")
+    assert report_main(["--out", str(tmp_path)]) == 2
+    assert target.read_text() == "old\n" and sorted(p.name for p in tmp_path.iterdir()) == [target.name]
+    assert "--force" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+def test_report_builds(tmp_path):
+    from semianalytic.ballistic_limit.report import main as report_main
+
+    assert report_main(["--out", str(tmp_path)]) == 0
+    text = (tmp_path / "part4_ballistic_limit.md").read_text()
+    assert "OUTSIDE TOLERANCE" not in text and "Closing note" in text

@@ -85,3 +85,20 @@ def test_missing_section_exit_2(tmp_path, capsys):
     case.write_text('title = "nothing"\n')
     code, _, err = run_cli(capsys, case)
     assert code == 2 and "material" in err
+
+
+def test_report_not_overwritten_without_force(tmp_path, capsys):
+    from semianalytic.cavity.report import main as report_main
+
+    target = tmp_path / "part2_cavity.md"
+    target.write_text("old\n")
+    assert report_main(["--out", str(tmp_path)]) == 2
+    assert target.read_text() == "old\n" and sorted(p.name for p in tmp_path.iterdir()) == [target.name]
+
+
+@pytest.mark.slow
+def test_report_builds(tmp_path):
+    from semianalytic.cavity.report import main as report_main
+
+    assert report_main(["--out", str(tmp_path)]) == 0
+    assert "Deviations and findings" in (tmp_path / "part2_cavity.md").read_text()
