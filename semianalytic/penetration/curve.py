@@ -35,7 +35,7 @@ from semianalytic.penetration.elastic import (
 from semianalytic.penetration.motion import DepthProfile, deep_coefficients, depth_profile
 from semianalytic.penetration.rod import Rod
 
-__all__ = ["PenetrationSetup", "penetration_curve", "sweep_support", "paper_coefficients"]
+__all__ = ["PenetrationSetup", "penetration_curve", "sweep_support", "paper_coefficients", "coefficients_for_case"]
 
 
 # The deep-penetration coefficients the paper quotes (section 2 and Appendix; errata item 2):
@@ -193,15 +193,20 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     rows = np.arange(n)
     a, b = st.s[j - 1].copy(), st.s[j].copy()
     fa, fb = vals[rows, j - 1].copy(), vals[rows, j].copy()
+    done = fb == 0
     for _ in range(100):
         with np.errstate(invalid="ignore", divide="ignore"):
             x = b - fb * (b - a) / (fb - fa)
-        x = np.where(np.isfinite(x) & (x > np.minimum(a, b)) & (x < np.maximum(a, b)), x, 0.5 * (a + b))
+        inside = np.isfinite(x) & (x > np.minimum(a, b)) & (x < np.maximum(a, b))
+        x = np.where(inside, x, 0.5 * (a + b))
         fx = g(x[:, None])[0][:, 0]
         flip = fx * fb < 0
-        a, fa = np.where(flip, b, a), np.where(flip, fb, 0.5 * fa)
-        b, fb = x, fx
-        if np.all((np.abs(b - a) <= 4e-16) | (fx == 0)):
+        upd = ~done
+        a = np.where(upd & flip, b, a)
+        fa = np.where(upd, np.where(flip, fb, 0.5 * fa), fa)
+        b, fb = np.where(upd, x, b), np.where(upd, fx, fb)
+        done |= (np.abs(b - a) <= 4e-16) | (fb == 0)
+        if np.all(done):
             break
     s_star = b
     # P = int u dt = int_0^s* (u/ubar) dPbar/ds ds on s = s* (1 - (1 - tau)^2), Gauss in tau
@@ -292,3 +297,43 @@ def sweep_support(case, coefficients, striking_velocities, full: bool = False) -
     if full:
         keys += ["depth_quasi_rigid_m", "depth_elastic_m", "depth_elastic_exact_rod_m"]
     return {k: res[k] for k in keys}
+
+
+def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False):
+    """(coefficients, description, fallback) for a case.
+
+    ``source="bem"``: the BEM table of the case's nose (cached on disk), in the B reading of
+    ``[coefficients] reading`` (errata item 2a); ``"paper"``: the paper's quoted constants
+    (:func:`paper_coefficients`).  ``fallback`` is True when "bem" was asked for but the table
+    module is not available (then the paper's constants are used).
+    """
+    psec = case.require("projectile")
+    if source == "paper":
+        return paper_coefficients(psec), "the paper's quoted deep-penetration Abar, Bbar, Cbar (constant in P)", False
+    if source != "bem":
+        raise InputError("coefficients", f"must be 'bem' or 'paper'; got {source!r}")
+    try:
+        from semianalytic.coefficients.table import cached_coefficient_table
+    except ImportError:
+        return (
+            paper_coefficients(psec),
+            "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",
+            True,
+        )
+    from semianalytic.geometry import nose_from_section
+
+    kwargs = dict(
+        order=case.bem.order,
+        refinement=case.bem.refinement,
+        n_depths=case.coefficients.depths,
+        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
+        progress=progress,
+    )
+    if cache_dir is not None:
+        kwargs["cache_dir"] = cache_dir
+    table = cached_coefficient_table(nose_from_section(psec), **kwargs).with_reading(case.coefficients.reading)
+    desc = (
+        f"BEM table (order {case.bem.order}, refinement {case.bem.refinement:g}, {case.coefficients.depths} depths "
+        f"to {case.coefficients.max_depth_nose_lengths:g} nose lengths, B reading '{case.coefficients.reading}')"
+    )
+    return table, desc, False

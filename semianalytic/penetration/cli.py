@@ -1,0 +1,204 @@
+"""``python -m semianalytic penetrate CASE.toml [CASE.toml ...]``
+
+For each striking velocity of each case: final depth and time of the rigid, quasi-rigid and
+elastic projectiles of Part I (eq. (11); eqs. (26), (29)/(30'); the exact-rod energy of errata
+item 5), the critical impact velocity U_sC (eqs. (33)/(36)) and the flag U_s >= U_sC (the
+projectile yields: the model is outside its validity).  With a ``[data]`` section: the
+dynamic yield stress from a measured U_sC (Appendix) and/or the comparison with measured
+depths.  ``--json`` prints the same as JSON (lists over velocity); ``--report DIR`` writes the
+markdown report with plots (:mod:`semianalytic.penetration.report`).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import sys
+
+import numpy as np
+
+from semianalytic.errors import InputError
+
+JSON_KEYS = (
+    "striking_velocity_m_s",
+    "depth_rigid_m",
+    "depth_quasi_rigid_m",
+    "depth_elastic_m",
+    "depth_elastic_exact_rod_m",
+    "critical_velocity_m_s",
+    "yields",
+)
+
+
+def add_arguments(parser) -> None:
+    from semianalytic.penetration.elastic import W1_MODELS
+
+    parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target], [impact]")
+    parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
+    parser.add_argument(
+        "--coefficients", choices=("bem", "paper"), default="bem",
+        help="A, B, C from the BEM table of the nose (default) or the paper's quoted constants",
+    )
+    parser.add_argument("--w1", choices=W1_MODELS, default="neglect",
+                        help="lateral-compression energy W1 of eq. (28) (default: neglect, as the paper)")
+    parser.add_argument("--cache-dir", default=None, help="folder of the cached coefficient tables")
+    parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
+    parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
+    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+
+
+def _load(paths):
+    from semianalytic.case import load_case
+
+    cases = []
+    for p in paths:
+        case = load_case(p)
+        for sec in ("projectile", "target", "impact"):
+            case.require(sec)
+        if case.target.resistance is None:
+            raise InputError("target.resistance", f"{p}: missing; add [target.resistance] with a 'model'")
+        cases.append(case)
+    return cases
+
+
+def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None) -> dict:
+    """All results of one case as a JSON-able dict (SI units in the keys)."""
+    from semianalytic.penetration import critical as crit
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+    from semianalytic.penetration.motion import deep_coefficients
+    from semianalytic.penetration.resistance import resistance_from_case
+    from semianalytic.penetration.validation import error_statistics, load_shots, peer_depths, predict_shots
+
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+    if setup.rod is None:
+        raise InputError("projectile.youngs_modulus", "missing: the elastic projectile needs it (e.g. '210 GPa')")
+    data = case.section("data")
+    out: dict = {"case": str(case.path) if case.path else case.title, "title": case.title}
+    if data is not None and data.critical_velocity is not None:
+        phi = setup.phi
+        psec = case.projectile
+        if psec.buckling == "johnson-euler":
+            lam = crit.slenderness(setup.rod.length, setup.rod.diameter)
+            phi = lambda Y: float(crit.johnson_euler_phi(lam, psec.youngs_modulus, Y))  # noqa: E731
+        Y_inv = crit.yield_stress_from_critical_velocity(data.critical_velocity, setup.critical_inputs(), phi)
+        out["measured_critical_velocity_m_s"] = data.critical_velocity
+        out["yield_stress_from_critical_velocity_Pa"] = Y_inv
+        if setup.yield_stress is None:
+            setup = dataclasses.replace(setup, yield_stress=Y_inv)
+            if psec.buckling != "none":
+                setup = dataclasses.replace(setup, phi=phi(Y_inv) if callable(phi) else phi)
+    if setup.yield_stress is None:
+        raise InputError("projectile.yield_stress", "missing: U_sC needs the dynamic yield stress (e.g. '1.5 GPa') "
+                         "or a measured [data] critical_velocity")
+    U = np.asarray(case.impact.striking_velocities if velocities is None else velocities, float)
+    res = penetration_curve(setup, U, w1=w1)
+    A, B, C = deep_coefficients(coefficients)
+    area = math.pi * setup.rod.diameter**2 / 4
+    resistance = resistance_from_case(case)
+    out.update(
+        {
+            "resistance_model": resistance.name,
+            "resistance_equation": resistance.equation,
+            "resistance_Pa": setup.resistance_pa,
+            "mass_kg": setup.mass,
+            "length_m": setup.rod.length,
+            "yield_stress_Pa": setup.yield_stress,
+            "buckling_factor": setup.phi,
+            "deep_A_bar_m": A / area,
+            "deep_B_bar": B / area,
+            "deep_C_bar": C / area,
+            "w1": w1,
+        }
+    )
+    for key, val in res.items():
+        out[key] = np.asarray(val).tolist()
+    pe = peer_depths(case, setup, U)
+    out["depth_forrestal_m"] = pe["forrestal"].tolist()
+    out["depth_chen_li_m"] = pe["chen_li"].tolist()
+    if data is not None and data.file is not None:
+        rows = predict_shots(case, coefficients, load_shots(case), w1=w1)
+        out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}
+    return out
+
+
+def _fmt(x, scale=1.0, digits=1):
+    return "nan" if not np.isfinite(x) else f"{x * scale:.{digits}f}"
+
+
+def _print_text(result: dict, desc: str, file=sys.stdout) -> None:
+    p = lambda *a: print(*a, file=file)  # noqa: E731
+    p(f"case: {result['title']}  ({result['case']})")
+    p(f"  coefficients: {desc}")
+    p(
+        f"  deep limit: Abar = {result['deep_A_bar_m'] * 1e3:.4f} mm, Bbar = {result['deep_B_bar']:.4f}, "
+        f"Cbar = {result['deep_C_bar']:.4f};  R_t = {result['resistance_Pa'] / 1e6:.1f} MPa ({result['resistance_equation']}); "
+        f"m = {result['mass_kg'] * 1e3:.3f} g"
+    )
+    if "yield_stress_from_critical_velocity_Pa" in result:
+        p(
+            f"  Appendix inverse problem: U_sC = {result['measured_critical_velocity_m_s']:.0f} m/s gives the dynamic "
+            f"yield stress Y_p = {result['yield_stress_from_critical_velocity_Pa'] / 1e6:.1f} MPa (eq. (36))"
+        )
+    Uc = result["critical_velocity_m_s"][0]
+    p(
+        f"  U_sC = {_fmt(Uc, 1, 0)} m/s (eqs. (33)/(36); Y_p = {result['yield_stress_Pa'] / 1e6:.0f} MPa, "
+        f"buckling factor {result['buckling_factor']:.3f}); W1: {result['w1']}"
+    )
+    head = (
+        f"  {'U_s':>7} | {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} | {'elastic exact rod':>17} |"
+        f" {'Forrestal':>9} | {'Chen-Li':>8} | yields"
+    )
+    p(head)
+    p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} |")
+    n = len(result["striking_velocity_m_s"])
+    for i in range(n):
+        r = {k: result[k][i] for k in (
+            "striking_velocity_m_s", "depth_rigid_m", "time_rigid_s", "depth_quasi_rigid_m", "time_quasi_rigid_s",
+            "depth_elastic_m", "stop_time_elastic_s", "depth_elastic_exact_rod_m", "stop_time_elastic_exact_rod_s",
+            "depth_forrestal_m", "depth_chen_li_m", "yields")}
+        p(
+            f"  {r['striking_velocity_m_s']:7.0f} | {_fmt(r['depth_rigid_m'], 1e3):>7} {_fmt(r['time_rigid_s'], 1e6):>7} |"
+            f" {_fmt(r['depth_quasi_rigid_m'], 1e3):>7} {_fmt(r['time_quasi_rigid_s'], 1e6):>7} |"
+            f" {_fmt(r['depth_elastic_m'], 1e3):>7} {_fmt(r['stop_time_elastic_s'], 1e6):>7} |"
+            f" {_fmt(r['depth_elastic_exact_rod_m'], 1e3):>8} {_fmt(r['stop_time_elastic_exact_rod_s'], 1e6):>8} |"
+            f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
+            f" {'YES (outside the model)' if r['yields'] else 'no'}"
+        )
+    val = result.get("validation")
+    if val:
+        p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
+        for key, st in val["statistics"].items():
+            p(f"    {key:<18} mean {st['mean'] * 100:+6.1f} %   mean |e| {st['mean_abs'] * 100:5.1f} %   max |e| {st['max_abs'] * 100:5.1f} %")
+
+
+def run(args) -> int:
+    from semianalytic.io import check_report_target
+    from semianalytic.penetration.curve import coefficients_for_case
+
+    cases = _load(args.cases)
+    if args.report is not None:
+        from semianalytic.penetration.report import report_path
+
+        check_report_target(report_path(args.report, cases, args.report_name), args.force)
+    results, descs = [], []
+    for case in cases:
+        coefficients, desc, fallback = coefficients_for_case(case, args.coefficients, args.cache_dir)
+        if fallback:
+            print("warning: the BEM coefficient table is not available in this version; using the paper's quoted "
+                  "constant Abar, Bbar, Cbar instead", file=sys.stderr)
+        results.append(evaluate_case(case, coefficients, w1=args.w1))
+        descs.append(desc)
+    if args.json:
+        objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
+        print(json.dumps(objs[0] if len(objs) == 1 else {"cases": objs}, indent=1, allow_nan=True))
+    else:
+        for r, d in zip(results, descs):
+            _print_text(r, d)
+    if args.report is not None:
+        from semianalytic.penetration.report import write_report
+
+        path = write_report(args.report, cases, args, name=args.report_name, force=args.force)
+        if not args.json:
+            print(f"report: {path}")
+    return 0
