@@ -8,8 +8,8 @@ Two domains (Part I, section 1.2 and Fig. 1; sign conventions of errata item 1b)
   +x).  For P < L_h the nose is cut by the free surface x = 0 at the waterline radius r_w;
   for P >= L_h the entry hole and the shank form one cylinder r = d/2, 0 <= x <= P - L_h
   (n_x = 0 there, so the projectile length L does not enter, errata item 1b).  Closed by a
-  quarter circle of radius ``far_radius`` centred on the origin (the centre of the mirrored
-  source, errata item 2f).
+  quarter circle of radius ``far_radius`` = far (d + P) centred on the origin (the centre of
+  the mirrored source, errata item 2f).
 
 Boundary tags: ``body`` (Neumann -n_x), ``wall`` (hole and shank, 0), ``free`` (x = 0, 0),
 ``axis`` (r = 0, natural), ``far`` (Robin far field).  A third domain, ``annulus_domain``, is
@@ -129,7 +129,8 @@ class MeshOptions:
     junction, free-surface corner or waterline) as a fraction of ``h``; ``growth``: the
     element size at distance s from the body is h (d + growth s), so that refining ``h``
     refines the whole mesh uniformly (needed for clean convergence rates); ``far``:
-    far radius / d (for the half-space: measured beyond the depth, R = P + far d);
+    far radius / d (for the half-space: R = far (d + P), since the image of the hole makes the
+    quadrupole part of the far field grow with P);
     ``order``: geometric order (1 straight edges, 2 curved isoparametric edges).
     """
 
@@ -230,11 +231,11 @@ def _nose_waterline(nose: Nose, depth: float) -> tuple[int, float]:
 
 
 def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
-    """Target x >= 0 around a nose at depth P (tip at x = P), quarter circle at R = P + far d."""
+    """Target x >= 0 around a nose at depth P (tip at x = P), quarter circle at R = far (d + P)."""
     if not depth > 0:
         raise InputError("depth", f"must be positive; got {depth!r} m")
     d, Rb, Lh = nose.diameter, nose.radius, nose.length
-    Rf = depth + options.far * d
+    Rf = options.far * (d + depth)
     tip = (depth, 0.0)
     pieces: list[tuple[str, Piece]] = [("axis", _line(tip, (Rf, 0.0))), ("far", _far_arc((0.0, 0.0), Rf, 0.0, 0.5 * math.pi))]
     refine = [tip]
