@@ -320,3 +320,18 @@ def test_initial_porosity_lowers_front_stress():
     r0 = solve_cavity(AD995)
     r1 = solve_cavity(BrittleMaterial(373.14 * GPa, 0.232, 0.262 * GPa, 2.62 * GPa, 231.8 * GPa, 0.01))
     assert r1.theta_star > r0.theta_star and abs(r1.sigma_star) < abs(r0.sigma_star)
+
+
+def test_fixed_point_fails_at_its_start_value_limit():
+    """New finding (report): with sigma*_0 = -Y_s the iteration (22) cannot start once
+    Y_s <= 2 (1 - nu)^2 sigma_f (e_c <= 0 at the start), although |g'(x*)| ~ 0.74 < 1 there;
+    just inside that limit it converges."""
+    nu, Ys = 0.2, 2.62 * GPa
+    limit = Ys / (2 * (1 - nu) ** 2)
+    outside = BrittleMaterial(373.14 * GPa, nu, 1.02 * limit, Ys)
+    inside = BrittleMaterial(373.14 * GPa, nu, 0.9 * limit, Ys)
+    root, _ = solve_front_stress_bracket(outside)
+    assert abs(iteration_slope(-root, outside)) < 0.8
+    run = fixed_point_iteration(outside)
+    assert not run.converged and run.iterations == 0 and "domain" in run.reason
+    assert fixed_point_iteration(inside).converged

@@ -240,6 +240,14 @@ def build(out: Path) -> tuple[str, dict[str, bytes]]:
     doc.image("part2_validity_map.png", "Classification of (nu, sigma_f/Y_s) with AD995's E and Y_s. Above the black "
                                         "line the paper's iteration (22) fails; the bracketed root still works "
                                         "everywhere outside the grey region.")
+    # where the iteration (22) fails, compared with its start-value limit sigma_f/Y_s = 1/(2 (1 - nu)^2)
+    first_fail = [ratios[np.argmax(fp[:, j] > 0)] * 2 * (1 - nu) ** 2 for j, nu in enumerate(nus) if fp[:, j].any()]
+    doc.para(
+        "The black line follows the start-value limit: the iteration cannot start once -Y_s leaves the domain "
+        "e_c > 0 (Y_s <= 2 (1 - nu)^2 sigma_f), and the first failing sigma_f/Y_s on the grid lies at "
+        f"{min(first_fail):.2f}-{max(first_fail):.2f} times 1/(2 (1 - nu)^2) (grid spacing 12 %), where "
+        "|g'(x*)| is still below 1."
+    )
     doc.para(
         f"For AD995's E, sigma_f, Y_s: theta_k < 0 (rejected) for nu > {nu0:.3f}, and theta_k > theta* (warned) for "
         f"nu < {nu1:.3f}; errata item 20 gives 0.31-0.34 and 0.16-0.21. A cracked zone needs -sigma* > 2 sigma_f "
@@ -299,7 +307,9 @@ def build(out: Path) -> tuple[str, dict[str, bytes]]:
         "New: (1) the iteration (22) can also fail without any local instability: when Y_s <= 2 (1 - nu)^2 sigma_f "
         "the start value itself lies where e_c <= 0, so the first iterate's square root is imaginary (e.g. nu = 0.05, "
         "sigma_f = 2 GPa with AD995's E, Y_s, where |g'(x*)| = 0.81 < 1), and for |g'| near 1 the oscillating "
-        "iterates can overshoot out of that domain. The bracketed root is unaffected. (2) With the errata's forms "
+        "iterates can overshoot out of that domain. In the map above this start-value limit, sigma_f/Y_s = "
+        "1/(2 (1 - nu)^2), is the boundary that binds; errata 13's local limit (1 - nu) sqrt(2 sigma_f/|sigma*|) ~ 0.65 "
+        "is only reached beyond it. The bracketed root is unaffected. (2) With the errata's forms "
         "the paper's example is reproduced to every printed digit; the only remaining difference, R_r = 11.63 vs "
         "11.61 GPa, comes from the paper rounding theta_k to 0.018 in eq. (34)."
     )
