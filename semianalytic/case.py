@@ -159,7 +159,9 @@ class BemSection(Section):
     """``[bem]``: numerical options of the boundary-element solver (all optional)."""
 
     order: int = Field(default=8, ge=2, le=16, description="Gauss points (unknowns) per panel")
-    refinement: float = Field(default=1.0, gt=0.0, le=8.0, description="panel-count multiplier")
+    refinement: float | None = Field(
+        default=None, gt=0.0, le=8.0, description="panel-count multiplier (default: 1 for bodies, 0.5 for tables)"
+    )
 
 
 class CoefficientsSection(Section):

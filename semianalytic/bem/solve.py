@@ -78,8 +78,8 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     """Parameter u* of the point of panel ``pan`` nearest to (xq, rq), and the distance in
     the panel's parameter, du = distance / |dy/du| at u*.
 
-    Sampled, then refined by Newton's method where the nearest sample is interior (an end
-    of the panel, the usual case for neighbouring panels, is taken as it is)."""
+    Sampled, then refined by Newton's method (projected onto [-1, 1]): the minimum may lie
+    between an end sample and its neighbour."""
     samples = _samples(ps.order)
     x, r, xu, ru = ps.evaluate(pan[:, None], samples[None, :])
     d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
@@ -87,7 +87,7 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     rows = np.arange(len(pan))
     u = samples[j]
     du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
-    inner = np.nonzero((j > 0) & (j < len(samples) - 1))[0]
+    inner = np.arange(len(pan))
     if inner.size:
         ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
         for _ in range(3):  # Newton on (y(u) - x) . y'(u) = 0
@@ -178,12 +178,50 @@ def _flat_nodes(ps: PanelSet):
     return g.x.ravel(), g.r.ravel(), g.tr.ravel(), -g.tx.ravel(), g.w.ravel()
 
 
-def assemble(ps: PanelSet) -> tuple[np.ndarray, np.ndarray]:
+@dataclass(frozen=True)
+class AssemblyPlan:
+    """Which rule each (target, panel) pair gets.
+
+    Made from one panel set and reusable on any other of the same topology (the layouts of
+    neighbouring depths in a difference in P): the rules then stay the same, so the
+    computed potential is a smooth function of P.
+    """
+
+    self_levels: np.ndarray  # (N, 2): dyadic levels of the self rule, right and left of u_q
+    near_target: np.ndarray
+    near_panel: np.ndarray
+    near_u: np.ndarray  # u* of each near pair
+    near_du: np.ndarray  # distance in the panel parameter
+
+
+def plan_assembly(ps: PanelSet) -> AssemblyPlan:
+    """Choose the self and near rules for the primary nodes of ``ps``."""
+    p = ps.order
+    X, R, _, _, _ = _flat_nodes(ps)
+    N = ps.n_primary * p
+    xt, rt = X[:N], R[:N]
+    own_panel = np.arange(N) // p
+    uq = gauss_legendre(p)[0][np.arange(N) % p]
+    levels = np.zeros((N, 2), dtype=int)
+    cx, cr = ps.centers
+    # targets whose image in the axis is close to their own panel (see _self_block)
+    close = np.nonzero(np.hypot(xt - cx[own_panel], rt + cr[own_panel]) < (IMAGE_MARGIN + 1) * ps.lengths[own_panel])[0]
+    if close.size:
+        _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
+        # one rule for all of them (the most graded): few groups, fast
+        levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN).max()
+        levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN).max()
+    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
+    return AssemblyPlan(levels, tgt, pan, ustar, du)
+
+
+def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Matrices (Smat, Dmat) of the single and double layer at the primary nodes.
 
     Columns of mirror nodes are already folded onto their images, so both are
     (N, N) with N = n_primary * p, and (**) reads (I/2 - Dmat) phi = -Smat g.
     """
+    plan = plan or plan_assembly(ps)
     p = ps.order
     X, R, NX, NR, W = _flat_nodes(ps)
     N = ps.n_primary * p
@@ -196,17 +234,16 @@ def assemble(ps: PanelSet) -> tuple[np.ndarray, np.ndarray]:
     own_panel = np.arange(N) // p
 
     # self panels: product integration of the logarithm
-    q = np.arange(N) % p
-    S_self, D_self = _self_block(ps, xt, rt, own_panel, q, gauss_u)
+    S_self, D_self = _self_block(ps, xt, rt, own_panel, np.arange(N) % p, gauss_u, plan.self_levels)
     cols = own_panel[:, None] * p + np.arange(p)[None, :]
     rows = np.arange(N)[:, None]
     S[rows, cols] = S_self
     D[rows, cols] = D_self
 
     # nearly singular panels: dyadically graded rules
-    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
+    tgt, pan = plan.near_target, plan.near_panel
     if tgt.size:
-        Sn, Dn = _near_blocks(ps, xt[tgt], rt[tgt], pan, ustar, du, gauss_u, want="layers")
+        Sn, Dn = _near_blocks(ps, xt[tgt], rt[tgt], pan, plan.near_u, plan.near_du, gauss_u, want="layers")
         cols = pan[:, None] * p + np.arange(p)[None, :]
         S[tgt[:, None], cols] = Sn
         D[tgt[:, None], cols] = Dn
@@ -250,64 +287,48 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
         for key, parts in zip(out, (su, sw, swl, lu, lw, fu, fw)):
             out[key].append(np.concatenate(parts) if parts else np.empty(0))
     table = {k: np.array(v) for k, v in out.items()}
-    for k in ("su", "lu", "fu"):
-        table["L" + k] = lagrange_matrix(uq_all, table[k])
+    if table["fu"].ndim == 1:  # no outer pieces
+        table["fu"] = np.empty((p, 0))
+        table["fw"] = np.empty((p, 0))
+    table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
     return table
 
 
-def _self_block(ps, xt, rt, panel, q, gauss_u):
+def _self_block(ps, xt, rt, panel, q, gauss_u, levels):
     """Integrals of the kernels times l_j over each target's own panel (log singular).
 
     Where the target is close to the axis its image (x, -r) makes the kernels nearly
-    singular too; the rule is then graded towards the target so that the innermost
-    piece stays IMAGE_MARGIN times shorter than the distance to the image."""
+    singular too; the rule is then graded towards the target (``levels``, chosen by
+    :func:`plan_assembly`) so that the innermost piece stays IMAGE_MARGIN times shorter
+    than the distance to the image."""
     N, p = len(xt), ps.order
     uq = gauss_u[q]
-    lev_r = np.zeros(N, dtype=int)
-    lev_l = np.zeros(N, dtype=int)
-    cx, cr = ps.centers
-    close = np.nonzero(np.hypot(xt - cx[panel], rt + cr[panel]) < (IMAGE_MARGIN + 1) * ps.lengths[panel])[0]
-    if close.size:
-        # one rule for all targets near the axis (the most graded one): few groups, fast
-        _, du_img = closest_points(ps, panel[close], xt[close], -rt[close])
-        lev_r[close] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN).max()
-        lev_l[close] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN).max()
     S_blk = np.empty((N, p))
     D_blk = np.empty((N, p))
-    key = lev_r * (MAX_LEVELS + 1) + lev_l
+    key = levels[:, 0] * (MAX_LEVELS + 1) + levels[:, 1]
     for k in np.unique(key):
         sel = np.nonzero(key == k)[0]
         t = _self_rule_table(p, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
         qs = q[sel]
-        pan = panel[sel, None]
-        X, R, U = xt[sel, None], rt[sel, None], uq[sel, None]
-        # innermost pieces: smooth part K + ln|u - u_q| Q, plus Q against the log weight
-        su = t["su"][qs]
-        x, r, xu, ru = ps.evaluate(pan, su)
+        ns, nl = t["su"].shape[1], t["lu"].shape[1]
+        # all nodes of the rule in one evaluation: split nodes | log nodes | outer pieces
+        u = np.concatenate([t["su"][qs], t["lu"][qs], t["fu"][qs]], axis=1)
+        x, r, xu, ru = ps.evaluate(panel[sel, None], u)
         J = np.hypot(xu, ru)
-        S, D, QS, QD = single_double_split(X, R, x, r, ru / J, -xu / J)
-        lnu = np.log(np.abs(su - U))
+        with np.errstate(divide="ignore", invalid="ignore"):
+            S, D, QS, QD = single_double_split(xt[sel, None], rt[sel, None], x, r, ru / J, -xu / J)
+        su = u[:, :ns]
+        lnu = np.log(np.abs(su - uq[sel, None]))
         sw, swl = t["sw"][qs], t["swl"][qs]
-        Lg = t["Lsu"][qs]
-        Sb = np.einsum("nq,nqj->nj", (sw * (S + lnu * QS) + swl * QS) * J, Lg)
-        Db = np.einsum("nq,nqj->nj", (sw * (D + lnu * QD) + swl * QD) * J, Lg)
-        x, r, xu, ru = ps.evaluate(pan, t["lu"][qs])
-        J = np.hypot(xu, ru)
-        _, _, QS, QD = single_double_split(X, R, x, r, ru / J, -xu / J)
-        lwJ = t["lw"][qs] * J
-        Lg = t["Llu"][qs]
-        Sb += np.einsum("nq,nqj->nj", lwJ * QS, Lg)
-        Db += np.einsum("nq,nqj->nj", lwJ * QD, Lg)
-        if t["fu"].shape[1]:
-            x, r, xu, ru = ps.evaluate(pan, t["fu"][qs])
-            J = np.hypot(xu, ru)
-            S, D = single_double(X, R, x, r, ru / J, -xu / J)
-            fwJ = t["fw"][qs] * J
-            Lg = t["Lfu"][qs]
-            Sb += np.einsum("nq,nqj->nj", fwJ * S, Lg)
-            Db += np.einsum("nq,nqj->nj", fwJ * D, Lg)
-        S_blk[sel] = Sb
-        D_blk[sel] = Db
+        wS = np.concatenate(
+            [sw * (S[:, :ns] + lnu * QS[:, :ns]) + swl * QS[:, :ns], t["lw"][qs] * QS[:, ns:ns + nl],
+             t["fw"][qs] * S[:, ns + nl:]], axis=1) * J
+        wD = np.concatenate(
+            [sw * (D[:, :ns] + lnu * QD[:, :ns]) + swl * QD[:, :ns], t["lw"][qs] * QD[:, ns:ns + nl],
+             t["fw"][qs] * D[:, ns + nl:]], axis=1) * J
+        Lg = t["L"][qs]
+        S_blk[sel] = np.einsum("nq,nqj->nj", wS, Lg)
+        D_blk[sel] = np.einsum("nq,nqj->nj", wD, Lg)
     return S_blk, D_blk
 
 
@@ -491,13 +512,15 @@ def solve_panels(
     depth: float | None = None,
     volume: float | None = None,
     neumann=None,
+    plan: AssemblyPlan | None = None,
 ) -> SurfaceSolution:
     """Assemble and solve (**).
 
     ``neumann(x, r, nx, nr) -> g`` gives dphi/dn at the primary nodes; the default is
-    unit motion in +x, g = -n_x (Part I, eq. (7)).
+    unit motion in +x, g = -n_x (Part I, eq. (7)).  ``plan`` reuses the quadrature rules
+    of a panel set of the same topology.
     """
-    S, D = assemble(ps)
+    S, D = assemble(ps, plan)
     N = S.shape[0]
     geo = ps.nodes
     n = ps.n_primary

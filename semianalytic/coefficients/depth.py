@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from semianalytic.bem.panels import HalfspaceLayout, LayoutOptions, halfspace_layout
-from semianalytic.bem.solve import SurfaceSolution, solve_panels
+from semianalytic.bem.solve import SurfaceSolution, plan_assembly, solve_panels
 from semianalytic.geometry import Nose
 
 # central-difference weights for the first derivative (step h): order -> offsets, weights
@@ -84,13 +84,15 @@ def coefficients_at_depth(
     layout = halfspace_layout(nose, depth, options)
     h = step if step is not None else _step(nose, depth)
     offsets, weights = STENCILS[fd_order]
-    center = _solve(layout)
-    sols = [_solve(layout.at_depth(depth + k * h)) for k in offsets]
+    panels = layout.panels()
+    plan = plan_assembly(panels)  # the same rules at every depth of the stencil
+    center = solve_panels(panels, "halfspace", depth=depth, plan=plan)
+    sols = [_solve(layout.at_depth(depth + k * h), plan) for k in offsets]
     return _combine(center, sols, weights, h)
 
 
-def _solve(layout: HalfspaceLayout) -> SurfaceSolution:
-    return solve_panels(layout.panels(), "halfspace", depth=layout.depth)
+def _solve(layout: HalfspaceLayout, plan) -> SurfaceSolution:
+    return solve_panels(layout.panels(), "halfspace", depth=layout.depth, plan=plan)
 
 
 def _combine(center: SurfaceSolution, sols, weights, h) -> DepthCoefficients:

@@ -49,8 +49,10 @@ def default_depths(nose: Nose, n_depths: int = 64, max_depth_nose_lengths: float
     return np.geomspace(0.01 * scale + Lh, P_max, n_depths)
 
 
-def deep_limit(depth: np.ndarray, values: np.ndarray, tail: int = 8) -> float:
-    """Limit as P -> infinity from a least-squares fit X = X_inf + a/P + b/P^2 over the tail."""
+def deep_limit(depth: np.ndarray, values: np.ndarray) -> float:
+    """Limit as P -> infinity from a least-squares fit X = X_inf + a/P + b/P^2 over the
+    deepest decade of the table (at least the last four depths)."""
+    tail = max(4, int(np.sum(depth >= 0.1 * depth[-1])))
     P = depth[-tail:]
     X = values[-tail:]
     M = np.column_stack([np.ones_like(P), 1.0 / P, 1.0 / P**2])
