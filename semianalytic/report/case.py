@@ -9,6 +9,7 @@ Example (Part I, Fig. 13: the velocity field around the ogival nose at P = 35.9 
     field_grid = [49, 25]                           # nodes along x and r of the meridian grid
     field_segments = 24                             # azimuthal segments of the revolved 3D grid
     render = true                                   # off-screen pyvista render into the report
+    coefficients = "bem"                            # or "paper": the paper's quoted Abar, Bbar, Cbar
     vtk_dir = "vtk"                                 # sub-folder of the output folder
 
 Paths (``vtk_dir``, ``figures_dir``) are relative to the output folder and may not leave it
@@ -74,6 +75,7 @@ class RunSection(Section):
     field_segments: int = Field(default=24, ge=3, le=180)
     field_velocity: Velocity | None = None
     render: bool = True
+    coefficients: Literal["bem", "paper"] = "bem"  # "paper": the paper's quoted Abar, Bbar, Cbar (errata 2, 2c)
     vtk_dir: str = "vtk"
     figures_dir: str = "figures"
 

@@ -53,12 +53,26 @@ def _projectile(case: Case):
     return projectile_from_section(case.require("projectile"))
 
 
-def _field_velocity(case: Case, run: RunSection) -> float:
+def _field_velocity(case: Case, run: RunSection, memo: dict | None = None, depth: float | None = None) -> tuple[float, str]:
+    """u for v = -u grad(phi): [run] field_velocity, else the rigid projectile's speed at this
+    depth for the first striking velocity (when the penetration step ran), else U_s."""
     if run.field_velocity is not None:
-        return run.field_velocity
-    if case.impact is not None:
-        return float(case.impact.striking_velocities[0])
-    return 1.0
+        return run.field_velocity, "[run] field_velocity"
+    if case.impact is None:
+        return 1.0, "unit speed"
+    U = float(case.impact.striking_velocities[0])
+    motion = (memo or {}).get("rigid_motion", {}).get(U)
+    if motion is not None and depth is not None and depth < motion.final_depth:
+        return float(np.interp(depth, motion.P, motion.u)), f"rigid projectile at this depth, U_s = {U:g} m/s"
+    return U, "striking velocity U_s"
+
+
+def bem_options(case: Case) -> dict:
+    """order (and refinement, when the case sets it) for the BEM solvers."""
+    out = {"order": case.bem.order}
+    if case.bem.refinement is not None:
+        out["refinement"] = case.bem.refinement
+    return out
 
 
 def _mm(v) -> str:
@@ -72,6 +86,14 @@ def _coefficient_table(ctx: Context):
 
         ctx.memo["table"] = coefficient_table_for(ctx.case, ctx.cache_dir)
     return ctx.memo["table"]
+
+
+def table_available() -> bool:
+    try:
+        importlib.import_module("semianalytic.coefficients.table")
+    except ImportError:
+        return False
+    return True
 
 
 # --------------------------------------------------------------------------------------
@@ -113,10 +135,9 @@ def introduction(ctx: Context, case_path, steps: list[Step], skipped: dict[str, 
                 rows.append([label, fmt(v * scale)])
     if case.target is not None:
         rows.append(["target density rho [kg/m^3]", fmt(case.target.density)])
-        if case.target.resistance:
-            res = case.target.resistance
-            items = res.items() if isinstance(res, dict) else res.model_dump().items()
-            rows.append(["target resistance", ", ".join(f"{k} = {v}" for k, v in items)])
+        raw = case.raw.get("target", {}).get("resistance")
+        if isinstance(raw, dict):
+            rows.append(["target resistance", ", ".join(f"{k} = {v}" for k, v in raw.items())])
     if case.impact is not None:
         rows.append(["striking velocities U_s [m/s]", ", ".join(fmt(v) for v in case.impact.striking_velocities)])
     if case.body is not None:
@@ -149,7 +170,7 @@ def _added_mass_run(ctx: Context) -> None:
 
     b = ctx.case.body
     meridian = body_from_section(b)
-    sol = solve_body(meridian, order=ctx.case.bem.order, refinement=ctx.case.bem.refinement)
+    sol = solve_body(meridian, **bem_options(ctx.case))
     k = sol.added_mass_coefficient
     ref = None
     if b.shape == "sphere":
@@ -206,20 +227,20 @@ def _velocity_field_run(ctx: Context) -> None:
 
     case, run = ctx.case, ctx.run
     pr = _projectile(case)
-    u = _field_velocity(case, run)
     d = ctx.doc
     d.heading("Velocity field (Part I, eq. (23); Figs. 12-13)")
     d.para(
-        f"v = -u grad(phi) (eq. (8)) from the BEM potential of the half-space problem, at u = {fmt(u)} m/s, on a "
+        "v = -u grad(phi) (eq. (8)) from the BEM potential of the half-space problem, on a "
         f"{run.field_grid[0]} x {run.field_grid[1]} grid of the meridian plane {run.field_extent:g} diameters around "
         f"the nose, revolved into {run.field_segments} azimuthal segments. Open the `.vtu` files in ParaView or "
         "pyvista (point data `velocity` [m/s], `speed` [m/s], `phi` [m] at unit speed, `Phi` = u phi [m^2/s])."
     )
     out = []
     for P in _field_depths(case, run):
+        u, why = _field_velocity(case, run, ctx.memo, P)
         field, sol = vtk.projectile_field(
             pr.nose, pr.length, P, u, extent=run.field_extent, grid=tuple(run.field_grid),
-            order=case.bem.order, refinement=case.bem.refinement,
+            **bem_options(case),
         )
         tag = f"P{P * 1e3:.1f}mm".replace(".", "p")
         rel2, p2 = ctx.vtk_path(f"velocity_meridian_{tag}.vtu")
@@ -243,6 +264,7 @@ def _velocity_field_run(ctx: Context) -> None:
         out.append({
             "depth_m": P,
             "speed_u_m_s": u,
+            "speed_u_from": why,
             "phi_tip_m": sol.phi_tip,
             "max_speed_m_s": float(np.nanmax(speed)),
             "A_m3": sol.A,
@@ -250,8 +272,8 @@ def _velocity_field_run(ctx: Context) -> None:
             "vtk": {"meridian": rel2, "revolved": rel3, "projectile": rels},
         })
     d.table(
-        ["P [mm]", "u [m/s]", "max |v| on grid [m/s]", "phi at tip [mm]", "Abar [mm]", "Cbar"],
-        [[_mm(o["depth_m"]), fmt(o["speed_u_m_s"]), fmt(o["max_speed_m_s"]), _mm(o["phi_tip_m"]),
+        ["P [mm]", "u [m/s] (from)", "max |v| on grid [m/s]", "phi at tip [mm]", "Abar [mm]", "Cbar"],
+        [[_mm(o["depth_m"]), f'{fmt(o["speed_u_m_s"])} ({o["speed_u_from"]})', fmt(o["max_speed_m_s"]), _mm(o["phi_tip_m"]),
           _mm(4 * o["A_m3"] / (math.pi * pr.diameter**2)), fmt(4 * o["C_m2"] / (math.pi * pr.diameter**2))]
          for o in out],
     )
@@ -398,3 +420,7 @@ def select_steps(case: Case, run: RunSection, only=None) -> tuple[list[Step], di
     if not chosen:
         raise InputError(field if requested else "case", "nothing to run: no analysis applies to this case")
     return chosen, skipped
+
+
+# Part I steps register themselves on import
+from semianalytic.report import steps_part1  # noqa: E402,F401

@@ -306,7 +306,7 @@ def projectile_field(
     extent: float = 2.0,
     grid: tuple[int, int] = (49, 25),
     order: int = 8,
-    refinement: float = 1.0,
+    refinement: float | None = None,
     solution=None,
 ):
     """BEM velocity field around the projectile at depth P: Part I, eq. (23).
@@ -316,7 +316,8 @@ def projectile_field(
     """
     from semianalytic.bem import solve_halfspace
 
-    sol = solution if solution is not None else solve_halfspace(nose, depth, order=order, refinement=refinement)
+    opts = {"order": order} if refinement is None else {"order": order, "refinement": refinement}
+    sol = solution if solution is not None else solve_halfspace(nose, depth, **opts)
     x0, x1, r1 = field_window(nose, length, depth, extent)
     g = meridian_grid(x0, x1, r1, grid[0], grid[1], projectile_inside(nose, length, depth))
     return evaluate_field(g, sol.gradient, u, sol.potential, depth=depth), sol

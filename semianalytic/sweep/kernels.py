@@ -61,11 +61,12 @@ def coefficient_table_for(case: Case, cache_dir=None, progress: bool = False):
     nose = nose_from_section(case.require("projectile"))
     kwargs = dict(
         order=case.bem.order,
-        refinement=case.bem.refinement,
         n_depths=case.coefficients.depths,
         max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
         progress=progress,
     )
+    if case.bem.refinement is not None:  # None: the table's own default
+        kwargs["refinement"] = case.bem.refinement
     if cache_dir is not None:
         kwargs["cache_dir"] = cache_dir
     table = cached_coefficient_table(nose, **kwargs)
