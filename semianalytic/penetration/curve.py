@@ -232,7 +232,6 @@ def penetration_curve(
     *,
     w1: str = "neglect",
     elastic: bool = True,
-    rtol: float = 1e-12,
     n_grid: int = 512,
 ) -> dict[str, np.ndarray]:
     """Every Part I projectile model for each striking velocity (arrays, SI; keys carry units).
@@ -249,7 +248,7 @@ def penetration_curve(
     U = np.atleast_1d(np.asarray(striking_velocities, float))
     if U.size == 0 or np.any(~np.isfinite(U)) or np.any(U <= 0):
         raise InputError("impact.striking_velocities", "must be positive (m/s)")
-    prof = depth_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa, float(U.max()), rtol=rtol)
+    prof = depth_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa, float(U.max()))
     rigid = _stops(prof, U, n_grid)
     nan = np.full(U.shape, np.nan)
     out = {
@@ -324,16 +323,19 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
 
     kwargs = dict(
         order=case.bem.order,
-        refinement=case.bem.refinement,
         n_depths=case.coefficients.depths,
         max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
         progress=progress,
     )
+    refinement = getattr(case.bem, "refinement", None)
+    if refinement is not None:  # else the table's own default
+        kwargs["refinement"] = refinement
     if cache_dir is not None:
         kwargs["cache_dir"] = cache_dir
     table = cached_coefficient_table(nose_from_section(psec), **kwargs).with_reading(case.coefficients.reading)
+    ref = f"refinement {refinement:g}" if refinement is not None else "default refinement"
     desc = (
-        f"BEM table (order {case.bem.order}, refinement {case.bem.refinement:g}, {case.coefficients.depths} depths "
+        f"BEM table (order {case.bem.order}, {ref}, {case.coefficients.depths} depths "
         f"to {case.coefficients.max_depth_nose_lengths:g} nose lengths, B reading '{case.coefficients.reading}')"
     )
     return table, desc, False

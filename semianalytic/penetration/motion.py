@@ -14,8 +14,9 @@ Three evaluations, each a check on the others:
 * :func:`final_depth` / :func:`depth_profile`: P as the independent variable.  With
   w = u^2, eq. (11) is linear, (m + rho A) dw/dP = -(rho B w + 2 C R_t), so
   w(P) = exp(-F(P)) [U_0^2 - G(P)] with F = int rho B/(m + rho A) dP and
-  G = int 2 C R_t exp(F)/(m + rho A) dP.  One integration serves every U_0; the final depth
-  solves G(P_f) = U_0^2 (vectorised).
+  G = int 2 C R_t exp(F)/(m + rho A) dP, both by spectral quadrature on panels aligned with
+  the coefficient table's knots.  One integration serves every U_0; the final depth solves
+  G(P_f) = U_0^2 (vectorised).
 * :class:`ConstantCoefficientSolution`: the closed form for constant A, B, C, Part IV,
   eqs. (2)-(3), with the corrections of errata items 22-24.
 """
@@ -253,10 +254,35 @@ def solve_motion(
 # P as the independent variable: all striking velocities at once
 
 
+def _chebyshev_panel_rule(n: int):
+    """Chebyshev-Lobatto nodes x (n, on [-1, 1], ascending), barycentric weights, and the
+    spectral integration matrix Q with (Q f)_i = int_{-1}^{x_i} p_f, p_f the interpolant of f."""
+    from numpy.polynomial import chebyshev as ch
+
+    x = -np.cos(np.pi * np.arange(n) / (n - 1))
+    V = ch.chebvander(x, n - 1)  # V[i, j] = T_j(x_i)
+    coef_of_values = np.linalg.inv(V)
+    integ = np.column_stack([ch.chebint(np.eye(n)[j]) for j in range(n)])  # (n+1, n) antiderivative coefficients
+    W = ch.chebvander(x, n) @ integ - ch.chebvander(np.array([-1.0]), n) @ integ
+    bw = (-1.0) ** np.arange(n)
+    bw[0] *= 0.5
+    bw[-1] *= 0.5
+    return x, bw, W @ coef_of_values
+
+
+_NODES = 16
+_X, _BW, _Q = _chebyshev_panel_rule(_NODES)
+
+
 @dataclass(frozen=True, eq=False)
 class DepthProfile:
-    """F(P), G(P) of the linear form of eq. (11) in w = u^2 (see the module docstring),
-    integrated once up to ``P_end`` (where G exceeds U_max^2).  SI units.
+    """F(P), G(P) of the linear form of eq. (11) in w = u^2 (see the module docstring) on
+    [0, ``P_end``], where G(P_end) > U_max^2.  SI units.
+
+    F and G are computed by spectral (Chebyshev) integration on panels whose ends include
+    the breakpoints of piecewise-smooth coefficients (a ``depth`` attribute, as the BEM
+    table's interpolation knots), so that every panel sees a smooth integrand; between the
+    nodes they are evaluated by barycentric interpolation.
 
     ``speed2(U0, P)`` = u^2 at depth P for start velocity U0 (broadcasting);
     ``final_depth(U0)`` solves G(P_f) = U0^2; ``dG(P)`` = G'(P) exactly from the coefficients.
@@ -268,19 +294,30 @@ class DepthProfile:
     resistance_pa: float
     U_max: float
     P_end: float
-    _sol: object = field(repr=False)
-    _P_steps: np.ndarray = field(repr=False)
-    _G_steps: np.ndarray = field(repr=False)
-    # ``final_depth`` brackets each root between two integrator steps (G increases)
+    _edges: np.ndarray = field(repr=False)  # panel ends (n_panels + 1)
+    _F: np.ndarray = field(repr=False)  # (n_panels, nodes) values at the Chebyshev nodes
+    _G: np.ndarray = field(repr=False)
 
     def M(self, P):
         return self.mass + self.target_density * np.asarray(self.coefficients.A(P), float)
 
     def _eval(self, P):
-        """(F, G) at P of any shape (the dense output takes 1-D arrays)."""
+        """(F, G) at P of any shape, 0 <= P <= P_end (barycentric interpolation per panel)."""
         P = np.asarray(P, float)
-        y = self._sol(P.ravel())
-        return y[0].reshape(P.shape), y[1].reshape(P.shape)
+        flat = P.ravel()
+        e = self._edges
+        k = np.clip(np.searchsorted(e, flat, side="right") - 1, 0, len(e) - 2)
+        x = 2.0 * (flat - e[k]) / (e[k + 1] - e[k]) - 1.0
+        d = x[:, None] - _X[None, :]
+        exact = d == 0.0
+        with np.errstate(divide="ignore", invalid="ignore"):
+            c = _BW[None, :] / d
+        hit = exact.any(axis=1)
+        c[hit] = exact[hit].astype(float)
+        c /= c.sum(axis=1, keepdims=True)
+        F = np.einsum("ij,ij->i", c, self._F[k])
+        G = np.einsum("ij,ij->i", c, self._G[k])
+        return F.reshape(P.shape), G.reshape(P.shape)
 
     def F(self, P):
         return self._eval(P)[0]
@@ -291,8 +328,7 @@ class DepthProfile:
     def dG(self, P):
         """G'(P) = 2 C R_t exp(F) / (m + rho A)."""
         P = np.asarray(P, float)
-        F = self.F(P)
-        return 2.0 * np.asarray(self.coefficients.C(P), float) * self.resistance_pa * np.exp(F) / self.M(P)
+        return 2.0 * np.asarray(self.coefficients.C(P), float) * self.resistance_pa * np.exp(self.F(P)) / self.M(P)
 
     def speed2(self, U0, P):
         """u^2 = exp(-F(P)) (U0^2 - G(P)) (>= 0 before the stop)."""
@@ -300,15 +336,17 @@ class DepthProfile:
         return np.exp(-F) * (np.asarray(U0, float) ** 2 - G)
 
     def final_depth(self, U0):
-        """P_f with G(P_f) = U0^2, vectorised (safeguarded Newton in the integrator's step)."""
+        """P_f with G(P_f) = U0^2, vectorised (safeguarded Newton inside the bracketing panel node pair)."""
         U0 = np.asarray(U0, float)
         if np.any(U0 > self.U_max * (1 + 1e-12)) or np.any(U0 < 0):
             raise ValueError("U0 must lie in [0, U_max] of the profile")
         g = U0.ravel() ** 2
-        Ps, Gs = self._P_steps, self._G_steps
-        k = np.clip(np.searchsorted(Gs, g, side="left"), 1, len(Gs) - 1)
-        lo, hi = Ps[k - 1].copy(), Ps[k].copy()
-        Glo, Ghi = Gs[k - 1], Gs[k]
+        e = self._edges
+        Pn = (e[:-1, None] + 0.5 * (e[1:] - e[:-1])[:, None] * (_X + 1.0)[None, :]).ravel()
+        Gn = np.maximum.accumulate(self._G.ravel())
+        k = np.clip(np.searchsorted(Gn, g, side="left"), 1, len(Gn) - 1)
+        lo, hi = Pn[k - 1].copy(), Pn[k].copy()
+        Glo, Ghi = Gn[k - 1], Gn[k]
         with np.errstate(invalid="ignore", divide="ignore"):
             frac = np.where(Ghi > Glo, (g - Glo) / (Ghi - Glo), 0.5)
         P = lo + np.clip(frac, 0.0, 1.0) * (hi - lo)
@@ -322,55 +360,77 @@ class DepthProfile:
                 self.mass + self.target_density * np.asarray(A(P), float)
             )
             with np.errstate(invalid="ignore", divide="ignore"):
-                Pn = P - r / dG
-            bad = ~np.isfinite(Pn) | (Pn < lo) | (Pn > hi)
-            Pn = np.where(bad, 0.5 * (lo + hi), Pn)
-            done = (np.abs(Pn - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
-            P = Pn
+                Pn_ = P - r / dG
+            bad = ~np.isfinite(Pn_) | (Pn_ < lo) | (Pn_ > hi)
+            Pn_ = np.where(bad, 0.5 * (lo + hi), Pn_)
+            done = (np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
+            P = Pn_
             if np.all(done):
                 break
         P = np.where(g == 0, 0.0, P)
         return P.reshape(U0.shape)[()]
 
 
+def _panels(breaks: np.ndarray, P_to: float, max_len: float, start: float = 0.0) -> np.ndarray:
+    """Panel ends on [start, P_to]: the breakpoints inside, each gap cut into pieces <= max_len."""
+    pts = np.unique(np.concatenate([[start, P_to], breaks[(breaks > start) & (breaks < P_to)]]))
+    out = [pts[:1]]
+    for a, b in zip(pts[:-1], pts[1:]):
+        n = int(np.ceil((b - a) / max_len))
+        out.append(np.linspace(a, b, n + 1)[1:])
+    return np.concatenate(out)
+
+
 def depth_profile(
-    coefficients, mass: float, target_density: float, resistance_pa: float, U_max: float, *, rtol: float = 1e-12
+    coefficients, mass: float, target_density: float, resistance_pa: float, U_max: float, *, panel_scale: float = 1.0
 ) -> DepthProfile:
-    """Integrate F and G of the w = u^2 form of Part I, eq. (11) in P until G > U_max^2."""
+    """F and G of the w = u^2 form of Part I, eq. (11), integrated in P until G > U_max^2.
+
+    Panels: the coefficients' breakpoints (``coefficients.depth`` if present) plus pieces no
+    longer than a fortieth of the deep-limit stopping depth of U_max (times ``panel_scale``),
+    16 Chebyshev nodes each.
+    """
     _check_inputs(mass, target_density, resistance_pa)
     if not (np.isfinite(U_max) and U_max > 0):
         raise ValueError(f"U_max must be positive; got {U_max!r}")
     rho, R, m = float(target_density), float(resistance_pa), float(mass)
     d = float(coefficients.diameter)
-    cA, cB, cC = coefficients.A, coefficients.B, coefficients.C
-    g_end = U_max**2 * (1.0 + 1e-6)
-
-    def rhs(P, y):
-        A, B, C = float(cA(P)), float(cB(P)), float(cC(P))
-        M = m + rho * A
-        return (rho * B / M, 2.0 * C * R * math.exp(y[0]) / M)
-
-    def past(P, y):
-        return y[1] - g_end
-
-    past.terminal = True
-    past.direction = 1
+    breaks = np.asarray(getattr(coefficients, "depth", np.empty(0)), float).ravel()
     A8, B8, C8 = deep_coefficients(coefficients)
-    P_guess = 2.0 * ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U_max).final_depth + 200.0 * d
-    sol = solve_ivp(
-        rhs, (0.0, P_guess), [0.0, 0.0], method="DOP853", rtol=rtol, atol=[rtol * 1e-3, rtol * 1e-3 * U_max**2],
-        events=past, dense_output=True,
-    )
-    if sol.status != 1:
-        raise RuntimeError(f"eq. (11) in P: G did not reach U_max^2 before P = {P_guess:g} m ({sol.message})")
-    P_end = float(sol.t_events[0][0])
-    Ps = sol.t.copy()
-    Gs = sol.y[1].copy()
-    Ps[-1], Gs[-1] = P_end, float(sol.y_events[0][0][1])
-    return DepthProfile(coefficients, m, rho, R, float(U_max), P_end, sol.sol, Ps, np.maximum.accumulate(Gs))
+    P_scale = ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U_max).final_depth + 2.0 * d
+    max_len = panel_scale * P_scale / 40.0
+    g_end = U_max**2 * (1.0 + 1e-9)
+    edges = np.array([0.0])
+    Fs, Gs = np.empty((0, _NODES)), np.empty((0, _NODES))
+    F0 = G0 = 0.0
+    P_to = 1.5 * P_scale
+    for _ in range(60):
+        new = _panels(breaks, P_to, max_len, start=edges[-1])
+        a, b = new[:-1], new[1:]
+        h = 0.5 * (b - a)
+        nodes = a[:, None] + h[:, None] * (_X + 1.0)[None, :]
+        A = np.asarray(coefficients.A(nodes), float)
+        B = np.asarray(coefficients.B(nodes), float)
+        C = np.asarray(coefficients.C(nodes), float)
+        M = m + rho * A
+        fF = rho * B / M
+        Floc = h[:, None] * (fF @ _Q.T)
+        F = F0 + np.concatenate([[0.0], np.cumsum(Floc[:, -1])[:-1]])[:, None] + Floc
+        fG = 2.0 * C * R * np.exp(F) / M
+        Gloc = h[:, None] * (fG @ _Q.T)
+        G = G0 + np.concatenate([[0.0], np.cumsum(Gloc[:, -1])[:-1]])[:, None] + Gloc
+        edges = np.concatenate([edges, new[1:]])
+        Fs, Gs = np.vstack([Fs, F]), np.vstack([Gs, G])
+        F0, G0 = F[-1, -1], G[-1, -1]
+        if G0 > g_end:
+            break
+        P_to = edges[-1] * 2.0
+    else:
+        raise RuntimeError("eq. (11) in P: G did not reach U_max^2 (does the projectile stop?)")
+    return DepthProfile(coefficients, m, rho, R, float(U_max), float(edges[-1]), edges, Fs, Gs)
 
 
-def final_depth(coefficients, mass: float, target_density: float, resistance_pa: float, U0, *, rtol: float = 1e-12):
+def final_depth(coefficients, mass: float, target_density: float, resistance_pa: float, U0):
     """Final depth [m] of Part I, eq. (11) for every U0 [m/s] (array in, array out), from one
     integration in P (see the module docstring).  U0 = 0 gives 0."""
     U0 = np.asarray(U0, float)
@@ -378,5 +438,5 @@ def final_depth(coefficients, mass: float, target_density: float, resistance_pa:
         raise ValueError("U0 must be finite and non-negative")
     if U0.size == 0 or np.max(U0) == 0:
         return np.zeros_like(U0)[()]
-    prof = depth_profile(coefficients, mass, target_density, resistance_pa, float(np.max(U0)), rtol=rtol)
+    prof = depth_profile(coefficients, mass, target_density, resistance_pa, float(np.max(U0)))
     return prof.final_depth(U0)
