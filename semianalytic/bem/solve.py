@@ -45,8 +45,8 @@ from semianalytic.bem.quadrature import (
     lagrange_matrix,
 )
 
-N_SELF = 10  # points per half-panel in the self rules (plain and log)
-N_NEAR = 10  # Gauss points per dyadic piece in the near rules
+N_SELF = 8  # points per half-panel in the self rules (plain and log)
+N_NEAR = 8  # Gauss points per dyadic piece in the near rules
 NEAR_FACTOR = 1.3  # a panel is "near" a target closer than this many panel lengths to its centre
 MAX_LEVELS = 48
 IMAGE_MARGIN = 4.0  # innermost self piece <= (distance to the axis image)/IMAGE_MARGIN
@@ -140,33 +140,114 @@ def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
     return np.clip(lev, 0, MAX_LEVELS).astype(int)
 
 
-def near_rules(ustar: np.ndarray, du: np.ndarray):
-    """Yield (selection, u, w): graded rules on [-1, 1] split at u*, grouped by level counts.
+@dataclass(frozen=True)
+class PairQuadrature:
+    """Quadrature points for a list of (target, panel) pairs, flattened.
 
-    ``u`` and ``w`` are (n, Q) arrays, or shared (Q,) arrays when the nearest point is an
-    end of the panel for the whole group."""
+    Point k belongs to pair ``pair[k]`` (points sorted by pair; ``starts`` indexes the
+    first point of each pair), sits at the panel coordinate ``u[k]`` and contributes
+    ``(a[k] K + b[k] Q) |dy/du| lag[k, j]`` to the integral of the kernel K against the
+    Lagrange basis function l_j; Q is the coefficient of the logarithm (self rules only,
+    b = 0 elsewhere).
+    """
+
+    target: np.ndarray
+    panel: np.ndarray
+    pair: np.ndarray
+    starts: np.ndarray
+    u: np.ndarray
+    a: np.ndarray
+    b: np.ndarray
+    lag: np.ndarray
+
+    @staticmethod
+    def build(target, panel, order, parts) -> "PairQuadrature":
+        """From parts (pair indices (n,), u (n, Q), a (n, Q), b (n, Q), lag) with any Q
+        each; lag is the (n, Q, p) or shared (Q, p) Lagrange matrix, or None."""
+        if not parts:
+            return PairQuadrature(target, panel, *(np.empty(0, int),) * 2, *(np.empty(0),) * 3, np.empty((0, order)))
+        nodes = gauss_legendre(order)[0]
+        pair = np.concatenate([np.repeat(sel, part[1].shape[1]) for sel, *part in parts])
+        flat = [np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3)]
+        lags = []
+        for sel, u, _, _, lag in parts:
+            if lag is None:
+                lag = lagrange_matrix(nodes, u)
+            lags.append(np.broadcast_to(lag, (*u.shape, order)).reshape(-1, order))
+        order_idx = np.argsort(pair, kind="stable")
+        pair = pair[order_idx]
+        u, a, b = (f[order_idx] for f in flat)
+        lag = np.concatenate(lags)[order_idx]
+        starts = np.searchsorted(pair, np.arange(len(target)))
+        return PairQuadrature(target, panel, pair, starts, u, a, b, lag)
+
+    def integrate(self, ps: PanelSet, xt, rt, kernels):
+        """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
+
+        ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
+        pairs when the rule carries logarithms (b != 0)."""
+        x, r, xu, ru = ps.evaluate(self.panel[self.pair], self.u)
+        J = np.hypot(xu, ru)
+        t = self.target[self.pair]
+        out = []
+        for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J):
+            if isinstance(ker, tuple):
+                K, Q = ker
+                wk = (self.a * K + self.b * Q) * J
+            else:
+                wk = self.a * ker * J
+            out.append(np.add.reduceat(wk[:, None] * self.lag, self.starts, axis=0))
+        return out
+
+
+def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
+    """Dyadic rules on [-1, 1] split at u* (the panel point nearest each target), with
+    pieces no longer than their distance from the target (``du`` in the panel parameter)."""
     left, right = 1.0 + ustar, 1.0 - ustar
-    lev_l, lev_r = _levels(left, du), _levels(right, du)
-    # nearest point at an end of the panel (adjacent panels): one-sided rule, shared nodes
-    end = np.where(left <= 0, -1, np.where(right <= 0, 1, 0))
-    key = (lev_l * (MAX_LEVELS + 1) + lev_r) * 3 + end + 1
+    # levels per side; -1: the side is empty (u* at that end of the panel)
+    lev_l = np.where(left > 0, _levels(left, du), -1)
+    lev_r = np.where(right > 0, _levels(right, du), -1)
+    base = MAX_LEVELS + 2
+    key = (lev_l + 1) * base + lev_r + 1
+    parts = []
     for k in np.unique(key):
         sel = np.nonzero(key == k)[0]
-        e = int(k % 3) - 1
-        levs = k // 3
-        if e == -1:
-            s, w = dyadic_rule(int(levs % (MAX_LEVELS + 1)), N_NEAR)
-            yield sel, -1.0 + 2.0 * s, 2.0 * w
-        elif e == 1:
-            s, w = dyadic_rule(int(levs // (MAX_LEVELS + 1)), N_NEAR)
-            yield sel, 1.0 - 2.0 * s, 2.0 * w
-        else:
-            sl, wl = dyadic_rule(int(levs // (MAX_LEVELS + 1)), N_NEAR)
-            sr, wr = dyadic_rule(int(levs % (MAX_LEVELS + 1)), N_NEAR)
-            us, L, Rr = ustar[sel, None], left[sel, None], right[sel, None]
-            u = np.concatenate([us - L * sl, us + Rr * sr], axis=1)
-            w = np.concatenate([L * wl, Rr * wr], axis=1)
-            yield sel, u, w
+        us = ustar[sel, None]
+        u_parts, w_parts = [], []
+        for lev, side, sign in ((int(k // base) - 1, left, -1.0), (int(k % base) - 1, right, 1.0)):
+            if lev >= 0:
+                s_, w_ = dyadic_rule(lev, N_NEAR)
+                u_parts.append(us + sign * side[sel, None] * s_)
+                w_parts.append(side[sel, None] * w_)
+        u, w = np.concatenate(u_parts, axis=1), np.concatenate(w_parts, axis=1)
+        # u* at an end (neighbouring panels): the same nodes for the whole group
+        shared = np.all(u == u[0])
+        lag = lagrange_matrix(gauss_legendre(order)[0], u[0]) if shared else None
+        parts.append((sel, u, w, np.zeros_like(w), lag))
+    return PairQuadrature.build(target, panel, order, parts)
+
+
+def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
+    """Self rules (log split, graded towards the node by ``levels``) for every primary node."""
+    N = len(levels)
+    q = np.arange(N) % order
+    uq = gauss_legendre(order)[0][q]
+    key = levels[:, 0] * (MAX_LEVELS + 1) + levels[:, 1]
+    parts = []
+    for k in np.unique(key):
+        sel = np.nonzero(key == k)[0]
+        t = _self_rule_table(order, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
+        qs = q[sel]
+        su = t["su"][qs]
+        lnu = np.log(np.abs(su - uq[sel, None]))
+        sw, swl = t["sw"][qs], t["swl"][qs]
+        # split nodes: w (K + ln|u - u_q| Q) + wl Q; log nodes: w Q; outer pieces: w K
+        u = np.concatenate([su, t["lu"][qs], t["fu"][qs]], axis=1)
+        a = np.concatenate([sw, np.zeros_like(t["lw"][qs]), t["fw"][qs]], axis=1)
+        b = np.concatenate([sw * lnu + swl, t["lw"][qs], np.zeros_like(t["fw"][qs])], axis=1)
+        parts.append((sel, u, a, b, t["L"][qs]))
+    own = np.arange(N) // order
+    return PairQuadrature.build(np.arange(N), own, order, parts)
 
 
 # ------------------------------------------------------------------------------------
@@ -180,22 +261,23 @@ def _flat_nodes(ps: PanelSet):
 
 @dataclass(frozen=True)
 class AssemblyPlan:
-    """Which rule each (target, panel) pair gets.
+    """The quadrature of each singular and nearly singular (target, panel) pair.
 
     Made from one panel set and reusable on any other of the same topology (the layouts of
     neighbouring depths in a difference in P): the rules then stay the same, so the
     computed potential is a smooth function of P.
     """
 
-    self_levels: np.ndarray  # (N, 2): dyadic levels of the self rule, right and left of u_q
-    near_target: np.ndarray
-    near_panel: np.ndarray
-    near_u: np.ndarray  # u* of each near pair
-    near_du: np.ndarray  # distance in the panel parameter
+    self_rule: PairQuadrature
+    near_rule: PairQuadrature
 
 
 def plan_assembly(ps: PanelSet) -> AssemblyPlan:
-    """Choose the self and near rules for the primary nodes of ``ps``."""
+    """Choose the self and near rules for the primary nodes of ``ps``.
+
+    Self rules are graded towards the node where the target's image in the axis, (x, -r),
+    is close to its own panel (the analytically continued kernels are singular there), so
+    that the innermost piece stays IMAGE_MARGIN times shorter than the distance to it."""
     p = ps.order
     X, R, _, _, _ = _flat_nodes(ps)
     N = ps.n_primary * p
@@ -204,7 +286,6 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
     uq = gauss_legendre(p)[0][np.arange(N) % p]
     levels = np.zeros((N, 2), dtype=int)
     cx, cr = ps.centers
-    # targets whose image in the axis is close to their own panel (see _self_block)
     close = np.nonzero(np.hypot(xt - cx[own_panel], rt + cr[own_panel]) < (IMAGE_MARGIN + 1) * ps.lengths[own_panel])[0]
     if close.size:
         _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
@@ -212,7 +293,17 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN).max()
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN).max()
     tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
-    return AssemblyPlan(levels, tgt, pan, ustar, du)
+    return AssemblyPlan(self_quadrature(levels, p), near_quadrature(tgt, pan, ustar, du, p))
+
+
+def _layers(X, R, x, r, nx, nr):
+    return single_double(X, R, x, r, nx, nr)
+
+
+def _layers_split(X, R, x, r, nx, nr):
+    with np.errstate(divide="ignore", invalid="ignore"):
+        S, D, QS, QD = single_double_split(X, R, x, r, nx, nr)
+    return (S, QS), (D, QD)
 
 
 def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray, np.ndarray]:
@@ -230,24 +321,13 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray
         S, D = single_double(xt[:, None], rt[:, None], X[None, :], R[None, :], NX[None, :], NR[None, :])
     S *= W[None, :]
     D *= W[None, :]
-    gauss_u, _ = gauss_legendre(p)
-    own_panel = np.arange(N) // p
-
-    # self panels: product integration of the logarithm
-    S_self, D_self = _self_block(ps, xt, rt, own_panel, np.arange(N) % p, gauss_u, plan.self_levels)
-    cols = own_panel[:, None] * p + np.arange(p)[None, :]
-    rows = np.arange(N)[:, None]
-    S[rows, cols] = S_self
-    D[rows, cols] = D_self
-
-    # nearly singular panels: dyadically graded rules
-    tgt, pan = plan.near_target, plan.near_panel
-    if tgt.size:
-        Sn, Dn = _near_blocks(ps, xt[tgt], rt[tgt], pan, plan.near_u, plan.near_du, gauss_u, want="layers")
-        cols = pan[:, None] * p + np.arange(p)[None, :]
-        S[tgt[:, None], cols] = Sn
-        D[tgt[:, None], cols] = Dn
-
+    for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
+        if rule.target.size:
+            Sb, Db = rule.integrate(ps, xt, rt, kernels)
+            rows = rule.target[:, None]
+            cols = rule.panel[:, None] * p + np.arange(p)[None, :]
+            S[rows, cols] = Sb
+            D[rows, cols] = Db
     mirror = ps.mirror_node_index()
     if mirror.size:
         S = S[:, :N] + S[:, mirror]
@@ -292,67 +372,6 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
         table["fw"] = np.empty((p, 0))
     table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
     return table
-
-
-def _self_block(ps, xt, rt, panel, q, gauss_u, levels):
-    """Integrals of the kernels times l_j over each target's own panel (log singular).
-
-    Where the target is close to the axis its image (x, -r) makes the kernels nearly
-    singular too; the rule is then graded towards the target (``levels``, chosen by
-    :func:`plan_assembly`) so that the innermost piece stays IMAGE_MARGIN times shorter
-    than the distance to the image."""
-    N, p = len(xt), ps.order
-    uq = gauss_u[q]
-    S_blk = np.empty((N, p))
-    D_blk = np.empty((N, p))
-    key = levels[:, 0] * (MAX_LEVELS + 1) + levels[:, 1]
-    for k in np.unique(key):
-        sel = np.nonzero(key == k)[0]
-        t = _self_rule_table(p, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
-        qs = q[sel]
-        ns, nl = t["su"].shape[1], t["lu"].shape[1]
-        # all nodes of the rule in one evaluation: split nodes | log nodes | outer pieces
-        u = np.concatenate([t["su"][qs], t["lu"][qs], t["fu"][qs]], axis=1)
-        x, r, xu, ru = ps.evaluate(panel[sel, None], u)
-        J = np.hypot(xu, ru)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            S, D, QS, QD = single_double_split(xt[sel, None], rt[sel, None], x, r, ru / J, -xu / J)
-        su = u[:, :ns]
-        lnu = np.log(np.abs(su - uq[sel, None]))
-        sw, swl = t["sw"][qs], t["swl"][qs]
-        wS = np.concatenate(
-            [sw * (S[:, :ns] + lnu * QS[:, :ns]) + swl * QS[:, :ns], t["lw"][qs] * QS[:, ns:ns + nl],
-             t["fw"][qs] * S[:, ns + nl:]], axis=1) * J
-        wD = np.concatenate(
-            [sw * (D[:, :ns] + lnu * QD[:, :ns]) + swl * QD[:, :ns], t["lw"][qs] * QD[:, ns:ns + nl],
-             t["fw"][qs] * D[:, ns + nl:]], axis=1) * J
-        Lg = t["L"][qs]
-        S_blk[sel] = np.einsum("nq,nqj->nj", wS, Lg)
-        D_blk[sel] = np.einsum("nq,nqj->nj", wD, Lg)
-    return S_blk, D_blk
-
-
-def _near_blocks(ps, xt, rt, pan, ustar, du, gauss_u, want):
-    """Integrals of kernel * l_j over the panels ``pan`` for targets (xt, rt).
-
-    want="layers": (S, D) blocks; want="field": (S, D, Sx, Sr, Wx, Wr) blocks.
-    """
-    p = ps.order
-    n_out = 2 if want == "layers" else 6
-    out = [np.zeros((len(pan), p)) for _ in range(n_out)]
-    for sel, u, w in near_rules(ustar, du):
-        shared = u.ndim == 1
-        x, r, xu, ru = ps.evaluate(pan[sel, None], u[None, :] if shared else u)
-        J = np.hypot(xu, ru)
-        wJ = w * J
-        Lg = lagrange_matrix(gauss_u, u)
-        X, Rr = xt[sel, None], rt[sel, None]
-        kernels = list(single_double(X, Rr, x, r, ru / J, -xu / J))
-        if want == "field":
-            kernels += list(gradient_kernels(X, Rr, x, r))
-        for k, ker in enumerate(kernels):
-            out[k][sel] = (wJ * ker) @ Lg if shared else np.einsum("nq,nqj->nj", wJ * ker, Lg)
-    return out
 
 
 # ------------------------------------------------------------------------------------
@@ -481,14 +500,14 @@ class SurfaceSolution:
                 val = (D * phi - S * g) * W
         tgt, pan, ustar, du = near_pairs(ps, xt, rt)
         if tgt.size:
-            blocks = _near_blocks(ps, xt[tgt], rt[tgt], pan, ustar, du, gauss_legendre(p)[0], want="field")
+            rule = near_quadrature(tgt, pan, ustar, du, p)
             cols = pan[:, None] * p + np.arange(p)[None, :]
             if gradient:
-                _, _, bSx, bSr, bWx, bWr = blocks
+                bSx, bSr, bWx, bWr = rule.integrate(ps, xt, rt, lambda X, R, x, r, nx, nr: gradient_kernels(X, R, x, r))
                 gx[tgt[:, None], cols] = bWx * omega[cols] - bSx * g[cols]
                 gr[tgt[:, None], cols] = bWr * omega[cols] - bSr * g[cols]
             else:
-                bS, bD = blocks[:2]
+                bS, bD = rule.integrate(ps, xt, rt, _layers)
                 val[tgt[:, None], cols] = bD * phi[cols] - bS * g[cols]
         if gradient:
             out = np.column_stack([gx.sum(axis=1), gr.sum(axis=1)])

@@ -263,7 +263,7 @@ def coefficient_table(
     *,
     order: int = 8,
     refinement: float = 0.5,
-    levels: int = 8,
+    levels: int = 6,
     n_depths: int = 64,
     max_depth_nose_lengths: float = 300.0,
     depths=None,
