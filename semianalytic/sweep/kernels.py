@@ -88,6 +88,8 @@ class PenetrationKernel:
     full: bool = False
     name: str = "penetration"
     fast_keys: frozenset = frozenset({VELOCITY_KEY})
+    # per-process cache of unit-resistance depth profiles (see _rigid); not part of the identity
+    _profiles: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -121,15 +123,19 @@ class PenetrationKernel:
         return coefficient_table_for(case, self.cache_dir)
 
     def evaluate(self, case: Case, coefficients, fast: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
-        from semianalytic.penetration import sweep_support
-
         U = np.asarray(fast[VELOCITY_KEY], float)
         status = np.full(U.shape, None, dtype=object)
         message = np.full(U.shape, "", dtype=object)
         bad = ~(np.isfinite(U) & (U > 0))
         status[bad] = "invalid"
         message[bad] = "impact.striking_velocities: must be positive"
-        res = sweep_support(case, coefficients, np.where(bad, 1.0, U), full=self.full)
+        Us = np.where(bad, 1.0, U)
+        if self.full:
+            from semianalytic.penetration import sweep_support
+
+            res = sweep_support(case, coefficients, Us, full=True)
+        else:
+            res = self._rigid(case, coefficients, Us)
         out = {c: np.asarray(res[c]) for c in self.columns}
         for c in out:
             if out[c].dtype.kind == "f":
@@ -137,6 +143,36 @@ class PenetrationKernel:
         out["_status"] = np.where(status == None, "ok", status)  # noqa: E711
         out["_message"] = message
         return out
+
+
+    def _rigid(self, case: Case, coefficients, U: np.ndarray) -> dict[str, np.ndarray]:
+        """Rigid depth, U_sC and the yield flag for many velocities of one material.
+
+        Part I, eq. (11) in w = u^2 with P as the variable: w(P) = e^(-F) (U_0^2 - G(P)),
+        F = int rho B/(m + rho A), G = int 2 C R_t e^F/(m + rho A).  G is proportional to
+        R_t and F does not involve it, so one integration with R_t = 1 Pa serves every target
+        strength of the same density and projectile mass: P_f(U_0; R_t) = P_f(U_0/sqrt(R_t); 1 Pa).
+        The profile is kept per worker (``_profiles``) and reused by every batch.
+        """
+        from semianalytic.penetration.curve import PenetrationSetup
+        from semianalytic.penetration.motion import depth_profile
+
+        setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+        scaled = U / np.sqrt(setup.resistance_pa)
+        key = (id(coefficients), setup.mass, setup.target_density)
+        prof = self._profiles.get(key)
+        if prof is None or prof.U_max < scaled.max():
+            if len(self._profiles) > 32:
+                self._profiles.clear()
+            U_max = 1.5 * float(scaled.max()) if prof is None else 2.0 * max(prof.U_max, float(scaled.max()))
+            prof = depth_profile(coefficients, setup.mass, setup.target_density, 1.0, U_max)
+            self._profiles[key] = (prof)
+        U_sC = setup.critical_velocity()
+        return {
+            "depth_rigid_m": prof.final_depth(scaled),
+            "critical_velocity_m_s": np.full(U.shape, U_sC),
+            "yields": (U >= U_sC) if np.isfinite(U_sC) else np.zeros(U.shape, bool),
+        }
 
 
 @dataclass(frozen=True)
