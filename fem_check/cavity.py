@@ -120,9 +120,9 @@ def solve_radial(r_in: float, traction: float, E: float, nu: float, outer: float
     f[i_in] = -traction * r_in**2  # boundary term -sigma_r(r_in) r_in^2 v(r_in)
     u = spla.spsolve(K.tocsc(), f)
     ui = basis.interpolate(u)
-    r = basis.global_coordinates().value[0]
+    r = np.asarray(basis.global_coordinates())[0]
     du = ui.grad[0]
-    val = ui.value
+    val = np.asarray(ui)
     sr = np.where(cracked_q, E * du, (lam + 2 * mu) * du + 2 * lam * val / r)
     sp = np.where(cracked_q, 0.0, lam * du + 2 * (lam + mu) * val / r)
     order = np.argsort(r.ravel())
@@ -168,7 +168,7 @@ def solve_axisymmetric(a: float, traction: float, E: float, nu: float, outer: fl
     # P3/P4 facet dofs need consistently oriented (sorted) element vertices
     mesh = dataclasses.replace(dm.mesh, t=np.sort(dm.mesh.t, axis=0)) if degree > 2 else dm.mesh
     elem = ElementVector({2: ElementTriP2(), 3: ElementTriP3(), 4: ElementTriP4()}[degree])
-    basis = Basis(mesh, elem, intorder=2 * degree + 2)
+    basis = Basis(mesh, elem, intorder=2 * degree)
     if cracked_until is not None:
         xc = mesh.p[:, mesh.t].mean(axis=1)
         cracked = np.hypot(xc[0], xc[1]) < cracked_until
@@ -179,7 +179,7 @@ def solve_axisymmetric(a: float, traction: float, E: float, nu: float, outer: fl
     def strains(z, rho):
         """(e_xx, e_rhorho, e_thetatheta, e_xrho) of an axisymmetric displacement field."""
         g = z.grad
-        return g[0, 0], g[1, 1], z.value[1] / rho, 0.5 * (g[0, 1] + g[1, 0])
+        return g[0, 0], g[1, 1], np.asarray(z)[1] / rho, 0.5 * (g[0, 1] + g[1, 0])
 
     def radial_strain(e, w):
         R = np.sqrt(w.x[0] ** 2 + w.x[1] ** 2)
@@ -217,7 +217,7 @@ def solve_axisymmetric(a: float, traction: float, E: float, nu: float, outer: fl
                             basis.get_dofs(dm.boundaries["sym"]).all(["u^1"])])
     u = solve(*condense(K, f, D=np.unique(fixed)))
     ui = basis.interpolate(u)
-    x, rho = basis.global_coordinates().value
+    x, rho = np.asarray(basis.global_coordinates())
     e = strains(ui, rho)
     R = np.hypot(x, rho)
     nx, nr = x / R, rho / R
@@ -232,8 +232,9 @@ def solve_axisymmetric(a: float, traction: float, E: float, nu: float, outer: fl
     stt = np.where(cq, 0.0, stt)
     spsi = np.where(cq, 0.0, spsi)
     sRpsi = np.where(cq, 0.0, sRpsi)
-    uR = nx * ui.value[0] + nr * ui.value[1]
-    upsi = -nr * ui.value[0] + nx * ui.value[1]
+    uv = np.asarray(ui)
+    uR = nx * uv[0] + nr * uv[1]
+    upsi = -nr * uv[0] + nx * uv[1]
     return AxisymmetricSolution(x.ravel(), rho.ravel(), R.ravel(), uR.ravel(), upsi.ravel(), sRR.ravel(),
                                 stt.ravel(), spsi.ravel(), sRpsi.ravel(), int(basis.N), int(mesh.t.shape[1]),
                                 time.perf_counter() - t0)
@@ -354,13 +355,13 @@ def cavity_study(material, quick: bool = False) -> dict:
     out: dict = {"sigma_star_Pa": sigma_star, "lame_pressure_Pa": p}
     ns = [400] if quick else [50, 100, 200, 400, 800]
     out["lame_1d"] = [lame_errors_1d(E, nu, p, n) for n in ns]
-    hs = [0.05] if quick else [0.2, 0.1, 0.05]
+    hs = [0.06] if quick else [0.2, 0.1, 0.05]
     degrees = [4] if quick else [2, 4]
     out["lame_2d"] = [lame_errors_2d(E, nu, p, h, deg) for deg in degrees for h in hs]
     out["zones_1d"] = [zone_errors(material, sigma_star, n) for n in ([400] if quick else [100, 200, 400, 800])]
     if not quick:
         out["zones_1d"][-1].update(zone_errors(material, sigma_star, 800, axisymmetric_h=0.05))
-    best = {"lame_1d": out["lame_1d"][-1 if quick else 3], "lame_2d": [r for r in out["lame_2d"] if r["degree"] == 4 and r["h_over_d"] == 0.05][0],
+    best = {"lame_1d": out["lame_1d"][-1 if quick else 3], "lame_2d": [r for r in out["lame_2d"] if r["degree"] == 4][-1],
             "zones_1d": [z for z in out["zones_1d"] if z["n_elements"] == 400][0]}
     errs = {
         "lame_1d": max(best["lame_1d"][k] for k in ("u", "sigma_r", "sigma_phi")),
@@ -369,7 +370,7 @@ def cavity_study(material, quick: bool = False) -> dict:
     }
     out["max_rel_error_by_problem"] = errs
     out["max_rel_error"] = max(errs.values())
-    out["resolution"] = {"lame_1d_elements": best["lame_1d"]["n_elements"], "lame_2d": "P4, h = 0.05 d",
+    out["resolution"] = {"lame_1d_elements": best["lame_1d"]["n_elements"], "lame_2d": f"P4, h = {best['lame_2d']['h_over_d']} d",
                          "zones_1d_elements": 400}
     return out
 

@@ -121,7 +121,6 @@ class HalfspaceCoefficients:
     G: float  # int |grad phi|^2 n_x dS
     H: float  # int dphi/dx n_x dS
     Q: float  # int D phi/DP n_x dS
-    free_energy_flux: float  # -int_free |grad phi|^2 dS (equals G + 2H by the Maxwell-stress identity)
     n_dofs: int
     n_elements: int
     seconds: float
@@ -163,12 +162,10 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
         phi_w = sol.node_value((0.0, rw))
         waterline = 2 * math.pi * phi_w * rw * abs(dr) / abs(dx)
     Q = dA - waterline
-    free = sol.surface("free")
-    flux = -float(np.sum(free["weight"] * free["grad2"]))
     return HalfspaceCoefficients(
         depth=depth, A=sol.A, C=sol.C, B_body=G + 2 * Q, B_literal=G + 2 * (Q - H),
         B_bernoulli=-G + 2 * (Q - H), dA_dP=dA, phi_tip=sol.node_value((depth, 0.0)),
-        G=G, H=H, Q=Q, free_energy_flux=flux, n_dofs=sol.n_dofs, n_elements=int(dm.mesh.t.shape[1]),
+        G=G, H=H, Q=Q, n_dofs=sol.n_dofs, n_elements=int(dm.mesh.t.shape[1]),
         seconds=time.perf_counter() - t0,
     )
 

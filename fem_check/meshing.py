@@ -42,7 +42,7 @@ from skfem import MeshTri1, MeshTri2
 from semianalytic.errors import InputError
 from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, SplineCurve
 
-MESH_FORMAT_VERSION = 4  # bump when the domain construction changes (invalidates the cache)
+MESH_FORMAT_VERSION = 5  # bump when the domain construction changes (invalidates the cache)
 
 # ------------------------------------------------------------------------------------
 # curve pieces
@@ -125,8 +125,9 @@ def _line(p0, p1) -> Piece:
 class MeshOptions:
     """Mesh parameters, all relative to the length scale d of the domain (body or projectile diameter).
 
-    ``h``: element size on the body / d; ``corner``: size at the singular points (tip,
-    junction, free-surface corner or waterline) as a fraction of ``h``; ``growth``: the
+    ``h``: element size on the body / d; ``corner``: size at the junctions, the free-surface
+    corner or the waterline as a fraction of ``h``; ``tip``: the same at a pointed tip (a cone
+    point, whose gradient singularity is the strongest); ``growth``: the
     element size at distance s from the body is h (d + growth s), so that refining ``h``
     refines the whole mesh uniformly (needed for clean convergence rates); ``far``:
     far radius / d (for the half-space: R = far (d + P), since the image of the hole makes the
@@ -136,6 +137,7 @@ class MeshOptions:
 
     h: float = 0.08
     corner: float = 0.25
+    tip: float = 0.1
     growth: float = 3.0
     far: float = 20.0
     order: int = 2
@@ -145,6 +147,8 @@ class MeshOptions:
             raise InputError("mesh.h", f"element size over diameter must lie in (0, 1]; got {self.h!r}")
         if not 0 < self.corner <= 1:
             raise InputError("mesh.corner", f"must lie in (0, 1]; got {self.corner!r}")
+        if not 0 < self.tip <= 1:
+            raise InputError("mesh.tip", f"must lie in (0, 1]; got {self.tip!r}")
         if not 0 < self.growth <= 50:
             raise InputError("mesh.growth", f"must lie in (0, 50]; got {self.growth!r}")
         if not self.far > 1:
@@ -169,6 +173,7 @@ class Domain:
     refine_points: tuple[tuple[float, float], ...]
     info: dict = field(default_factory=dict, compare=False)
     interfaces: tuple[tuple[str, Piece], ...] = ()  # curves embedded in the domain (material interfaces)
+    tip_points: tuple[tuple[float, float], ...] = ()  # pointed tips (refined with options.tip)
 
     def key(self, options: MeshOptions) -> str:
         blob = {
@@ -179,6 +184,7 @@ class Domain:
             "far": [self.far_center, self.far_radius],
             "scale": self.length_scale,
             "refine": self.refine_points,
+            "tips": self.tip_points,
             "options": dataclasses.asdict(options),
         }
         text = json.dumps(blob, sort_keys=True, default=float)
@@ -203,10 +209,13 @@ def body_domain(meridian: Meridian, options: MeshOptions) -> Domain:
               ("far", _far_arc((xc, 0.0), R, 0.5 * math.pi, math.pi)), ("axis", _line((xc - R, 0.0), rear))]
     for seg in reversed(meridian.segments):
         pieces.append(("body", Piece(seg, seg.t1, seg.t0)))
-    refine = [front, rear]
+    angles = meridian.axis_angles()
+    tips = [p for p, ang in zip((front, rear), angles) if ang > 1e-6]
+    refine = [p for p, ang in zip((front, rear), angles) if ang <= 1e-6]
     refine += [pieces[-1 - i][1].start for i in range(len(meridian.segments) - 1)] if len(meridian.segments) > 1 else []
     return Domain("body", tuple(pieces), (xc, 0.0), R, d, tuple(tuple(map(float, p)) for p in refine),
-                  {"volume": meridian.volume(), "diameter": d, "length": length})
+                  {"volume": meridian.volume(), "diameter": d, "length": length},
+                  tip_points=tuple(tuple(map(float, p)) for p in tips))
 
 
 def _nose_waterline(nose: Nose, depth: float) -> tuple[int, float]:
@@ -238,7 +247,8 @@ def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
     Rf = options.far * (d + depth)
     tip = (depth, 0.0)
     pieces: list[tuple[str, Piece]] = [("axis", _line(tip, (Rf, 0.0))), ("far", _far_arc((0.0, 0.0), Rf, 0.0, 0.5 * math.pi))]
-    refine = [tip]
+    pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-6
+    refine = [] if pointed else [tip]
     tol = 1e-9 * Lh
     if depth < Lh - tol:
         k, tw = _nose_waterline(nose, depth)
@@ -261,7 +271,8 @@ def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
     for p in nose_pieces[1:]:
         refine.append(p.start)
     info.update({"depth": depth, "nose_length": Lh, "diameter": d})
-    return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info)
+    return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info,
+                  tip_points=(tip,) if pointed else ())
 
 
 def annulus_domain(a: float, outer: float, options: MeshOptions, interface: float | None = None) -> Domain:
@@ -373,16 +384,19 @@ def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
         f1 = fm.add("Distance")
         fm.setNumbers(f1, "CurvesList", body_curves)
         fm.setNumber(f1, "Sampling", 400)
-        hc = h * options.corner
         g = options.h * options.growth
         hmax = 0.25 * domain.far_radius
+        terms = [f"{h} + {g}*F{f1}"]
+        for pts, factor in ((domain.refine_points, options.corner), (domain.tip_points, options.tip)):
+            if pts:
+                fp = fm.add("Distance")
+                fm.setNumbers(fp, "PointsList", [point(p) for p in pts])
+                terms.append(f"{h * factor} + {g}*F{fp}")
+        expr = terms[0]
+        for t in terms[1:]:
+            expr = f"Min({expr}, {t})"
         f3 = fm.add("MathEval")
-        if domain.refine_points:
-            f2 = fm.add("Distance")
-            fm.setNumbers(f2, "PointsList", [point(p) for p in domain.refine_points])
-            fm.setString(f3, "F", f"Min({hmax}, Min({h} + {g}*F{f1}, {hc} + {g}*F{f2}))")
-        else:
-            fm.setString(f3, "F", f"Min({hmax}, {h} + {g}*F{f1})")
+        fm.setString(f3, "F", f"Min({hmax}, {expr})")
         fm.setAsBackgroundMesh(f3)
         gmsh.option.setNumber("Mesh.MeshSizeExtendFromBoundary", 0)
         gmsh.option.setNumber("Mesh.MeshSizeFromPoints", 0)

@@ -125,8 +125,8 @@ class PotentialSolution:
         order = intorder or 2 * self.basis.elem.maxdeg + 2
         fb = FacetBasis(self.dm.mesh, self.basis.elem, facets=facets, intorder=order)
         ph = fb.interpolate(self.phi)
-        x, r = fb.global_coordinates().value
-        nx, nr = -fb.normals.value[0], -fb.normals.value[1]
+        x, r = np.asarray(fb.global_coordinates())
+        nx, nr = -np.asarray(fb.normals)[0], -np.asarray(fb.normals)[1]
         tx, tr = -nr, nx
         gx, gr = ph.grad
         dphi_ds = tx * gx + tr * gr
@@ -136,7 +136,7 @@ class PotentialSolution:
         weight = 2 * math.pi * r * fb.dx
         return {
             "x": x.ravel(), "r": r.ravel(), "nx": nx.ravel(), "nr": nr.ravel(), "weight": weight.ravel(),
-            "phi": ph.value.ravel(), "dphi_ds": dphi_ds.ravel(), "grad2": grad2.ravel(), "dphi_dx": dphi_dx.ravel(),
+            "phi": np.asarray(ph).ravel(), "dphi_ds": dphi_ds.ravel(), "grad2": grad2.ravel(), "dphi_dx": dphi_dx.ravel(),
         }
 
 

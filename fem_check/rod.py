@@ -102,11 +102,13 @@ class RodHistory:
 
 
 def simulate_rod(rod: RodProblem, force: Callable[[np.ndarray], np.ndarray], t_end: float, n_elements: int = 400,
-                 degree: int = 1, courant: float = 0.5, snapshot_times=()) -> RodHistory:
+                 degree: int = 1, courant: float = 2**-0.5, snapshot_times=()) -> RodHistory:
     """Integrate the rod under the end force N(t) >= 0 (compressive) from rest at t = 0 to ``t_end``.
 
-    ``courant`` = c_0 dt / h_node (h_node the node spacing); the trapezoidal rule is unconditionally
-    stable, the Courant number sets the time resolution of the wave fronts.
+    ``courant`` = c_0 dt / h_node (h_node the node spacing).  The trapezoidal rule is
+    unconditionally stable; for P1 with consistent mass the default 1/sqrt(2) cancels the
+    second-order phase errors of space (omega_h ~ omega (1 + (kh)^2/24)) and time
+    (omega_dt ~ omega_h (1 - (omega_h dt)^2/12)), which keeps the step-load wave fronts sharp.
     """
     if n_elements < 2:
         raise InputError("rod.elements", f"need at least 2 elements; got {n_elements!r}")

@@ -26,9 +26,9 @@ def write_verify_report(r: Report, case, p: dict) -> None:
 def _body(r: Report, p: dict) -> None:
     r.add("## Added mass (coefficient A / V)", "",
           md_table(["method", "added-mass coefficient", "relative to exact", "unknowns/dofs", "time [s]"], [
-              ["exact (Lamb)", p["added_mass_exact"], 0.0 if p["added_mass_exact"] else None, None, None],
-              ["BEM (order 8, refinement 1)", p["added_mass_bem"], p["bem_minus_exact_rel"], p["bem_unknowns"], p["bem_seconds"]],
-              [f"FEM P2, h = {fmt(p['h_over_d'])} d", p["added_mass_fem"], p["fem_minus_exact_rel"], p["fem_dofs"], p["fem_seconds"]],
+              ["exact (Lamb)", _f10(p["added_mass_exact"]), 0.0 if p["added_mass_exact"] else None, None, None],
+              ["BEM (order 8, refinement 1)", _f10(p["added_mass_bem"]), p["bem_minus_exact_rel"], p["bem_unknowns"], p["bem_seconds"]],
+              [f"FEM P2, h = {fmt(p['h_over_d'])} d", _f10(p["added_mass_fem"]), p["fem_minus_exact_rel"], p["fem_dofs"], p["fem_seconds"]],
           ]), "",
           f"BEM-FEM relative difference: {fmt(p['fem_minus_bem_rel'])}.", "")
     conv = p.get("convergence")
@@ -39,7 +39,7 @@ def _body(r: Report, p: dict) -> None:
         for order in (1, 2):
             sel = [c for c in conv if c["order"] == order]
             for c, o in zip(sel, rate([c["error"] for c in sel], [c["h_over_d"] for c in sel])):
-                rows.append([f"P{order}", c["h_over_d"], c["n_dofs"], c["coefficient"], c["error"], o, c["seconds"]])
+                rows.append([f"P{order}", c["h_over_d"], c["n_dofs"], _f10(c["coefficient"]), c["error"], o, c["seconds"]])
         r.add(md_table(["element", "h/d", "dofs", "A/V", "rel. error", "order", "solve [s]"], rows), "")
         fig = new_figure()
         ax = fig.add_subplot(111)
@@ -57,10 +57,17 @@ def _body(r: Report, p: dict) -> None:
     if ff:
         r.add("### Far-field condition", "",
               "Error of the added mass against the far radius (R = far x max(length, d)) for three outer "
-              "conditions; the dipole Robin condition dphi/dR + 2 phi/R = 0 matches the far field of a closed body.", "",
+              "conditions (P2, h = 0.05 d). The dipole Robin condition dphi/dR + 2 phi/R = 0 matches the far field of a "
+              "closed body: its error is the discretisation error at every radius (for a sphere the condition is exact); "
+              "the monopole condition and the Neumann cut-off leave errors falling like (d/R)^3 (where such an error "
+              "crosses the discretisation error of opposite sign, it can look smaller by chance).", "",
               md_table(["far", "R [m]", "dipole (k=2)", "monopole (k=1)", "Neumann"],
                        [[f["far"], f["far_radius_m"], f["dipole"], f["monopole"], f["neumann"]] for f in ff]), "")
         _far_plot(r, ff, "far", "far radius / max(length, d)", ("dipole", "monopole", "neumann"))
+
+
+def _f10(v):
+    return "-" if v is None else f"{v:.10f}"
 
 
 def _far_plot(r, ff, key, xlabel, kinds):
