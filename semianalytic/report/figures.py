@@ -21,6 +21,7 @@ __all__ = [
     "png_bytes",
     "line_figure",
     "panels_figure",
+    "side_by_side_figure",
     "velocity_field_figure",
     "meridian_outline",
 ]
@@ -104,6 +105,23 @@ def panels_figure(
         if logx:
             ax.set_xscale("log")
     axes[-1].set_xlabel(xlabel)
+    fig.suptitle(title, fontsize=10)
+    return fig
+
+
+def side_by_side_figure(
+    panels: Sequence[tuple[str, str, Sequence[Series]]],
+    title: str,
+    size=None,
+) -> Figure:
+    """Panels in one row, each with its own axes: ``[(xlabel, ylabel, [Series, ...]), ...]``."""
+    n = len(panels)
+    fig = Figure(figsize=size or (4.6 * n, 3.9), layout="constrained")
+    axes = fig.subplots(1, n, squeeze=False)[0]
+    for ax, (xlabel, ylabel, series) in zip(axes, panels):
+        _draw(ax, series)
+        ax.set_xlabel(xlabel)
+        ax.set_ylabel(ylabel)
     fig.suptitle(title, fontsize=10)
     return fig
 

@@ -15,7 +15,7 @@ from semianalytic.errors import InputError
 from semianalytic.report.case import RunSection
 from semianalytic.report.context import Context
 from semianalytic.report.document import fmt
-from semianalytic.report.figures import Points, Series, line_figure, panels_figure
+from semianalytic.report.figures import Points, Series, line_figure, panels_figure, side_by_side_figure
 from semianalytic.report.steps import Step, _coefficient_table, _has, _mm, _projectile, register, table_available
 
 MM = 1e3  # m -> mm for display
@@ -141,19 +141,17 @@ def _coefficients_run(ctx: Context) -> None:
         depth = np.asarray(table.depth)
         phi = np.asarray(phi_tip(depth) if callable(phi_tip) else phi_tip)
         sel = depth <= P_end
-        fig = line_figure(
-            [Series(depth[sel] * MM, phi[sel] * MM, "phi at the tip (unit speed)", "o-")],
-            "penetration depth P [mm]", "phi_tip [mm]", "Potential at the projectile tip (cf. Fig. 6)",
-        )
-        ctx.figure("fig6_phi_tip", fig, "Potential phi at the tip against P (Part I, Fig. 6).")
-        # phi'_P at the tip, following the body (the `body` reading of errata 2a): d phi_tip / dP
+        # phi'_P at the tip following the body (the `body` reading of errata 2a): d phi_tip / dP
         dphi = np.gradient(phi, depth)
-        fig = line_figure(
-            [Series(depth[sel] * MM, dphi[sel], "d(phi_tip)/dP, point A fixed on the body", "o-")],
-            "penetration depth P [mm]", "phi'_P at the tip [-]", "Derivative phi'_P at the tip (cf. Fig. 7)",
+        fig = side_by_side_figure(
+            [("penetration depth P [mm]", "phi at the tip [mm] (unit speed)",
+              [Series(depth[sel] * MM, phi[sel] * MM, "phi_tip (cf. Fig. 6)", "o-")]),
+             ("penetration depth P [mm]", "phi'_P at the tip [-]",
+              [Series(depth[sel] * MM, dphi[sel], "d(phi_tip)/dP, point A on the body (cf. Fig. 7)", "o-")])],
+            f"Potential at the tip and its derivative in P, {case.projectile.nose} nose",
         )
-        ctx.figure("fig7_dphi_dP", fig, "phi'_P at the tip (point A) against P (Part I, Fig. 7), "
-                   "by differences of the tabulated phi_tip (following the body).")
+        ctx.figure("fig6_7_phi_tip", fig, "Potential phi at the tip (Part I, Fig. 6) and phi'_P at the tip, point A "
+                   "(Fig. 7), against P; phi'_P by differences of the tabulated phi_tip, following the body.")
         results["phi_tip_m"] = phi
     ctx.results["coefficients"] = results
 
@@ -274,10 +272,9 @@ def _penetration_run(ctx: Context) -> None:
         s_uP.append(Series(P * MM, uu, lab))
     ctx.figure("fig10_depth_time", line_figure(s_Pt, "time t [us]", "depth P [mm]", "P(t), rigid projectile (cf. Fig. 10)"),
                "Depth against time, rigid projectile (Part I, Fig. 10).")
-    fig = panels_figure([("u [m/s]", s_ut)], "time t [us]", "u(t), rigid projectile (cf. Fig. 11)", sharex=False)
-    ctx.figure("fig11_velocity_time", fig, "Velocity against time, rigid projectile (Part I, Fig. 11).")
-    ctx.figure("fig11_velocity_depth", line_figure(s_uP, "depth P [mm]", "u [m/s]", "u(P), rigid projectile (cf. Fig. 11)"),
-               "Velocity against depth, rigid projectile (Part I, Fig. 11).")
+    fig = side_by_side_figure([("time t [us]", "u [m/s]", s_ut), ("depth P [mm]", "u [m/s]", s_uP)],
+                              "u(t) and u(P), rigid projectile (cf. Fig. 11)")
+    ctx.figure("fig11_velocity", fig, "Velocity against time and against depth, rigid projectile (Part I, Fig. 11).")
 
     # P(U_s) curve with data points (Figs. 14-16)
     series = [Series(Ug, curve["depth_rigid_m"] * MM, "1: rigid projectile")]
@@ -300,8 +297,8 @@ def _penetration_run(ctx: Context) -> None:
     if np.isfinite(U_sC) and U_sC < hi:
         ax = fig.axes[0]
         ax.axvspan(max(U_sC, lo), hi, color="tab:red", alpha=0.08, lw=0)
-        ax.text(max(U_sC, lo), ax.get_ylim()[1] * 0.95, " U_s >= U_sC: projectile yields", color="tab:red", fontsize=8,
-                va="top")
+        ax.text(hi, ax.get_ylim()[1] * 0.97, "U_s >= U_sC: projectile yields ", color="tab:red", fontsize=8,
+                va="top", ha="right")
     ctx.figure("fig14_16_depth_velocity", fig, "Final depth against striking velocity, rigid (1) and elastic (2) "
                "projectile, with the experimental points when the case has data (Part I, Figs. 14-16).")
     out = {k: np.asarray(v) for k, v in res.items()}
