@@ -66,28 +66,33 @@ class PanelSet:
         ``panel`` and ``u`` broadcast together; returns x, r, x_u, r_u (and x_uu, r_uu
         with ``second=True``).
         """
-        panel, u = np.broadcast_arrays(np.asarray(panel), np.asarray(u, dtype=float))
+        panel = np.asarray(panel)
+        u = np.asarray(u, dtype=float)
+        if panel.shape != u.shape:
+            panel, u = np.broadcast_arrays(panel, u)
+        if len(self.segments) == 1:
+            return self._evaluate_segment(self.segments[0], panel, u, second)
         out = [np.empty(u.shape) for _ in range(6 if second else 4)]
         seg_of = self.segment_index[panel]
         for s, seg in enumerate(self.segments):
             mask = seg_of == s
             if not mask.any():
                 continue
-            pk = panel[mask]
-            base, da, db, sg = self.base[pk], self.da[pk], self.db[pk], self.sign[pk]
-            half = 0.5 * (db - da)
-            dt = da + half * (u[mask] + 1.0)
-            ex, er = seg.displacement(base, dt)
-            dx, dr = seg.derivative(base + dt)
-            # computational frame: x_b for primary panels, -x_b - 2 offset for mirrored ones
-            out[0][mask] = sg * (self.anchor_x[pk] + ex) + (sg - 1.0) * self.offset
-            out[1][mask] = self.anchor_r[pk] + er
-            out[2][mask] = sg * dx * half
-            out[3][mask] = dr * half
-            if second:
-                ddx, ddr = seg.second_derivative(base + dt)
-                out[4][mask] = sg * ddx * half * half
-                out[5][mask] = ddr * half * half
+            for o, v in zip(out, self._evaluate_segment(seg, panel[mask], u[mask], second)):
+                o[mask] = v
+        return tuple(out)
+
+    def _evaluate_segment(self, seg, pk, u, second):
+        base, da, db, sg = self.base[pk], self.da[pk], self.db[pk], self.sign[pk]
+        half = 0.5 * (db - da)
+        dt = da + half * (u + 1.0)
+        ex, er = seg.displacement(base, dt)
+        dx, dr = seg.derivative(base + dt)
+        # computational frame: x_b for primary panels, -x_b - 2 offset for mirrored ones
+        out = [sg * (self.anchor_x[pk] + ex) + (sg - 1.0) * self.offset, self.anchor_r[pk] + er, sg * dx * half, dr * half]
+        if second:
+            ddx, ddr = seg.second_derivative(base + dt)
+            out += [sg * ddx * half * half, ddr * half * half]
         return tuple(out)
 
     @cached_property

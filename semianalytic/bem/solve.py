@@ -71,7 +71,7 @@ def _single_threaded_blas():
 
 @functools.cache
 def _samples(order: int) -> np.ndarray:
-    return np.linspace(-1.0, 1.0, 4 * order + 1)
+    return np.linspace(-1.0, 1.0, 2 * order + 1)
 
 
 def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray):

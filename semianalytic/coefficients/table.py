@@ -25,7 +25,7 @@ from semianalytic.coefficients import READINGS
 from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_depth
 from semianalytic.geometry import Nose
 
-TABLE_VERSION = 1  # bump when the numerics change, to invalidate caches
+TABLE_VERSION = 2  # bump when the numerics change, to invalidate caches
 
 
 def default_depths(nose: Nose, n_depths: int = 64, max_depth_nose_lengths: float = 300.0) -> np.ndarray:
@@ -85,7 +85,7 @@ class CoefficientTable:
         splines = {}
         P = np.concatenate([[0.0], self.depth])
         for name, vals in self.values.items():
-            if name in ("dA_dP",):
+            if name in ("dA_dP", "dphi_tip_dP"):
                 continue
             splines[name] = PchipInterpolator(P, np.concatenate([[0.0], vals]), extrapolate=False)
         object.__setattr__(self, "_splines", splines)
@@ -278,9 +278,9 @@ def coefficient_table(
 
         it = tqdm(depths, desc="BEM depths", unit="depth", leave=False)
     rows: list[DepthCoefficients] = [coefficients_at_depth(nose, float(P), opts) for P in it]
-    names = ("A", "B_body", "B_literal", "B_bernoulli", "C", "phi_tip", "dA_dP")
+    names = ("A", "B_body", "B_literal", "B_bernoulli", "C", "phi_tip", "dA_dP", "dphi_tip_dP")
     values = {k: np.array([getattr(r, k) for r in rows]) for k in names}
-    limits = {k: deep_limit(depths, values[k]) for k in names if k != "dA_dP"}
+    limits = {k: deep_limit(depths, values[k]) for k in names if k not in ("dA_dP", "dphi_tip_dP")}
     if depths[-1] > nose.length:
         limits["C"] = math.pi * nose.radius**2  # exact once the nose is in
     return CoefficientTable(

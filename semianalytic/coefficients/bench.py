@@ -1,0 +1,227 @@
+"""``python -m semianalytic bench-bem [--out reports] [--force] [--quick]``.
+
+Measures the BEM against exact solutions and writes three reports:
+
+- ``bench_bem.md``: unknowns, wall time, memory and error for the exact cases, the time to
+  1e-6 on the 4:1 spheroid, one BLAS thread against the default, and the wall time of one
+  full A/B/C table per Fig. 5 projectile;
+- ``bem_convergence.md`` (+ PNG): error against unknowns with the observed order;
+- ``bem_coefficients.md`` (+ PNGs): the Fig. 5 tables, Figs. 6-8 analogues, the deep
+  values against the paper's, the identity B_bernoulli = dA/dP and the contact region of
+  eq. (15) (see :mod:`semianalytic.coefficients.report`).
+
+Times are the best of several repeats (the machine is shared); ratios are measured in the
+same run.
+"""
+
+from __future__ import annotations
+
+import math
+import platform
+import time
+import tracemalloc
+from pathlib import Path
+
+import numpy as np
+
+from semianalytic.errors import InputError
+
+REFINEMENTS = (0.2, 0.3, 0.4, 0.5, 0.7, 1.0, 1.4, 2.0)
+ASPECTS = (1.0, 2.0, 4.0, 5.0)
+
+
+def add_arguments(parser) -> None:
+    parser.add_argument("--out", default="reports", help="folder of the reports (default: reports)")
+    parser.add_argument("--force", action="store_true", help="overwrite existing reports")
+    parser.add_argument("--quick", action="store_true", help="fewer repeats and depths (for a smoke test)")
+
+
+def _best_time(fn, repeats: int) -> float:
+    best = math.inf
+    for _ in range(repeats):
+        t = time.perf_counter()
+        fn()
+        best = min(best, time.perf_counter() - t)
+    return best
+
+
+def convergence_rows(repeats: int = 3, refinements=REFINEMENTS, aspects=ASPECTS):
+    """(aspect, refinement, unknowns, relative error, max surface phi error, seconds, peak MiB)."""
+    from semianalytic.bem import solve_body
+    from semianalytic.exact import spheroid_added_mass_coefficient
+    from semianalytic.geometry import spheroid_body
+
+    rows = []
+    for aspect in aspects:
+        meridian = spheroid_body(aspect, 1.0)
+        exact = spheroid_added_mass_coefficient(aspect, 1.0)
+        for ref in refinements:
+            tracemalloc.start()
+            sol = solve_body(meridian, refinement=ref)
+            _, peak = tracemalloc.get_traced_memory()
+            tracemalloc.stop()
+            seconds = _best_time(lambda: solve_body(meridian, refinement=ref), repeats)
+            n = sol.nodes
+            err_phi = float(np.abs(n.phi - exact * n.x).max() / np.abs(exact * n.x).max())
+            rows.append((aspect, ref, sol.unknowns, abs(sol.added_mass_coefficient / exact - 1), err_phi, seconds, peak / 2**20))
+    return rows
+
+
+def observed_orders(rows):
+    """Local order -d ln(err)/d ln(N) between successive resolutions of each aspect."""
+    out = {}
+    for aspect in sorted({r[0] for r in rows}):
+        rs = [r for r in rows if r[0] == aspect]
+        orders = []
+        for a, b in zip(rs[:-1], rs[1:]):
+            if a[3] > 1e-13 and b[3] > 1e-13 and b[2] != a[2]:
+                orders.append(-math.log(b[3] / a[3]) / math.log(b[2] / a[2]))
+        out[aspect] = orders
+    return out
+
+
+def blas_threads(n: int = 200, repeats: int = 20):
+    """Dense LU solve of size n with one BLAS thread and with the library default."""
+    import scipy.linalg
+    from threadpoolctl import ThreadpoolController
+
+    rng = np.random.default_rng(0)
+    A = rng.standard_normal((n, n)) + n * np.eye(n)
+    b = rng.standard_normal(n)
+    ctl = ThreadpoolController()
+    default = max((i["num_threads"] for i in ctl.info() if i["user_api"] == "blas"), default=1)
+    t_default = _best_time(lambda: scipy.linalg.solve(A, b), repeats)
+    with ctl.limit(limits=1, user_api="blas"):
+        t_one = _best_time(lambda: scipy.linalg.solve(A, b), repeats)
+    return default, t_default, t_one
+
+
+def table_timing(repeats: int = 2, n_depths: int = 64):
+    """Wall time of one full A/B/C table for each Fig. 5 nose."""
+    from semianalytic.coefficients.table import coefficient_table
+    from semianalytic.geometry import ogive_nose, sphere_nose
+
+    out = []
+    for nose in (ogive_nose(7.11e-3, 3.0), sphere_nose(7.11e-3)):
+        box = {}
+
+        def build():
+            box["t"] = coefficient_table(nose, n_depths=n_depths)
+
+        seconds = _best_time(build, repeats)
+        tab = box["t"]
+        out.append((nose.kind, n_depths, seconds, float(tab.unknowns.mean()), int(tab.unknowns.max())))
+    return out
+
+
+def write_convergence_report(rows, out_dir: Path, force: bool) -> list[Path]:
+    from semianalytic.io import atomic_write_bytes, atomic_write_text
+    from semianalytic.report.document import Document, fmt, to_markdown
+    from semianalytic.report.figures import Series, line_figure, png_bytes
+
+    orders = observed_orders(rows)
+    doc = Document("BEM convergence against exact solutions")
+    doc.para(
+        "Closed spheroids (aspect ratio length/diameter; 1 is the sphere) moving along their axis in unbounded "
+        "fluid, solved by the direct axisymmetric BEM of `semianalytic.bem` (8 Gauss nodes per panel). "
+        "Errors against Lamb's added-mass coefficient k1 = alpha0/(2 - alpha0) and against the exact surface "
+        "potential phi = k1 x. Generated by `python -m semianalytic bench-bem`."
+    )
+    doc.table(
+        ("aspect", "refinement", "unknowns N", "added-mass rel. error", "max surface phi error / max|phi|"),
+        [(fmt(r[0], 3), fmt(r[1], 3), r[2], f"{r[3]:.2e}", f"{r[4]:.2e}") for r in rows],
+    )
+    doc.heading("Observed order")
+    doc.para(
+        "Local order -d ln(error)/d ln(N) between successive resolutions. With p Gauss nodes per panel on "
+        "smooth bodies the convergence is faster than any fixed power until round-off (about 1e-12 for the "
+        "added mass): the local order grows with N instead of settling, far above the order 2 that the "
+        "issue asks as a minimum. Pairs below 1e-13 are omitted (round-off)."
+    )
+    doc.table(
+        ("aspect", "local orders (coarse to fine)"),
+        [(fmt(a, 3), ", ".join(f"{o:.1f}" for o in orders[a]) or "at round-off") for a in sorted(orders)],
+    )
+    series = []
+    for aspect in sorted({r[0] for r in rows}):
+        rs = [r for r in rows if r[0] == aspect]
+        series.append(Series(np.array([r[2] for r in rs]), np.array([max(r[3], 1e-16) for r in rs]), f"aspect {aspect:g}", "o-"))
+    fig = line_figure(series, "unknowns N", "relative error of the added mass", "BEM convergence (spheroids)", logx=True)
+    fig.axes[0].set_yscale("log")
+    png = out_dir / "bem_convergence.png"
+    written = [atomic_write_bytes(png, png_bytes(fig), overwrite=force)]
+    doc.image(png.name, "Relative error of the added mass against the number of unknowns.")
+    written.append(atomic_write_text(out_dir / "bem_convergence.md", to_markdown(doc), overwrite=force))
+    return written
+
+
+def write_bench_report(rows, blas, tables, out_dir: Path, force: bool) -> list[Path]:
+    from semianalytic.io import atomic_write_text
+    from semianalytic.report.document import Document, fmt, to_markdown
+
+    doc = Document("BEM benchmark")
+    doc.para(
+        f"Machine: {platform.machine()}, Python {platform.python_version()}, one core (BLAS pinned to one "
+        "thread inside the solver). Times are the best of several repeats of assembly plus solve; the machine "
+        "is shared, so compare numbers from the same run. Generated by `python -m semianalytic bench-bem`."
+    )
+    doc.heading("Exact cases")
+    doc.table(
+        ("aspect", "unknowns N", "added-mass rel. error", "wall time [ms]", "peak memory [MiB]"),
+        [(fmt(r[0], 3), r[2], f"{r[3]:.2e}", f"{r[5] * 1e3:.2f}", f"{r[6]:.1f}") for r in rows],
+    )
+    four = [r for r in rows if r[0] == 4.0 and r[3] <= 1e-6]
+    if four:
+        best = min(four, key=lambda r: r[2])
+        verdict = "meets" if best[5] <= 0.010 else "misses"
+        doc.para(
+            f"**4:1 spheroid to 1e-6:** N = {best[2]} unknowns, error {best[3]:.1e}, {best[5] * 1e3:.2f} ms for "
+            f"assembly and solve: this {verdict} the 10 ms target."
+        )
+    ok400 = all(r[3] <= 1e-6 for r in rows if r[2] <= 400 and r[1] >= 0.5)
+    doc.para(
+        "**Sphere and spheroids within 1e-6 with at most 400 unknowns:** "
+        + ("yes, from refinement 0.5 on (see the table)." if ok400 else "no (see the table).")
+    )
+    doc.heading("BLAS threads")
+    default, t_default, t_one = blas
+    doc.para(
+        f"Dense LU solve of size 200: {t_one * 1e3:.2f} ms on one BLAS thread, {t_default * 1e3:.2f} ms with the "
+        f"library default ({default} threads); ratio {t_default / t_one:.2f}. The solver pins one thread."
+    )
+    doc.heading("A/B/C tables (Fig. 5 projectiles)")
+    doc.table(
+        ("nose", "depths", "wall time [s]", "mean N", "max N"),
+        [(k, n, f"{s:.2f}", f"{m:.0f}", mx) for k, n, s, m, mx in tables],
+    )
+    target = all(s <= 2.0 for _, n, s, _, _ in tables if n >= 60)
+    doc.para(
+        "Each depth costs three solves (P and P +- h for phi'_P) on one frozen panel topology with shared "
+        "quadrature rules. Target: one table of at least 60 depths in at most 2 s on one core: "
+        + ("met." if target else "not met on this run (see the times above).")
+    )
+    return [atomic_write_text(out_dir / "bench_bem.md", to_markdown(doc), overwrite=force)]
+
+
+def run(args) -> int:
+    out = Path(args.out)
+    names = ["bench_bem.md", "bem_convergence.md", "bem_convergence.png", "bem_coefficients.md"]
+    existing = [n for n in names if (out / n).exists()]
+    if existing and not args.force:
+        raise InputError("--out", f"{existing[0]} exists in {str(out)!r}; pass --force to overwrite the reports")
+    from semianalytic.bem.solve import _single_threaded_blas
+
+    repeats = 1 if args.quick else 5
+    refinements = REFINEMENTS[2:6] if args.quick else REFINEMENTS
+    with _single_threaded_blas():
+        rows = convergence_rows(repeats=repeats, refinements=refinements)
+        tables = table_timing(repeats=1 if args.quick else 2, n_depths=16 if args.quick else 64)
+    blas = blas_threads(repeats=5 if args.quick else 30)
+    written = write_convergence_report(rows, out, True)
+    written += write_bench_report(rows, blas, tables, out, True)
+    from semianalytic.coefficients.report import write_coefficients_report
+
+    written += write_coefficients_report(out, n_depths=16 if args.quick else 64)
+    for p in written:
+        print(f"wrote {p}")
+    return 0
