@@ -424,3 +424,4 @@ def select_steps(case: Case, run: RunSection, only=None) -> tuple[list[Step], di
 
 # Part I steps register themselves on import
 from semianalytic.report import steps_part1  # noqa: E402,F401
+from semianalytic.report import steps_other  # noqa: E402,F401

@@ -1,0 +1,97 @@
+"""Part III and Part IV steps of a ``run``: the ballistic limit velocity (Part IV, through
+:func:`semianalytic.ballistic_limit.cli.evaluate_case`) and the theoretical strength of
+nanoparticles (Part III, through :mod:`semianalytic.nanostrength`)."""
+
+from __future__ import annotations
+
+import math
+
+import numpy as np
+
+from semianalytic.case import Case
+from semianalytic.report.case import RunSection
+from semianalytic.report.context import Context
+from semianalytic.report.document import fmt
+from semianalytic.report.figures import Points, Series, line_figure
+from semianalytic.report.steps import Step, _has, register
+
+# --------------------------------------------------------------------------------------
+# Part IV: ballistic limit velocity
+
+_BL_COLUMNS = [
+    ("V_R1_m_s", "V(R1), eq. (5)"),
+    ("V_R2_m_s", "V(R2), eq. (5)"),
+    ("V_R3_m_s", "V(R3), eq. (5)"),
+    ("V_eq7_m_s", "V, eq. (7)"),
+    ("V_eq8_m_s", "V, eq. (8)"),
+    ("V_eq9_m_s", "V, eq. (9)"),
+]
+
+
+def _bl_evaluate(case: Case) -> dict:
+    from semianalytic.ballistic_limit.cli import evaluate_case
+
+    return evaluate_case(case)
+
+
+def _bl_preflight(case: Case, run: RunSection) -> None:
+    _bl_evaluate(case)  # reads the shot table, checks every shot
+
+
+def _bl_run(ctx: Context) -> None:
+    res = _bl_evaluate(ctx.case)
+    rows = res["rows"]
+    doc = ctx.doc
+    doc.heading("Ballistic limit velocity (Part IV)")
+    c = res["constants"]
+    doc.para(
+        f"Theory: eq. (5) with R(1) = HM delta_H ({res['hardness_rule']} hardness), R(2) = R(3) delta_H, R(3) of "
+        f"eq. (6). Empirical: eqs. (7)-(9) with P = {res['areal_mass_rule']} (errata 26), C1 = "
+        f"{c['C1_m2_per_s2']:.4g} m^2/s^2, C2 = {c['C2_m2_per_s2_per_GPa']:.4g} (m/s)^2/GPa, "
+        f"C3 = {c['C3_m2_per_s2']:.4g} m^2/s^2."
+    )
+    cols = [k for k, _ in _BL_COLUMNS if any(r.get(k) is not None for r in rows)]
+    labels = dict(_BL_COLUMNS)
+
+    def cell(v):
+        return "-" if v is None or not math.isfinite(v) else f"{v:.0f}"
+
+    doc.table(
+        ["shot", "measured V_cr [m/s]"] + [labels[k] + " [m/s]" for k in cols],
+        [[r["name"], r.get("measured_qualifier", "") + cell(r.get("measured_V_m_s"))] + [cell(r.get(k)) for k in cols]
+         for r in rows],
+        caption="Ballistic limit per shot.",
+    )
+    # measured values given as bounds ("<280") are shown but not used in the error statistics
+    meas = [r for r in rows if r.get("measured_V_m_s") is not None and not r.get("measured_qualifier")]
+    if meas:
+        m = np.array([r["measured_V_m_s"] for r in meas])
+        pts, stats = [], []
+        for k, mk in zip(cols, ("o", "s", "^", "v", "D", "x")):
+            pred = np.array([r.get(k) if r.get(k) is not None else np.nan for r in meas], float)
+            ok = np.isfinite(pred)
+            if ok.any():
+                pts.append(Points(m[ok], pred[ok], labels[k], mk))
+                e = (pred[ok] - m[ok]) / m[ok]
+                stats.append([labels[k], str(int(ok.sum())), f"{e.mean():+.1%}", f"{np.abs(e).mean():.1%}",
+                              f"{np.abs(e).max():.1%}"])
+        doc.table(["formula", "n", "mean error", "mean |error|", "max |error|"], stats,
+                  caption="Relative error (computed - measured)/measured.")
+        hi = 1.1 * max(m.max(), max(float(np.nanmax(p.y)) for p in pts))
+        fig = line_figure([Series(np.array([0, hi]), np.array([0, hi]), "computed = measured", "k-")],
+                          "measured V_cr [m/s]", "computed V_cr [m/s]", "Ballistic limit: computed against measured",
+                          points=pts)
+        ctx.figure("ballistic_limit_parity", fig, "Computed against measured ballistic limit velocity (Part IV).")
+    crit = [(r["name"], cc) for r in rows for cc in r.get("critical", [])]
+    if crit:
+        doc.table(
+            ["shot", "V_p [m/s]", "(rho h)_cr [g/cm^2]", "h_cr [mm]"],
+            [[n, fmt(cc["V_p_m_s"]), fmt(cc["rhoh_cr_kg_m2"] / 10), fmt(cc.get("h_cr_m") and cc["h_cr_m"] * 1e3)]
+             for n, cc in crit],
+            caption="Critical areal density and thickness (Table 4; eq. (9), P = rho_p L_p).",
+        )
+    ctx.results["ballistic_limit"] = res
+
+
+register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.ballistic_limit.cli",),
+              _has("ballistic_limit"), _bl_preflight, _bl_run))
