@@ -102,22 +102,13 @@ _K_SERIES = (math.pi / 2) * _C2  # K(q) = (pi/2) sum c_n^2 q^n
 _KME_Q_SERIES = (math.pi / 2) * _C2 * np.array([2 * n / (2 * n - 1) for n in range(SPLIT_TERMS)])  # K - E
 
 
-def _horner(x, coef):
-    """sum coef[n] x^n."""
-    out = np.full_like(x, coef[-1])
-    for c in coef[-2::-1]:
-        out *= x
-        out += c
-    return out
-
-
 def single_double_split(x, r, x1, r1, nx1, nr1):
     """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2."""
     dx, d2, D = _geometry(x, r, x1, r1)
     m1 = d2 / D
     K, E = ellip_ke(m1)
-    Kc = _horner(m1, _K_SERIES)  # K(1 - m), truncated
-    KcmEc = _horner(m1, _KME_Q_SERIES)  # K(1 - m) - E(1 - m), truncated
+    Kc = _polevl(m1, _K_SERIES[::-1])  # K(1 - m), truncated
+    KcmEc = _polevl(m1, _KME_Q_SERIES[::-1])  # K(1 - m) - E(1 - m), truncated
     inv = 1.0 / (math.pi * np.sqrt(D))
     bracket_over_d2 = (r1 * (dx * nx1 + (r - r1) * nr1) + 0.5 * nr1 * d2) / d2
     S = r1 * K * inv
@@ -141,7 +132,7 @@ def k_minus_e_over_m(m):
     m = np.asarray(m, dtype=float)
     small = m < 0.05
     out = np.empty_like(m)
-    out[small] = _horner(m[small], _KME_SERIES)
+    out[small] = _polevl(m[small], _KME_SERIES[::-1])
     mb = m[~small]
     out[~small] = (ellipk(mb) - ellipe(mb)) / mb
     return out

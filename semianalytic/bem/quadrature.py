@@ -7,10 +7,11 @@ converge at order 2p and the surface potential at about order p + 1 on graded me
 Three kinds of rules:
 
 - the panel's own Gauss rule, for well-separated (target, panel) pairs;
-- *self* rules for a target node u_i on its own panel: the panel is split at u_i and
-  each half gets a Gauss-Legendre rule (for the smooth part of the kernel) and a Gauss rule
-  for the weight -ln(s) (for the part multiplying -ln|u - u_i|), so the logarithmic
-  singularity of the ring kernels is integrated exactly in form;
+- *self* rules for a target node u_i on its own panel (built in :mod:`.solve` from
+  :func:`gauss_log`): the panel is split at u_i and the innermost piece on each side gets a
+  Gauss-Legendre rule (for the smooth part of the kernel) and a Gauss rule for the weight
+  -ln(s) (for the part multiplying -ln|u - u_i|), so the logarithmic singularity of the
+  ring kernels is integrated exactly in form;
 - *near* rules: dyadic composite Gauss rules graded towards the point of the panel nearest
   to the target, for nearly singular pairs.
 
@@ -70,19 +71,6 @@ def differentiation_matrix(p: int) -> np.ndarray:
 
 
 @functools.cache
-def integration_matrix(p: int) -> np.ndarray:
-    """I[i, k] = integral from -1 to u_i of l_k(u) du (spectral antiderivative at the nodes)."""
-    u, _ = gauss_legendre(p)
-    g, gw = gauss_legendre(p)
-    out = np.empty((p, p))
-    for i, ui in enumerate(u):
-        s = -1.0 + (ui + 1.0) * (g + 1.0) / 2.0
-        out[i] = (0.5 * (ui + 1.0) * gw) @ lagrange_matrix(u, s)
-    out.setflags(write=False)
-    return out
-
-
-@functools.cache
 def gauss_log(n: int) -> tuple[np.ndarray, np.ndarray]:
     """Gauss rule for the weight -ln(s) on [0, 1] (exact for polynomials of degree 2n-1).
 
@@ -118,43 +106,6 @@ def gauss_log(n: int) -> tuple[np.ndarray, np.ndarray]:
     nodes.setflags(write=False)
     weights.setflags(write=False)
     return nodes, weights
-
-
-@functools.cache
-def self_rules(p: int, n: int) -> dict[str, np.ndarray]:
-    """Rules for a target at each Gauss node u_i of a p-point panel.
-
-    For the singular node u_i the integral over [-1, 1] of ``K(u) f(u)`` with
-    ``K = smooth + (-ln|u - u_i|) Q`` is evaluated as
-
-        sum_q w_q [K(s_q) + ln|s_q - u_i| Q(s_q)] f(s_q) + sum_q wl_q Q(s_q) f(s_q)
-      + sum_q v_q Q(t_q) f(t_q),
-
-    where (s_q, w_q) is a Gauss-Legendre rule on each half, wl_q folds in the -ln(h) of
-    each half's length h, and (t_q, v_q) is the -ln(s) Gauss rule on each half.
-    Returned arrays have shape (p, 2n): plain nodes/weights/log-weights and log nodes/weights.
-    """
-    u, _ = gauss_legendre(p)
-    g, gw = gauss_legendre(n)
-    g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
-    t01, tw01 = gauss_log(n)
-    plain_u = np.empty((p, 2 * n))
-    plain_w = np.empty((p, 2 * n))
-    plain_wl = np.empty((p, 2 * n))
-    log_u = np.empty((p, 2 * n))
-    log_w = np.empty((p, 2 * n))
-    for i, ui in enumerate(u):
-        for side, (h, sign) in enumerate(((1.0 - ui, 1.0), (1.0 + ui, -1.0))):
-            sl = slice(side * n, (side + 1) * n)
-            plain_u[i, sl] = ui + sign * h * g01
-            plain_w[i, sl] = h * gw01
-            plain_wl[i, sl] = -math.log(h) * h * gw01
-            log_u[i, sl] = ui + sign * h * t01
-            log_w[i, sl] = h * tw01
-    rules = {"plain_u": plain_u, "plain_w": plain_w, "plain_wl": plain_wl, "log_u": log_u, "log_w": log_w}
-    for v in rules.values():
-        v.setflags(write=False)
-    return rules
 
 
 @functools.cache
