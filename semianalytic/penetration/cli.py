@@ -126,8 +126,8 @@ def _fmt(x, scale=1.0, digits=1):
     return "nan" if not np.isfinite(x) else f"{x * scale:.{digits}f}"
 
 
-def _print_text(result: dict, desc: str, file=sys.stdout) -> None:
-    p = lambda *a: print(*a, file=file)  # noqa: E731
+def _print_text(result: dict, desc: str, file=None) -> None:
+    p = lambda *a: print(*a, file=file or sys.stdout)  # noqa: E731
     p(f"case: {result['title']}  ({result['case']})")
     p(f"  coefficients: {desc}")
     p(

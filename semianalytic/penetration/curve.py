@@ -233,6 +233,7 @@ def penetration_curve(
     w1: str = "neglect",
     elastic: bool = True,
     n_grid: int = 512,
+    rtol: float | None = None,
 ) -> dict[str, np.ndarray]:
     """Every Part I projectile model for each striking velocity (arrays, SI; keys carry units).
 
@@ -241,7 +242,9 @@ def penetration_curve(
     stop_time_elastic_s (paper's W2, eq. (29)), depth_elastic_exact_rod_m and
     stop_time_elastic_exact_rod_s (errata item 5), critical_velocity_m_s (eq. (33)), yields.
     Without a projectile material (setup.rod None) or with ``elastic=False`` only the rigid
-    keys are filled (the rest NaN).
+    keys are filled (the rest NaN).  ``rtol`` is accepted for symmetry with
+    :func:`~semianalytic.penetration.motion.solve_motion` and not needed: the integration in P
+    is spectral on panels and converges to round-off (see the tests).
     """
     if w1 not in W1_MODELS:
         raise InputError("w1", f"must be one of {', '.join(W1_MODELS)}; got {w1!r}")

@@ -135,12 +135,9 @@ class ElasticResult:
         return np.where(t <= self.t_star, corrected_velocity(ub, self.energy(t), self.quasi_rigid.mass), 0.0)[()]
 
     def depth(self, t):
-        """P(t) = int_0^t u, by the same panel quadrature as the final depth."""
-        t = np.atleast_1d(np.asarray(t, float))
-        return np.array([self._integral(min(x, self.t_star)) for x in t]).reshape(np.shape(t))
-
-    def _integral(self, t_end: float) -> float:
-        return _integrate_u(self, t_end)
+        """P(t) = int_0^t u (vectorised; the same panel quadrature as the final depth)."""
+        t = np.asarray(t, float)
+        return _depths(self, np.minimum(t.ravel(), self.t_star), self._rod).reshape(t.shape)[()]  # type: ignore[attr-defined]
 
 
 def _panel_edges(t_end: float, rod: rodmod.Rod) -> np.ndarray:
@@ -153,23 +150,29 @@ def _panel_edges(t_end: float, rod: rodmod.Rod) -> np.ndarray:
 _GX, _GW = np.polynomial.legendre.leggauss(12)
 
 
-def _integrate_u(res: ElasticResult, t_end: float, rod: rodmod.Rod | None = None) -> float:
-    rod = rod or res._rod  # type: ignore[attr-defined]
-    if t_end <= 0:
-        return 0.0
-    edges = _panel_edges(t_end, rod)
-    total = 0.0
-    for a, b in zip(edges[:-1], edges[1:]):
-        x = 0.5 * (_GX + 1.0)
-        if b == res.t_star and a < b:
-            # u ~ sqrt(t* - t) at the stop: t = a + (b - a)(1 - (1 - x)^2), dt = 2 (b - a)(1 - x) dx
-            t = a + (b - a) * (1.0 - (1.0 - x) ** 2)
-            w = 0.5 * _GW * 2.0 * (b - a) * (1.0 - x)
-        else:
-            t = a + (b - a) * x
-            w = 0.5 * _GW * (b - a)
-        total += float(np.sum(w * res.velocity(t)))
-    return total
+def _depths(res: ElasticResult, t_ends: np.ndarray, rod: rodmod.Rod) -> np.ndarray:
+    """int_0^t u dt for each t in ``t_ends`` (<= t*): Gauss panels between the kinks, the last
+    panel mapped t = a + (b - a)(1 - (1 - x)^2) because u ~ sqrt(t* - t) at the stop."""
+    t_ends = np.asarray(t_ends, float)
+    if res.t_star <= 0:
+        return np.zeros_like(t_ends)
+    edges = _panel_edges(res.t_star, rod)
+    x = 0.5 * (_GX + 1.0)
+    a, b = edges[:-1, None], edges[1:, None]
+    last = np.zeros((len(edges) - 1, 1), bool)
+    last[-1] = True
+    tn = np.where(last, a + (b - a) * (1.0 - (1.0 - x) ** 2), a + (b - a) * x)
+    wn = np.where(last, 0.5 * _GW * 2.0 * (b - a) * (1.0 - x), 0.5 * _GW * (b - a))
+    panel = np.sum(wn * res.velocity(tn.ravel()).reshape(tn.shape), axis=1)
+    cum = np.concatenate([[0.0], np.cumsum(panel)])
+    k = np.clip(np.searchsorted(edges, t_ends, side="right") - 1, 0, len(edges) - 2)
+    full = t_ends >= res.t_star
+    lo = edges[k][:, None]
+    hi = t_ends[:, None]
+    tp = lo + (hi - lo) * x[None, :]
+    wp = 0.5 * _GW[None, :] * (hi - lo)
+    part = np.sum(wp * res.velocity(tp.ravel()).reshape(tp.shape), axis=1)
+    return np.where(full, cum[-1], cum[k] + part)
 
 
 def solve_elastic(
@@ -223,5 +226,5 @@ def solve_elastic(
     res = ElasticResult(U_s=float(U_s), U0=U0, sigma0=sigma0, t_star=float(t_star), final_depth=0.0,
                         quasi_rigid=qr, w1=w1, w2=w2, _energy=energy)
     object.__setattr__(res, "_rod", rod)
-    object.__setattr__(res, "final_depth", _integrate_u(res, res.t_star, rod))
+    object.__setattr__(res, "final_depth", float(_depths(res, np.array([res.t_star]), rod)[0]))
     return res
