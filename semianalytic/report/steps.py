@@ -281,6 +281,51 @@ def _velocity_field_run(ctx: Context) -> None:
 
 
 # --------------------------------------------------------------------------------------
+# FEM potential field of fem_check (explicit only: [run] analyses or --only fem_field)
+
+
+def _fem_field_run(ctx: Context) -> None:
+    from fem_check.meshing import MeshOptions, build_mesh, halfspace_domain
+    from fem_check.potential import solve_potential
+
+    from semianalytic.bem import solve_halfspace
+    from semianalytic.report import vtk
+
+    case, run = ctx.case, ctx.run
+    pr = _projectile(case)
+    d = ctx.doc
+    d.heading("FEM potential field (fem_check)")
+    d.para(
+        "The independent finite-element solution of the same potential problem (fem_check: gmsh mesh of the "
+        "meridian half-plane, P2 elements with curved edges, monopole Robin far field, errata item 2f), written "
+        "as `.vtu` with the BEM potential at the same vertices for comparison (`phi_bem`, `phi_difference`)."
+    )
+    rows, out = [], []
+    opts = MeshOptions()
+    for P in _field_depths(case, run):
+        u, why = _field_velocity(case, run, ctx.memo, P)
+        dm = build_mesh(halfspace_domain(pr.nose, P, opts), opts)
+        sol = solve_potential(dm, "monopole")
+        bem = solve_halfspace(pr.nose, P, **bem_options(case))
+        mesh = vtk.fem_meridian_mesh(sol, u, bem)
+        tag = f"P{P * 1e3:.1f}mm".replace(".", "p")
+        rel, path = ctx.vtk_path(f"fem_potential_{tag}.vtu")
+        vtk.write_vtu(mesh, path)
+        pts = mesh.points
+        near = np.hypot(pts[:, 0] - P, pts[:, 1]) < 3 * pr.diameter
+        diff, ref = mesh.point_data["phi_difference"], mesh.point_data["phi_bem"]
+        ok = near & np.isfinite(diff)
+        dmax = float(np.max(np.abs(diff[ok])) / np.max(np.abs(ref[ok]))) if ok.any() else float("nan")
+        rows.append([_mm(P), str(sol.n_dofs), fmt(sol.A), fmt(bem.A), f"{abs(sol.A - bem.A) / abs(bem.A):.1e}",
+                     f"{dmax:.1e}"])
+        out.append({"depth_m": P, "dofs": sol.n_dofs, "A_fem_m3": sol.A, "A_bem_m3": bem.A, "C_fem_m2": sol.C,
+                    "C_bem_m2": bem.C, "max_rel_phi_difference_near_nose": dmax, "vtk": rel, "speed_u_m_s": u})
+    d.table(["P [mm]", "FEM dofs", "A FEM [m^3]", "A BEM [m^3]", "relative difference",
+             "max |phi_FEM - phi_BEM| / max |phi| within 3 d of the tip"], rows)
+    ctx.results["fem_field"] = out
+
+
+# --------------------------------------------------------------------------------------
 # Part II: brittle cavity expansion
 
 
@@ -381,6 +426,8 @@ def register(step: Step) -> Step:
 
 register(Step("added_mass", "Added mass", ("body",), ("semianalytic.bem",), _has("body"),
               _added_mass_preflight, _added_mass_run))
+register(Step("fem_field", "FEM field", ("projectile", "target"), ("fem_check.potential", "fem_check.meshing"),
+              lambda case: False, _velocity_field_preflight, _fem_field_run))
 register(Step("cavity", "Brittle cavity expansion", ("material",), ("semianalytic.cavity",), _has("material"),
               _cavity_preflight, _cavity_run))
 register(Step("velocity_field", "Velocity field", ("projectile", "target"),

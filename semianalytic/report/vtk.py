@@ -35,6 +35,7 @@ __all__ = [
     "write_vtu",
     "projectile_inside",
     "projectile_field",
+    "fem_meridian_mesh",
     "render_png",
 ]
 
@@ -321,6 +322,44 @@ def projectile_field(
     x0, x1, r1 = field_window(nose, length, depth, extent)
     g = meridian_grid(x0, x1, r1, grid[0], grid[1], projectile_inside(nose, length, depth))
     return evaluate_field(g, sol.gradient, u, sol.potential, depth=depth), sol
+
+
+# --------------------------------------------------------------------------------------
+# FEM fields of fem_check
+
+
+def fem_meridian_mesh(solution, u: float, reference=None, exclude_tags=("body", "wall")):
+    """A fem_check :class:`~fem_check.potential.PotentialSolution` in the meridian plane as a
+    meshio mesh: the mesh's vertices (x, r, 0), its triangles, point data ``phi`` (FEM, unit
+    speed) [m], ``velocity`` = -u grad(phi) (L2 projection of the FEM gradient onto the FEM
+    space, Part I eq. (8)) [m/s] and ``speed``.  With ``reference`` (a BEM solution with
+    ``potential(points)``), also ``phi_bem`` and ``phi_difference`` = FEM - BEM at the vertices
+    off the surfaces in ``exclude_tags`` (NaN on them: the BEM field is singular there).
+    """
+    import meshio
+
+    basis = solution.basis
+    vert = basis.nodal_dofs[0]
+    pts2 = basis.doflocs[:, vert].T
+    tri = solution.dm.mesh.t[:3].T
+    ip = basis.interpolate(solution.phi)
+    gx = basis.project(ip.grad[0])[vert]
+    gr = basis.project(ip.grad[1])[vert]
+    phi = solution.phi[vert]
+    vel = np.column_stack([-u * gx, -u * gr, np.zeros(len(vert))])
+    pdata = {"phi": phi, "velocity": vel, "speed": np.hypot(vel[:, 0], vel[:, 1])}
+    if reference is not None:
+        on = np.zeros(len(vert), dtype=bool)
+        for tag in exclude_tags:
+            if tag in solution.dm.boundaries:
+                nodes = solution.dm.facet_nodes(solution.dm.boundaries[tag])
+                on[nodes[nodes < len(vert)]] = True
+        ref = np.full(len(vert), np.nan)
+        ref[~on] = reference.potential(pts2[~on])
+        pdata["phi_bem"] = ref
+        pdata["phi_difference"] = phi - ref
+    pts = np.column_stack([pts2, np.zeros(len(vert))])
+    return meshio.Mesh(pts, [("triangle", tri)], point_data=pdata, field_data={"speed_u_m_s": np.array([u])})
 
 
 # --------------------------------------------------------------------------------------
