@@ -122,10 +122,8 @@ def part4_resistance(Y: float, E: float) -> float:
 
     Not Part I, eq. (16) at nu = 1/2: the log term's coefficient is 1, not 2/3 (errata item 6).
     """
-    try:  # one implementation in the project: the ballistic-limit module's, once it exists
-        from semianalytic.ballistic_limit.theory import resistance_part4
-    except ImportError:
-        return Y * (2.0 / 3.0 + math.log(2.0 * E / (3.0 * Y)))
+    from semianalytic.ballistic_limit.theory import resistance_part4  # the one implementation (Part IV module)
+
     return float(resistance_part4(Y, E))
 
 
