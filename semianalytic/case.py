@@ -96,7 +96,8 @@ class ProjectileSection(Section):
 
     nose: Literal["ogive", "sphere", "cone", "flat", "table"]
     diameter: Length
-    shank_length: NonNegativeLength
+    shank_length: NonNegativeLength | None = None
+    length: Length | None = Field(default=None, description="total length L = shank + nose (instead of shank_length)")
     density: Density | None = None
     mass: Mass | None = None
     crh: float | None = Field(default=None, description="ogive caliber radius head psi = s/d")
@@ -135,7 +136,38 @@ class ProjectileSection(Section):
                 raise ValueError("'corner_radius' must not exceed half the diameter")
         if self.nose == "table" and (not self.points or self.points_unit is None):
             raise ValueError("a table nose needs 'points' = [[x, r], ...] and 'points_unit'")
+        if self.shank_length is None and self.length is None:
+            raise ValueError("give 'shank_length' (the cylindrical part) or 'length' (the total length)")
         return self
+
+    def check_geometry(self) -> None:
+        """Build the nose (rejecting impossible shapes with the field at fault) and check
+        the lengths against it.  Raises ``InputError``."""
+        from semianalytic.geometry import nose_from_section
+
+        nose = nose_from_section(self)
+        if self.length is not None:
+            shank = self.length - nose.length
+            if shank < -1e-12 * self.length:
+                raise InputError(
+                    "projectile.length",
+                    f"the nose (L_h = {nose.length * 1e3:.4g} mm) is longer than the body (length = {self.length * 1e3:.4g} mm)",
+                )
+            if self.shank_length is not None and abs(self.shank_length - shank) > 1e-6 * self.length:
+                raise InputError(
+                    "projectile.length",
+                    f"{self.length * 1e3:.4g} mm differs from shank_length + nose length "
+                    f"({(self.shank_length + nose.length) * 1e3:.4g} mm); give one of them",
+                )
+
+    @property
+    def shank(self) -> float:
+        """The cylindrical length L_c [m] (from 'shank_length' or 'length' minus the nose)."""
+        if self.shank_length is not None:
+            return self.shank_length
+        from semianalytic.geometry import nose_from_section
+
+        return max(self.length - nose_from_section(self).length, 0.0)
 
     def points_si(self) -> list[tuple[float, float]]:
         s = _UNIT_SCALE[self.points_unit or "m"]
@@ -275,6 +307,12 @@ def parse_case(data: Mapping[str, Any], path: Path | None = None) -> Case:
         raise InputError("body", "a case is either a [body] in unbounded fluid or a [projectile] in a target, not both")
     if "projectile" in core and "target" not in core:
         raise InputError("target", "a [projectile] case needs a [target] section with 'density'")
+    if "projectile" in core:
+        core["projectile"].check_geometry()
+    if "body" in core:
+        from semianalytic.geometry import body_from_section
+
+        body_from_section(core["body"])  # rejects impossible tables with the field at fault
     return Case(
         path=path,
         title=str(data.get("title", path.stem if path else "case")),

@@ -456,7 +456,7 @@ def nose_from_section(sec) -> Nose:
 
 def projectile_from_section(sec) -> Projectile:
     """Build the projectile of a ``[projectile]`` case section."""
-    return Projectile(nose_from_section(sec), sec.shank_length, sec.density, sec.mass)
+    return Projectile(nose_from_section(sec), sec.shank, sec.density, sec.mass)
 
 
 def body_from_section(sec) -> Meridian:
