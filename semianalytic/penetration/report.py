@@ -218,6 +218,7 @@ def _validation_section(doc, ctx, w):
         two = _two_term_reading(ctx, cs, rows)
         if two is not None:
             doc.note(two)
+        doc.table(*_buckling_table(ctx, cs))
         flagged = [r["shot"] for r in rows if r["yields"]]
         if flagged:
             doc.note(f"Shots with U_s >= U_sC (the model says the projectile yields; outside its validity): "
@@ -253,6 +254,32 @@ def _validation_section(doc, ctx, w):
                           f"P(U_s), {label}; m = {m_mean * 1e3:.2f} g", points=pts)
         doc.image(w.figure(f"depth_velocity_Rt{tag}", fig),
                   f"Depth against striking velocity (cf. Fig. 15), curves for the mean shot mass {m_mean * 1e3:.2f} g, {label}.")
+
+
+def _buckling_table(ctx, cs):
+    """U_sC of each projectile without and with the Johnson-Euler buckling factor (Fig. 4)."""
+    from semianalytic.penetration import critical as crit
+
+    rows = []
+    for case in cs:
+        setup = ctx.setup(case)
+        lam = crit.slenderness(setup.rod.length, setup.rod.diameter)
+        phi = float(crit.johnson_euler_phi(lam, setup.rod.youngs_modulus, setup.yield_stress))
+        ci = setup.critical_inputs()
+        rows.append([_material(case), f"{setup.yield_stress / 1e6:.0f}", f"{lam:.1f}", f"{crit.critical_velocity(setup.yield_stress, ci):.0f}",
+                     f"{phi:.3f}", f"{crit.critical_velocity(setup.yield_stress, ci, phi):.0f}"])
+    low = max(float(r[-1]) for r in rows) < min(r["velocity_m_s"] for r in ctx_rows(ctx, cs))
+    return (["projectile", "Y_p [MPa]", "lambda = 4L/d", "U_sC, no buckling [m/s]", "phi (Johnson-Euler)", "U_sC with buckling [m/s]"],
+            rows, "Critical impact velocity (eqs. (33)/(36)) without and with the longitudinal-buckling factor of a "
+                  "pin-ended free column (section 2, Fig. 4); the cases use buckling = 'none'."
+                  + (" With buckling every rigid-regime shot would exceed U_sC although the projectiles stayed intact: "
+                     "the free-column estimate is far too pessimistic for a projectile whose nose is held by the target."
+                     if low else ""))
+
+
+def ctx_rows(ctx, cs):
+    """The validation rows of the group the cases ``cs`` belong to."""
+    return ctx.rows[_target_label(cs[0])]
 
 
 def _two_term_reading(ctx, cs, rows) -> str | None:
@@ -385,8 +412,10 @@ def _histories_section(doc, ctx, w):
     fig.axes[0].set_ylim(bottom=0.1)
     doc.image(w.figure("energies", fig),
               "The paper's W2 (eq. (29)) grows linearly in time; the vibration energy of the exact rod solution stays "
-              "between 0 and pi d^2 sigma_0^2 L/(8 E_p) (errata item 5). The elastic projectile of eq. (30') stops "
-              "where the quasi-rigid kinetic energy m ubar^2/2 falls to W1 + W2.")
+              "between 0 and pi d^2 sigma_0^2 L/(8 E_p) (errata item 5). Even during the first wave transit (t < 2L/c_0) "
+              "eq. (29), W2 = N w(L, t)/2, is not the rod's vibration energy, which is N w_el(L, t) = N (sigma_0/E_p)"
+              "(c_0 t - c_0^2 t^2/(2L)): twice eq. (29) as t -> 0, equal at t = L/c_0, zero at 2L/c_0. The elastic "
+              "projectile of eq. (30') stops where the quasi-rigid kinetic energy m ubar^2/2 falls to W1 + W2.")
 
 
 def _curves_section(doc, ctx, w):
