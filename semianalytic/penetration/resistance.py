@@ -383,22 +383,13 @@ _ADAPTER = TypeAdapter(ResistanceSpec)
 
 
 def _message(err: dict) -> str:
-    typ = err.get("type", "")
-    if typ == "missing":
-        return "missing (required)"
-    if typ == "extra_forbidden":
-        return "unknown key"
-    if typ in ("union_tag_invalid", "union_tag_not_found"):
-        return f"'model' must be one of {', '.join(MODELS)}" + (
-            f"; got {err['input'].get('model')!r}" if isinstance(err.get("input"), dict) and "model" in err["input"] else ""
-        )
-    msg = err.get("msg", "invalid")
-    for prefix in ("Value error, ", "Assertion failed, "):
-        if msg.startswith(prefix):
-            msg = msg[len(prefix):]
-    if "input" in err and not isinstance(err["input"], dict) and typ != "value_error":
-        msg = f"{msg}; got {err['input']!r}"
-    return msg
+    if err.get("type") in ("union_tag_invalid", "union_tag_not_found"):
+        inp = err.get("input")
+        got = f"; got {inp.get('model')!r}" if isinstance(inp, dict) and "model" in inp else ""
+        return f"'model' must be one of {', '.join(MODELS)}{got}"
+    from semianalytic.case import _pydantic_message  # the case files' wording (imported late: no cycle)
+
+    return _pydantic_message(err)
 
 
 def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
