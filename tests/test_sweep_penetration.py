@@ -73,11 +73,16 @@ def test_velocity_by_material_inline(case_file, tmp_path):
     _check(pd.read_csv(tmp_path / "sw" / "results.csv"))
 
 
-def test_velocity_by_material_on_a_local_cluster(case_file, tmp_path):
+def test_velocity_by_material_on_an_existing_dask_cluster(case_file, tmp_path):
+    # --scheduler ADDRESS: a cluster started elsewhere (here: by the test), two worker processes
+    from dask.distributed import LocalCluster
+
     spec = build_spec(["target.resistance.yield_stress=300:500:50 MPa", "impact.striking_velocity=400:1600:100 m/s"])
     kernel = PenetrationKernel(coefficients=COEF)
-    s = run_sweep(case_file, spec, tmp_path / "sw", workers=2, progress=False, kernel=kernel, batch_size=13)
-    assert s.scheduler == "local" and s.workers == 2
+    with LocalCluster(n_workers=2, threads_per_worker=1, processes=True, dashboard_address=None) as cluster:
+        s = run_sweep(case_file, spec, tmp_path / "sw", scheduler=cluster.scheduler_address, progress=False,
+                      kernel=kernel, batch_size=13)
+    assert s.scheduler == cluster.scheduler_address and s.workers == 2
     assert s.n_ok == 5 * 13
     df = pd.read_csv(tmp_path / "sw" / "results.csv")
     assert sorted(df.case_id) == list(range(65))

@@ -307,8 +307,12 @@ def _penetration_run(ctx: Context) -> None:
     ctx.results["penetration"] = out
 
 
+def _penetration_applies(case: Case) -> bool:
+    return _has("projectile", "target", "impact")(case) and case.target.resistance is not None
+
+
 register(Step("penetration", "Penetration", ("projectile", "target", "impact"),
-              ("semianalytic.penetration.curve",), _has("projectile", "target", "impact"),
+              ("semianalytic.penetration.curve",), _penetration_applies,
               _penetration_preflight, _penetration_run))
 
 
@@ -318,7 +322,8 @@ register(Step("penetration", "Penetration", ("projectile", "target", "impact"),
 
 def _critical_applies(case: Case) -> bool:
     p, data = case.projectile, case.section("data")
-    return (p is not None and case.target is not None and p.youngs_modulus is not None
+    return (p is not None and case.target is not None and case.target.resistance is not None
+            and p.youngs_modulus is not None
             and (p.yield_stress is not None or (data is not None and data.critical_velocity is not None)))
 
 
@@ -383,7 +388,8 @@ register(Step("critical_velocity", "Critical velocity", ("projectile", "target")
 
 def _validation_applies(case: Case) -> bool:
     data = case.section("data")
-    return case.projectile is not None and case.target is not None and data is not None and data.file is not None
+    return (case.projectile is not None and case.target is not None and case.target.resistance is not None
+            and data is not None and data.file is not None)
 
 
 def _validation_preflight(case: Case, run: RunSection) -> None:

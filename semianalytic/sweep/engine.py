@@ -221,8 +221,8 @@ def _batches(ids: np.ndarray, size: int) -> list[np.ndarray]:
     return [ids[i : i + size] for i in range(0, len(ids), size)]
 
 
-def prepare_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict) -> bool:
-    """Check/prepare the output folder; returns True for a fresh start."""
+def check_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict) -> bool:
+    """Check the output folder (nothing is changed); returns True for a fresh start."""
     res = results_path(out, fmt)
     man = out / MANIFEST
     if out.exists() and not out.is_dir():
@@ -244,13 +244,41 @@ def prepare_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dic
         return False
     if has_results and not force:
         raise InputError("--out", f"{str(out)!r} already holds sweep results; pass --resume to continue or --force to start over")
-    if force:
-        for p in (results_path(out, "csv"), results_path(out, "parquet"), man):
-            if p.is_dir():
-                shutil.rmtree(p)
-            elif p.exists():
-                p.unlink()
     return True
+
+
+def _clear_results(out: Path) -> None:
+    """--force: remove an earlier sweep's results and manifest (only those files)."""
+    for p in (results_path(out, "csv"), results_path(out, "parquet"), out / MANIFEST):
+        if p.is_dir():
+            shutil.rmtree(p)
+        elif p.exists():
+            p.unlink()
+
+
+def _connect(scheduler: str | None, workers: int):
+    """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
+    else a client of the scheduler at that address (InputError if it cannot be used)."""
+    sched = (scheduler or "local").strip()
+    if sched == "inline":
+        return None, None, "inline"
+    from dask.distributed import Client, LocalCluster
+
+    if sched == "local":
+        cluster = LocalCluster(
+            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+            silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+        )
+        return Client(cluster), cluster, "local"
+    client = None
+    try:
+        client = Client(sched, timeout="10s")
+        client.wait_for_workers(1, timeout=60)
+    except (OSError, TimeoutError, ValueError) as exc:
+        if client is not None:
+            client.close()
+        raise InputError("--scheduler", f"cannot use the dask scheduler {sched!r}: {exc}") from None
+    return client, None, sched
 
 
 def run_sweep(
@@ -270,8 +298,8 @@ def run_sweep(
     kernel: Kernel | None = None,
     on_batch: Callable[[int], None] | None = None,
 ) -> SweepSummary:
-    """Run (or resume) a sweep; see :mod:`semianalytic.sweep`.  Bad input raises InputError
-    before anything is written."""
+    """Run (or resume) a sweep; see :mod:`semianalytic.sweep`.  Bad input (case, spec, output
+    folder, scheduler address) raises InputError before anything is written."""
     t0 = time.perf_counter()
     case_path = Path(case_path)
     case = load_case(case_path)
@@ -289,44 +317,31 @@ def run_sweep(
     manifest["fingerprint"] = hashlib.sha256(
         json.dumps({k: manifest[k] for k in ("case_sha256_16", "analysis", "spec")}, sort_keys=True).encode()
     ).hexdigest()[:16]
-    fresh = prepare_output(out, fmt, resume, force, manifest)
+    fresh = check_output(out, fmt, resume, force, manifest)
     columns = list(BASE_COLUMNS) + list(spec.columns.values()) + list(kernel.columns)
     store = ResultStore(out, fmt, columns)
     done = set() if fresh else store.finished_ids()
     all_ids = np.arange(spec.n_cases, dtype=np.int64)
     pending = all_ids[~np.isin(all_ids, np.fromiter(done, dtype=np.int64, count=len(done)))] if done else all_ids
-    out.mkdir(parents=True, exist_ok=True)
-    atomic_write_json(out / MANIFEST, manifest)
     summary = SweepSummary(out, store.path, spec.n_cases, len(done), len(pending))
     draws = spec.draws() if spec.samplers else {}
-    store.open(fresh)
-    client = cluster = None
+    t_prep = time.perf_counter()
+    client, cluster, summary.scheduler = _connect(scheduler, workers) if len(pending) else (None, None, "none")
     try:
+        # from here on the folder is written
+        if fresh and force:
+            _clear_results(out)
+        out.mkdir(parents=True, exist_ok=True)
+        atomic_write_json(out / MANIFEST, manifest)
+        store.open(fresh)
         if len(pending) == 0:
-            summary.seconds_total = time.perf_counter() - t0
             return summary
         # shared resources (coefficient tables), one per geometry
-        t_prep = time.perf_counter()
         rcases = _resource_cases(case, spec, kernel, pending, draws)
-        sched = (scheduler or "local").strip()
-        if sched == "inline":
+        if client is None:
             resources = {k: kernel.prepare(c) for k, c in rcases.items()}
-            summary.scheduler, summary.workers = "inline", 1
+            summary.workers = 1
         else:
-            from dask.distributed import Client, LocalCluster
-
-            if sched == "local":
-                cluster = LocalCluster(
-                    n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                    silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
-                )
-                client = Client(cluster)
-            else:
-                try:
-                    client = Client(sched, timeout="10s")
-                except (OSError, TimeoutError, ValueError) as exc:
-                    raise InputError("--scheduler", f"cannot connect to the dask scheduler {sched!r}: {exc}") from None
-            summary.scheduler = sched
             summary.workers = len(client.scheduler_info().get("workers", {})) or workers
             client.run(warm_up)
             futures = {k: client.submit(kernel.prepare, c, pure=False) for k, c in rcases.items()}
