@@ -19,6 +19,7 @@ norm (h^2 for P1, h^4 for P2 with curved edges).
 
 from __future__ import annotations
 
+import dataclasses
 import math
 import time
 from dataclasses import dataclass
@@ -98,6 +99,7 @@ class PotentialSolution:
     C: float  # m^2, Part I eq. (12)
     far_field: str
     seconds: float
+    shift: float = 0.0  # the FEM works in x - shift (see solve_potential)
 
     @property
     def n_dofs(self) -> int:
@@ -105,7 +107,8 @@ class PotentialSolution:
 
     def potential(self, points: np.ndarray) -> np.ndarray:
         """phi at points (M, 2) of (x, r) inside the mesh."""
-        return probe_matrix(self.basis, points) @ self.phi
+        pts = np.asarray(points, float) - np.array([self.shift, 0.0])
+        return probe_matrix(self.basis, pts) @ self.phi
 
     def node_value(self, point: tuple[float, float]) -> float:
         """phi at the mesh vertex nearest to ``point`` (a nodal value: the tip, the waterline)."""
@@ -123,9 +126,10 @@ class PotentialSolution:
         """
         facets = self.dm.boundaries[tag]
         order = intorder or 2 * self.basis.elem.maxdeg + 2
-        fb = FacetBasis(self.dm.mesh, self.basis.elem, facets=facets, intorder=order)
+        fb = FacetBasis(self.basis.mesh, self.basis.elem, facets=facets, intorder=order)
         ph = fb.interpolate(self.phi)
         x, r = np.asarray(fb.global_coordinates())
+        x = x + self.shift
         nx, nr = -np.asarray(fb.normals)[0], -np.asarray(fb.normals)[1]
         tx, tr = -nr, nx
         gx, gr = ph.grad
@@ -148,15 +152,20 @@ def solve_potential(dm: DomainMesh, far_field: str, order: int | None = None) ->
     order = order or dm.order
     elem = element_for(order)
     q = 2 * order + 2  # weight r and curved (quadratic) geometry: one degree above exact for straight edges
-    basis = Basis(dm.mesh, elem, intorder=q)
+    # Work in x - P (tip at the origin): scikit-fem inverts curved facet maps by Newton iterations
+    # with an absolute tolerance, which round-off defeats on the tiny tip elements when |x| is
+    # thousands of element sizes (deep penetration).  Only x is shifted: the weight r is unchanged.
+    shift = float(dm.domain.info.get("depth", 0.0)) if dm.domain.kind == "halfspace" else 0.0
+    mesh = dataclasses.replace(dm.mesh, doflocs=dm.mesh.doflocs - np.array([[shift], [0.0]])) if shift else dm.mesh
+    basis = Basis(mesh, elem, intorder=q)
     K = _laplace_r.assemble(basis)
-    body = FacetBasis(dm.mesh, elem, facets=dm.boundaries["body"], intorder=q)
+    body = FacetBasis(mesh, elem, facets=dm.boundaries["body"], intorder=q)
     f = _body_load.assemble(body)
     k = FAR_FIELD_EXPONENT[far_field]
     if k > 0:
-        far = FacetBasis(dm.mesh, elem, facets=dm.boundaries["far"], intorder=q)
+        far = FacetBasis(mesh, elem, facets=dm.boundaries["far"], intorder=q)
         xc, rc = dm.domain.far_center
-        K = K + _robin_r.assemble(far, xc=xc, rc=rc, k=k)
+        K = K + _robin_r.assemble(far, xc=xc - shift, rc=rc, k=k)
     if k == 0:
         # pure Neumann: fix the additive constant by phi = 0 at the far point on the axis
         far_nodes = basis.get_dofs(dm.boundaries["far"]).all()
@@ -169,4 +178,4 @@ def solve_potential(dm: DomainMesh, far_field: str, order: int | None = None) ->
     phi = spla.spsolve(K.tocsc(), f)
     A = 2 * math.pi * float(f @ phi) if k > 0 else 2 * math.pi * float(_body_load.assemble(body) @ phi)
     C = 2 * math.pi * float(_contact_area.assemble(body))
-    return PotentialSolution(dm, basis, phi, A, C, far_field, time.perf_counter() - t0)
+    return PotentialSolution(dm, basis, phi, A, C, far_field, time.perf_counter() - t0, shift)
