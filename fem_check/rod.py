@@ -18,7 +18,6 @@ p^2 / (2 m), p = 1^T M v the momentum; the paper's W2 (eq. (29)) is reported bes
 from __future__ import annotations
 
 import argparse
-import json
 import math
 import time
 from dataclasses import dataclass
@@ -26,11 +25,12 @@ from pathlib import Path
 from typing import Callable
 
 import numpy as np
-import scipy.sparse as sp
 import scipy.sparse.linalg as spla
 from skfem import Basis, BilinearForm, ElementLineP1, ElementLineP2, MeshLine1
 
 from semianalytic.errors import InputError
+from semianalytic.penetration import rod as series  # the series solution (24)-(29) compared with
+from semianalytic.penetration.rod import Rod  # length L, diameter d, E_p, rho_p; c0, area, mass, period 2L/c0
 
 
 @BilinearForm
@@ -41,39 +41,6 @@ def _mass(u, v, w):
 @BilinearForm
 def _stiff(u, v, w):
     return u.grad[0] * v.grad[0]
-
-
-@dataclass(frozen=True)
-class RodProblem:
-    """Rod data [SI]: length L, diameter d, Young's modulus E_p, density rho_p."""
-
-    length: float
-    diameter: float
-    youngs_modulus: float
-    density: float
-
-    def __post_init__(self):
-        for name in ("length", "diameter", "youngs_modulus", "density"):
-            v = getattr(self, name)
-            if not (isinstance(v, (int, float)) and math.isfinite(v) and v > 0):
-                raise InputError(f"rod.{name}", f"must be a positive finite number; got {v!r}")
-
-    @property
-    def area(self) -> float:
-        return math.pi * self.diameter**2 / 4
-
-    @property
-    def c0(self) -> float:
-        return math.sqrt(self.youngs_modulus / self.density)
-
-    @property
-    def mass(self) -> float:
-        return self.density * self.area * self.length
-
-    @property
-    def round_trip(self) -> float:
-        """2 L / c_0 [s]."""
-        return 2 * self.length / self.c0
 
 
 @dataclass
@@ -101,7 +68,7 @@ class RodHistory:
         return self.energy - self.rigid_kinetic
 
 
-def simulate_rod(rod: RodProblem, force: Callable[[np.ndarray], np.ndarray], t_end: float, n_elements: int = 400,
+def simulate_rod(rod: Rod, force: Callable[[np.ndarray], np.ndarray], t_end: float, n_elements: int = 400,
                  degree: int = 1, courant: float = 2**-0.5, snapshot_times=()) -> RodHistory:
     """Integrate the rod of Part I, eq. (24) under the end force N(t) >= 0 (compressive) from rest
     at t = 0 to ``t_end`` (the paper's problem is N = sigma_0 pi d^2/4 constant).
@@ -177,17 +144,11 @@ def simulate_rod(rod: RodProblem, force: Callable[[np.ndarray], np.ndarray], t_e
 # ------------------------------------------------------------------------------------
 # comparisons with the series solution (Part I, eqs. (24)-(29)) and the command `rod`
 
-DEFAULT_ROD = RodProblem(71.1e-3, 7.11e-3, 210e9, 7830.0)  # Fig. 5 ogival projectile (errata 2d)
+DEFAULT_ROD = Rod(71.1e-3, 7.11e-3, 210e9, 7830.0)  # Fig. 5 ogival projectile (errata 2d)
 DEFAULT_SIGMA0 = 1.0e9
 
 
-def _series_module():
-    from semianalytic.penetration import rod as series
-
-    return series
-
-
-def step_load_study(rod: RodProblem, sigma0: float, round_trips: float = 10.5, n_elements: int = 400,
+def step_load_study(rod: Rod, sigma0: float, round_trips: float = 10.5, n_elements: int = 400,
                     courant: float = 2**-0.5) -> dict:
     """FEM against the series (24) for a suddenly applied end stress sigma0 (Part I, eqs. (24)-(29)).
 
@@ -196,28 +157,27 @@ def step_load_study(rod: RodProblem, sigma0: float, round_trips: float = 10.5, n
     time relative to sigma0 c0 / E_p; the strain (27) in RMS over x at t = L/c0 (2i - 1), where
     (27) gives -sigma0/E_p everywhere; the vibrational energy against the exact solution's.
     """
-    series = _series_module()
-    R = series.Rod(rod.length, rod.diameter, rod.youngs_modulus, rod.density)
-    T = round_trips * rod.round_trip
+
+    T = round_trips * rod.period
     t_snap = [(2 * i - 1) * rod.length / rod.c0 for i in range(1, int(round_trips) + 1)]
     hist = simulate_rod(rod, lambda t: sigma0 * rod.area * np.ones_like(t), T, n_elements, courant=courant,
                         snapshot_times=t_snap)
-    w = series.end_displacement(R, sigma0, hist.t)
-    v = series.end_velocity(R, sigma0, hist.t)
+    w = series.end_displacement(rod, sigma0, hist.t)
+    v = series.end_velocity(rod, sigma0, hist.t)
     E = rod.youngs_modulus
     amp = sigma0 * rod.length / (2 * E)
     err_w = np.abs(hist.u_end - w)
     snaps = []
     for ts, eps in zip(hist.snapshot_times, hist.strain_snapshots):
-        ex = series.strain(R, sigma0, hist.x_mid, ts)
+        ex = series.strain(rod, sigma0, hist.x_mid, ts)
         snaps.append({"t_s": float(ts), "rms_rel": float(np.sqrt(np.mean((eps - ex) ** 2)) / (sigma0 / E)),
                       "paper_value": -sigma0 / E, "fem_mean": float(np.mean(eps))})
-    vib_exact = series.vibrational_energy(R, sigma0, hist.t)
-    W2 = series.paper_W2(R, sigma0, hist.t)
-    vmax = series.max_vibrational_energy(R, sigma0)
+    vib_exact = series.vibrational_energy(rod, sigma0, hist.t)
+    W2 = series.paper_W2(rod, sigma0, hist.t)
+    vmax = series.max_vibrational_energy(rod, sigma0)
     return {
         "rod": {"length_m": rod.length, "diameter_m": rod.diameter, "youngs_modulus_Pa": E, "density_kg_m3": rod.density,
-                "c0_m_s": rod.c0, "round_trip_s": rod.round_trip},
+                "c0_m_s": rod.c0, "round_trip_s": rod.period},
         "sigma0_Pa": sigma0, "round_trips": round_trips, "t_end_s": float(T), "n_elements": n_elements,
         "n_dofs": hist.n_dofs, "n_steps": len(hist.t) - 1, "courant": courant, "seconds": hist.seconds,
         "max_rel_error": float(err_w.max() / np.abs(w).max()),
@@ -237,7 +197,7 @@ def step_load_study(rod: RodProblem, sigma0: float, round_trips: float = 10.5, n
     }
 
 
-def driven_study(case, rod: RodProblem, n_elements: int = 400, courant: float = 2**-0.5) -> dict:
+def driven_study(case, rod: Rod, n_elements: int = 400, courant: float = 2**-0.5) -> dict:
     """The rod driven by the braking force N(t) of the Part I dynamics (eq. (11)) of ``case``.
 
     N(t) = -m du/dt from :func:`semianalytic.penetration.motion.solve_motion` with the case's
@@ -258,8 +218,7 @@ def driven_study(case, rod: RodProblem, n_elements: int = 400, courant: float = 
     t_m, N_m = motion.t, motion.force
     T = motion.penetration_time
     hist = simulate_rod(rod, lambda t: np.interp(t, t_m, N_m), T, n_elements, courant=courant)
-    series = _series_module()
-    R = series.Rod(rod.length, rod.diameter, rod.youngs_modulus, rod.density)
+
     sigma0 = 4 * hist.force / (math.pi * rod.diameter**2)
     W2 = math.pi * rod.diameter**2 * sigma0**2 * rod.c0 * hist.t / (8 * rod.youngs_modulus)
     return {
@@ -268,7 +227,7 @@ def driven_study(case, rod: RodProblem, n_elements: int = 400, courant: float = 
         "vibrational_energy_J": float(hist.vibrational[-1]), "max_vibrational_energy_J": float(hist.vibrational.max()),
         "mean_vibrational_energy_J": float(np.mean(hist.vibrational)),
         "paper_W2_J": float(W2[-1]), "initial_kinetic_energy_J": 0.5 * proj.mass * U0**2,
-        "bound_pi_d2_sigma0max2_L_over_8E_J": float(series.max_vibrational_energy(R, float(sigma0.max()))),
+        "bound_pi_d2_sigma0max2_L_over_8E_J": float(series.max_vibrational_energy(rod, float(sigma0.max()))),
         "energy_balance_max_abs_J": float(np.abs(hist.energy - hist.work).max()),
         "_history": hist, "_W2": W2,
     }
@@ -291,7 +250,7 @@ def _coefficients_for(nose):
             f"paper's constants (Abar = {Ab * 1e3} mm, Bbar = {Bb}, Cbar = {Cb}; BEM table not available)"
 
 
-def rod_from_case(case) -> tuple[RodProblem, float | None]:
+def rod_from_case(case) -> tuple[Rod, float | None]:
     """The cylinder of Part I, section 2 for a case's projectile (length L, diameter d, E_p, rho_p)
     and its yield stress (or None)."""
     from semianalytic.geometry import projectile_from_section
@@ -302,7 +261,7 @@ def rod_from_case(case) -> tuple[RodProblem, float | None]:
         raise InputError("projectile.youngs_modulus", "the rod problem needs E_p (e.g. '210 GPa')")
     if sec.density is None:
         raise InputError("projectile.density", "the rod problem needs rho_p (e.g. '7830 kg/m^3')")
-    return RodProblem(proj.length, proj.diameter, sec.youngs_modulus, sec.density), sec.yield_stress
+    return Rod(proj.length, proj.diameter, sec.youngs_modulus, sec.density), sec.yield_stress
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
