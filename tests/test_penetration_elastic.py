@@ -100,3 +100,36 @@ def test_no_penetration_below_the_elastic_jump():
     c = penetration_curve(setup, [5.0, 20.0])
     assert np.all(c["start_velocity_m_s"] == 0.0) and np.all(c["depth_quasi_rigid_m"] == 0.0)
     assert np.all(c["depth_elastic_m"] == 0.0) and np.all(c["depth_rigid_m"] > 0)
+
+
+class _UniformPressure:
+    """Constant coefficients with a flat contact-pressure profile p_c = R_t over the submerged length."""
+
+    def __init__(self):
+        self.diameter = COEF.diameter
+
+    def A(self, P):
+        return COEF.A(P)
+
+    def B(self, P):
+        return COEF.B(P)
+
+    def C(self, P):
+        return COEF.C(P)
+
+    def pressure_profile(self, P, rho, u, du_dt, R_t, reading=None):
+        x = np.linspace(0.0, P, 41)
+        return x, np.full_like(x, R_t)
+
+
+def test_W1_from_a_pressure_profile_reduces_to_the_static_form():
+    # with p_c = R_t everywhere, eq. (28) is e(R_t) min(P, L): the "static" closed form
+    P = np.array([0.01, 0.05, 0.0711, 0.2])
+    for p in P:
+        x, pc = _UniformPressure().pressure_profile(p, RHO, 0, 0, RT)
+        ref = el.lateral_energy("static", p, sigma0=0.0, resistance_pa=RT, rod=ROD, poisson_ratio=0.29)
+        assert el.lateral_energy_from_profile(x, pc, p, ROD, 0.29) == pytest.approx(ref, rel=1e-12)
+    a = el.solve_elastic(_UniformPressure(), M, RHO, RT, 1000.0, ROD, w2="paper", w1="pressure")
+    b = el.solve_elastic(COEF, M, RHO, RT, 1000.0, ROD, w2="paper", w1="static")
+    # W1 sampled at 201 times and interpolated linearly (kink at P = L): 1e-6
+    assert a.final_depth == pytest.approx(b.final_depth, rel=1e-6)

@@ -7,8 +7,9 @@ corrected penetration (eqs. (26), (28)-(30')).
   u = U_0 (solved together with (26): a quadratic in U_0).
 * W1 (28), the energy of lateral compression, e(p_l) = pi d^2 (1 - nu_p) p_l^2 / (4 E_p) per
   unit length over the submerged length min(P, L): "neglect" (the paper's calculations),
-  "bound" (p_l = sigma_0, the paper's upper estimate) or "static" (p_l = R_t, the static part
-  of eq. (9), which is what remains on the shank).
+  "bound" (p_l = sigma_0, the paper's upper estimate), "static" (p_l = R_t, the static part
+  of eq. (9), which is what remains on the shank) or "pressure" (p_l = p_c of eq. (9) at the
+  surface nodes of a BEM table with ``pressure_profile``; time domain only).
 * W2: "paper", eq. (29), W2 = pi d^2 sigma_0^2 c_0 t / (8 E_p) (grows with t), or
   "exact-rod", the vibration energy of the exact rod solution (24) (bounded; errata item 5).
 * Corrected velocity (30)/(30'): u = sqrt(ubar^2 - 2 (W1 + W2)/m), until t* where
@@ -34,10 +35,12 @@ from semianalytic.penetration.motion import MotionResult, deep_coefficients, sol
 __all__ = [
     "W2_MODELS",
     "W1_MODELS",
+    "W1_TIME_DOMAIN",
     "axial_stress",
     "start_force_coefficients",
     "quasi_rigid_start",
     "lateral_energy",
+    "lateral_energy_from_profile",
     "oscillation_energy",
     "corrected_velocity",
     "ElasticResult",
@@ -45,7 +48,8 @@ __all__ = [
 ]
 
 W2_MODELS = ("paper", "exact-rod")
-W1_MODELS = ("neglect", "bound", "static")
+W1_MODELS = ("neglect", "bound", "static")  # closed forms in P (also in the vectorised curve)
+W1_TIME_DOMAIN = W1_MODELS + ("pressure",)  # + eq. (9)'s pressure from the BEM table
 
 
 def axial_stress(N, diameter: float):
@@ -86,6 +90,28 @@ def lateral_energy(kind: str, P, *, sigma0, resistance_pa: float, rod: rodmod.Ro
         raise ValueError(f"W1 model must be one of {W1_MODELS}; got {kind!r}")
     e = math.pi * rod.diameter**2 * (1.0 - poisson_ratio) / (4.0 * rod.youngs_modulus) * np.square(p_l)
     return (e * np.minimum(P, rod.length))[()]
+
+
+def lateral_energy_from_profile(x, p_c, P: float, rod: rodmod.Rod, poisson_ratio: float) -> float:
+    """W1 of Part I, eq. (28) from a contact-pressure profile (p_l = p_c, sin(alpha) = 1) [J].
+
+    ``x``, ``p_c``: target-frame abscissae (tip at x = max(x)) and pressures of the surface
+    nodes of a tabulated depth; the integral runs over the distance s behind the tip from 0 to
+    min(P, L), the last pressure continued where P exceeds the tabulated depth.
+    """
+    x, p_c = np.asarray(x, float), np.asarray(p_c, float)
+    s = x.max() - x
+    order = np.argsort(s)
+    s, q = s[order], p_c[order] ** 2
+    end = min(P, rod.length)
+    inside = s <= end
+    s_in, q_in = s[inside], q[inside]
+    total = float(np.sum(0.5 * (q_in[1:] + q_in[:-1]) * np.diff(s_in))) if len(s_in) > 1 else 0.0
+    if len(s_in) and end > s_in[-1]:
+        q_end = np.interp(end, s, q) if end < s[-1] else q[-1]
+        total += 0.5 * (q_in[-1] + q_end) * (end - s_in[-1])
+    e = math.pi * rod.diameter**2 * (1.0 - poisson_ratio) / (4.0 * rod.youngs_modulus)
+    return e * total
 
 
 def oscillation_energy(kind: str, rod: rodmod.Rod, sigma0, t):
@@ -187,25 +213,49 @@ def solve_elastic(
     w2: str = "paper",
     w1: str = "neglect",
     rtol: float = 1e-10,
+    quasi_rigid: MotionResult | None = None,
 ) -> ElasticResult:
     """The elastic projectile of Part I, eqs. (26), (28)-(30'), in the time domain.
 
     ``rod`` carries L, d, E_p, rho_p of the projectile (as the cylinder of eq. (24)).
+    ``quasi_rigid``: a solution of eq. (11) from the start velocity U_0 of eq. (26) to reuse
+    (e.g. from an earlier call's ``.quasi_rigid``); it must start at that U_0.
     """
     if w2 not in W2_MODELS:
         raise ValueError(f"w2 must be one of {W2_MODELS}; got {w2!r}")
-    if w1 not in W1_MODELS:
-        raise ValueError(f"w1 must be one of {W1_MODELS}; got {w1!r}")
+    if w1 not in W1_TIME_DOMAIN:
+        raise ValueError(f"w1 must be one of {W1_TIME_DOMAIN}; got {w1!r}")
+    if w1 == "pressure" and not hasattr(coefficients, "pressure_profile"):
+        raise ValueError("w1 = 'pressure' needs coefficients with a pressure_profile (the BEM table)")
     alpha, beta = start_force_coefficients(coefficients, mass, target_density, resistance_pa)
     U0, sigma0 = quasi_rigid_start(U_s, rod.c0, rod.youngs_modulus, alpha, beta)
     U0, sigma0 = float(U0), float(sigma0)
-    qr = solve_motion(coefficients, mass, target_density, resistance_pa, U0, rtol=rtol)
+    if quasi_rigid is not None:
+        if not math.isclose(quasi_rigid.U0, U0, rel_tol=1e-12, abs_tol=1e-12):
+            raise ValueError(f"quasi_rigid starts at {quasi_rigid.U0!r} m/s, eq. (26) gives U_0 = {U0!r} m/s")
+        qr = quasi_rigid
+    else:
+        qr = solve_motion(coefficients, mass, target_density, resistance_pa, U0, rtol=rtol)
+
+    if w1 == "pressure":  # eq. (28) with eq. (9)'s pressure, sampled in time and interpolated
+        ts = np.linspace(0.0, qr.penetration_time, 201)
+        Ps, us = qr.at(ts)
+        A, B, C = (np.asarray(f(Ps), float) for f in (coefficients.A, coefficients.B, coefficients.C))
+        dus = -(0.5 * target_density * B * us**2 + C * resistance_pa) / (mass + target_density * A)
+        W1s = np.array([
+            lateral_energy_from_profile(*coefficients.pressure_profile(P, target_density, u, du, resistance_pa), P, rod, poisson_ratio)
+            for P, u, du in zip(Ps, us, dus)
+        ])
+
+        def W1(t, P):
+            return np.interp(t, ts, W1s)
+    else:
+        def W1(t, P):
+            return lateral_energy(w1, P, sigma0=sigma0, resistance_pa=resistance_pa, rod=rod, poisson_ratio=poisson_ratio)
 
     def energy(t):
         P, _ = qr.at(t)
-        return oscillation_energy(w2, rod, sigma0, t) + lateral_energy(
-            w1, P, sigma0=sigma0, resistance_pa=resistance_pa, rod=rod, poisson_ratio=poisson_ratio
-        )
+        return oscillation_energy(w2, rod, sigma0, t) + W1(t, P)
 
     def g(t):  # m ubar^2 - 2 W
         _, ub = qr.at(t)

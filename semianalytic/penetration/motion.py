@@ -220,7 +220,7 @@ def solve_motion(
     cA, cB, cC = coefficients.A, coefficients.B, coefficients.C
 
     def rhs(t, y):
-        P, u = y
+        P, u = max(y[0], 0.0), y[1]  # RK stages may step a hair below the surface at t = 0
         A, B, C = float(cA(P)), float(cB(P)), float(cC(P))
         return (u, -(0.5 * rho * B * u * u + C * R) / (m + rho * A))
 

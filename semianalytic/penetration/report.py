@@ -397,9 +397,17 @@ def _histories_section(doc, ctx, w):
                    Series(tt * US, rodmod.vibrational_energy(setup.rod, ep.sigma0, tt), "W2, exact rod (24) (errata 5)", "--"),
                    Series(tt * US, 0.5 * setup.mass * qr.at(tt)[1] ** 2, "kinetic energy m ubar^2/2 (quasi-rigid)", ":")]
             w_case = case
+    w1_rows = []
+    for case in hcases:
+        w1_rows += _w1_rows(ctx, case)
     doc.table(["nose", "U_s [m/s]", "target", "rigid P [mm]", "rigid t [us]", "quasi-rigid P [mm]", "elastic (29) P [mm]",
                "t* [us]", "elastic exact-rod P [mm]", "t* [us]", "sigma_0 [MPa]", "max N [kN]"], rows,
               caption="Final depths and times; t* is the stop of eq. (30).")
+    doc.table(["nose", "W1 of eq. (28)", "paper's W2: P [mm]", "W1(t*) [J]", "W2(t*) [J]",
+               "exact-rod W2: P [mm]", "W1(t*) [J]", "W2(t*) [J]"], w1_rows,
+              caption="The lateral-compression energy W1 (eq. (28)): neglected (the paper), the paper's bound p_l = sigma_0, "
+                      "the static pressure p_l = R_t, and the contact pressure of eq. (9) from the BEM table. With the "
+                      "exact-rod W2, W1 is not small against W2 (errata item 5(b): W1,max/W2,max = 2 (1 - nu_p)).")
     doc.image(w.figure("fig9_velocity_time", line_figure(s_ut, "time t [us]", "u [m/s]", "u(t) (cf. Figs. 9, 11)")),
               "Penetration velocity against time: rigid (1), quasi-rigid (2), elastic (3) projectile (Fig. 9), both noses.")
     doc.image(w.figure("fig10_depth_time", line_figure(s_Pt, "time t [us]", "P [mm]", "P(t) (cf. Fig. 10)")),
@@ -416,6 +424,35 @@ def _histories_section(doc, ctx, w):
               "eq. (29), W2 = N w(L, t)/2, is not the rod's vibration energy, which is N w_el(L, t) = N (sigma_0/E_p)"
               "(c_0 t - c_0^2 t^2/(2L)): twice eq. (29) as t -> 0, equal at t = L/c_0, zero at 2L/c_0. The elastic "
               "projectile of eq. (30') stops where the quasi-rigid kinetic energy m ubar^2/2 falls to W1 + W2.")
+
+
+def _w1_rows(ctx, case):
+    """Depth and energies at the stop for each W1 option (eq. (28)) and both W2 forms."""
+    from semianalytic.penetration.elastic import W1_TIME_DOMAIN, solve_elastic
+
+    setup = ctx.setup(case)
+    coef = ctx.coefficients(case)[0]
+    U = float(case.impact.striking_velocities[0])
+    nu = setup.poisson_ratio if setup.poisson_ratio is not None else 0.29
+    args = (coef, setup.mass, setup.target_density, setup.resistance_pa, U, setup.rod)
+    rows, qr = [], None
+    for w1 in W1_TIME_DOMAIN:
+        if w1 == "pressure" and not hasattr(coef, "pressure_profile"):
+            continue
+        cells = [case.projectile.nose, w1]
+        for w2 in ("paper", "exact-rod"):
+            r = solve_elastic(*args, poisson_ratio=nu, w2=w2, w1=w1, quasi_rigid=qr)
+            qr = r.quasi_rigid
+            W2 = float(_w2_only(r, setup, w2))
+            cells += [f"{r.final_depth * MM:.1f}", f"{float(r.energy(r.t_star)) - W2:.1f}", f"{W2:.1f}"]
+        rows.append(cells)
+    return rows
+
+
+def _w2_only(res, setup, w2):
+    from semianalytic.penetration.elastic import oscillation_energy
+
+    return oscillation_energy(w2, setup.rod, res.sigma0, res.t_star)
 
 
 def _curves_section(doc, ctx, w):
