@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import shlex
-import sys
 import time
 from collections import OrderedDict
 from pathlib import Path
@@ -456,7 +455,7 @@ def _w2_only(res, setup, w2):
 
 
 def _curves_section(doc, ctx, w):
-    from semianalytic.report.figures import Points, Series, line_figure
+    from semianalytic.report.figures import Series, line_figure
 
     ccases = ctx.curve_cases()
     if not ccases:
