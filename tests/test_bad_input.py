@@ -1,6 +1,8 @@
 """Bad-input corpus: every file in tests/bad_cases/ must be rejected by ``run`` with exit
 status 2, one line ``error: <field>: ...`` naming the field given in the file's
-``# expect:`` header, and nothing written (neither the output folder nor a staging folder).
+``# expect:`` header (and, where that field is a whole section, the key named by the
+``# expect-text:`` header in the message), and nothing written (neither the output folder
+nor a staging folder).
 
 The expected field is written by hand in each file (independent of the code under test).
 """
@@ -25,6 +27,14 @@ def _expected(path: Path) -> str:
     raise AssertionError(f"{path.name} has no '# expect:' header")
 
 
+def _expected_text(path: Path) -> str | None:
+    """Where the field is a whole section (a model-level check), the key the message must name."""
+    for line in path.read_text().splitlines():
+        if line.startswith("# expect-text:"):
+            return line.split(":", 1)[1].strip()
+    return None
+
+
 def test_corpus_is_large_enough():
     assert len(CORPUS) >= 30
 
@@ -37,6 +47,9 @@ def test_bad_case_rejected(path, tmp_path, capsys):
     assert rc == 2, err
     assert "\n" not in err, err  # one line
     assert err.startswith(f"error: {_expected(path)}"), err
+    text = _expected_text(path)
+    if text is not None:
+        assert text in err, err
     assert not out.exists()
     assert list(tmp_path.iterdir()) == []  # no staging folder left behind
 

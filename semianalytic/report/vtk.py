@@ -340,7 +340,9 @@ def fem_meridian_mesh(solution, u: float, reference=None, exclude_tags=("body", 
 
     basis = solution.basis
     vert = basis.nodal_dofs[0]
-    pts2 = basis.doflocs[:, vert].T
+    # fem_check may solve in x - shift (tip-centred); the file is in the target frame
+    shift = float(getattr(solution, "shift", 0.0))
+    pts2 = basis.doflocs[:, vert].T + np.array([shift, 0.0])
     tri = solution.dm.mesh.t[:3].T
     ip = basis.interpolate(solution.phi)
     gx = basis.project(ip.grad[0])[vert]
