@@ -240,7 +240,9 @@ def penetration_curve(
     Keys: striking_velocity_m_s, depth_rigid_m, time_rigid_s, start_velocity_m_s (eq. (26)),
     axial_stress_Pa (sigma_0), depth_quasi_rigid_m, time_quasi_rigid_s, depth_elastic_m and
     stop_time_elastic_s (paper's W2, eq. (29)), depth_elastic_exact_rod_m and
-    stop_time_elastic_exact_rod_s (errata item 5), critical_velocity_m_s (eq. (33)), yields.
+    stop_time_elastic_exact_rod_s (errata item 5), delta_P_elastic_m and
+    delta_P_elastic_exact_rod_m (Delta P = P - Pbar of section 2, against the quasi-rigid
+    depth), critical_velocity_m_s (eq. (33)), yields.
     Without a projectile material (setup.rod None) or with ``elastic=False`` only the rigid
     keys are filled (the rest NaN).  ``rtol`` is accepted for symmetry with
     :func:`~semianalytic.penetration.motion.solve_motion` and not needed: the integration in P
@@ -266,6 +268,8 @@ def penetration_curve(
         "stop_time_elastic_s": nan.copy(),
         "depth_elastic_exact_rod_m": nan.copy(),
         "stop_time_elastic_exact_rod_s": nan.copy(),
+        "delta_P_elastic_m": nan.copy(),
+        "delta_P_elastic_exact_rod_m": nan.copy(),
     }
     U_sC = setup.critical_velocity()
     out["critical_velocity_m_s"] = np.full(U.shape, U_sC)
@@ -286,6 +290,7 @@ def penetration_curve(
         depth, t_star = _elastic(prof, qr, sigma0, setup, w2, w1)
         out[f"depth_{key}_m"] = depth
         out[f"stop_time_{key}_s"] = t_star
+        out[f"delta_P_{key}_m"] = depth - qr.P_f  # Delta P = P - Pbar < 0 (section 2)
     return out
 
 

@@ -598,7 +598,8 @@ def _interpretation(ctx) -> str:
             " That support comes through an oscillation energy that the paper's own rod solution (24) does not "
             "have: the exact energy is bounded by pi d^2 sigma_0^2 L/(8 E_p) and leaves the quasi-rigid depth almost "
             "unchanged, so the paper's agreement is a calibration effect of eq. (29), not evidence for the "
-            "mechanism. The physically consistent Part I prediction (quasi-rigid start plus the exact-rod energy) "
+            "mechanism (the independent FEM rod check, reports/fem_rod.md, also finds the bounded energy). "
+            "The physically consistent Part I prediction (quasi-rigid start plus the exact-rod energy) "
             f"overpredicts these depths by {s['elastic_exact_rod'] * 100:+.0f} % on average."
         )
     if "forrestal" in first:
