@@ -95,3 +95,68 @@ def _bl_run(ctx: Context) -> None:
 
 register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.ballistic_limit.cli",),
               _has("ballistic_limit"), _bl_preflight, _bl_run))
+
+
+# --------------------------------------------------------------------------------------
+# Part III: theoretical strength of diamond-like crystals and nanoparticles
+
+
+def _nano_preflight(case: Case, run: RunSection) -> None:
+    section = case.require("nanostrength")
+    section.crystals()
+    section.studies()
+
+
+def _nano_run(ctx: Context) -> None:
+    from semianalytic.nanostrength.cli import compute
+    from semianalytic.nanostrength.report import build_report
+
+    section = ctx.case.require("nanostrength")
+    a = compute(section)
+    o = a.options
+    doc = ctx.doc
+    doc.heading("Theoretical strength of diamond-like crystals and nanoparticles (Part III)")
+    doc.para(f"Interplanar law `{o['law']}` calibrated to Tables 1-2, stress measure `{o['stress_measure']}`, "
+             f"odd-plate surface ratio {o['odd_surface_ratio']:g} (errata item 21: the paper's pseudo-potential is "
+             "not given, so the bulk law is calibrated; see reports/part3_nanostrength.md for the full discussion).")
+    doc.table(
+        ["crystal", "sigma1 [GPa] (Table 2)", "-e* (Table 2)", "E [GPa] (Table 2)", "sigma2 [GPa] (Table 2)",
+         "e** (Table 2)"],
+        [[name, f"{fmt(r.bulk.sigma_c / 1e9)} ({fmt(r.crystal.sigma_c / 1e9)})", f"{fmt(r.bulk.e_c)} ({fmt(r.crystal.e_c)})",
+          f"{fmt(r.law.youngs_modulus / 1e9)} ({fmt(r.crystal.E / 1e9)})",
+          f"{fmt(r.bulk.sigma_t / 1e9)} ({fmt(r.crystal.sigma_t / 1e9)})", f"{fmt(r.bulk.e_t)} ({fmt(r.crystal.e_t)})"]
+         for name, r in a.crystals.items()],
+        caption="Bulk strength from eq. (14) on the calibrated law, with Table 2 in brackets.",
+    )
+    key = f"{o['surface_energy']}/{o['deformation_energy'] if o['surface_energy'] == 'eq16' else 'law'}"
+    rows = []
+    for name, r in a.crystals.items():
+        ft, fc = r.fracture.get(f"{key}/tension"), r.fracture.get(f"{key}/compression")
+        if ft is not None and fc is not None:
+            rows.append([name, fmt(ft.Y1c), fmt(fc.Y1c), fmt(ft.K1c / 1e6), fmt(fc.K1c / 1e6)])
+    if rows:
+        doc.table(["crystal", "Y_1c I [N/m]", "Y_1c II [N/m]", "K_1c I [MPa m^1/2]", "K_1c II [MPa m^1/2]"], rows,
+                  caption=f"Fracture quantities (Table 3; eqs. (15)-(16), {key}); I tension, II compression.")
+    for s in a.studies:
+        shown = s.rows[:40]
+        cmp_ = s.spec.compare is not None
+        doc.table(
+            ["crystal", "basis", "l", "m = n", "i", "Phi_i/Phi_0", "sigma1 [GPa]", "sigma2 [GPa]"]
+            + (["printed sigma1 / sigma2 [GPa]", "difference"] if cmp_ else []),
+            [[r.material, r.geometry.basis, "inf" if r.geometry.l is None else str(r.geometry.l),
+              "inf" if r.geometry.m is None else str(r.geometry.m), "-" if r.geometry.i is None else str(r.geometry.i),
+              f"{r.factor:.6f}", fmt(r.strength.sigma_c / 1e9), fmt(r.strength.sigma_t / 1e9)]
+             + ([f"{r.printed[0]:g} / {r.printed[1]:g}",
+                 "{:+.2%} / {:+.2%}".format(*r.differences())] if cmp_ and r.printed is not None else
+                (["-", "-"] if cmp_ else []))
+             for r in shown],
+            caption=f"Study `{s.spec.name}`: {s.spec.title}" + (f" (first 40 of {len(s.rows)} rows)" if len(s.rows) > 40 else ""),
+        )
+    _, figs = build_report(a, case_path=str(ctx.case.path), stem="part3", elapsed=0.0, command="run")
+    for name, blob in figs.items():
+        ctx.png(name.removesuffix(".png"), blob, f"Part III: `{name}` (see reports/part3_nanostrength.md for its discussion).")
+    ctx.results["nanostrength"] = a.to_json()
+
+
+register(Step("nanostrength", "Theoretical strength", ("nanostrength",), ("semianalytic.nanostrength.cli",),
+              _has("nanostrength"), _nano_preflight, _nano_run))
