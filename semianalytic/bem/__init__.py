@@ -16,13 +16,13 @@ from semianalytic.geometry import Meridian, Nose
 __all__ = ["solve_body", "solve_halfspace", "SurfaceSolution", "LayoutOptions"]
 
 
-def solve_body(meridian: Meridian, order: int = 8, refinement: float = 1.0, levels: int = 8) -> SurfaceSolution:
+def solve_body(meridian: Meridian, order: int = 8, refinement: float = 1.0, levels: int = 12) -> SurfaceSolution:
     """phi on a closed body moving with unit speed along +x in unbounded fluid."""
     ps = body_panels(meridian, LayoutOptions(order, refinement, levels))
     return solve_panels(ps, "body", volume=meridian.volume())
 
 
-def solve_halfspace(nose: Nose, depth: float, order: int = 8, refinement: float = 1.0, levels: int = 8) -> SurfaceSolution:
+def solve_halfspace(nose: Nose, depth: float, order: int = 8, refinement: float = 1.0, levels: int = 12) -> SurfaceSolution:
     """phi on a nose at depth P in the target x >= 0 (tip at x = P), free surface x = 0."""
     layout = halfspace_layout(nose, depth, LayoutOptions(order, refinement, levels))
     return solve_panels(layout.panels(), "halfspace", depth=depth)

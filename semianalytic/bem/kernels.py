@@ -71,26 +71,30 @@ def ellip_ke(q):
 _TWO_OVER_PI = 2.0 / math.pi
 
 
-def _geometry(x, r, x1, r1):
-    dx = x - x1
-    d2 = dx * dx + (r - r1) ** 2
+def _geometry(x, r, x1, r1, delta=None):
+    """(x - x1, r - r1, d^2, D); ``delta`` gives the two differences directly when they
+    are known more accurately than by subtracting coordinates (points on one panel)."""
+    dx, dr = (x - x1, r - r1) if delta is None else delta
+    d2 = dx * dx + dr * dr
     D = dx * dx + (r + r1) ** 2
-    return dx, d2, D
+    return dx, dr, d2, D
 
 
-def single_double(x, r, x1, r1, nx1, nr1):
+def single_double(x, r, x1, r1, nx1, nr1, delta=None):
     """Single-layer and double-layer ring kernels.
 
     S = integral over the ring of G r1 dtheta = r1 K(m) / (pi sqrt(D)),
     Dl = integral of dG/dn1 r1 dtheta with n1 = (nx1, nr1) the normal at the source
        = [E(m) (r1 (x - y).n1 + nr1 d^2/2) / d^2 - nr1 K(m)/2] / (pi sqrt(D)).
-    The second form has no 1/r factor, so targets on the axis are fine.
+    The second form has no 1/r factor, so targets on the axis are fine.  Near the source
+    (x - y).n1 is of order d^2: with coordinates of size P it must come from accurate
+    differences (``delta``), or the double layer loses digits.
     """
-    dx, d2, D = _geometry(x, r, x1, r1)
+    dx, dr, d2, D = _geometry(x, r, x1, r1, delta)
     m1 = d2 / D
     K, E = ellip_ke(m1)
     inv = 1.0 / (math.pi * np.sqrt(D))
-    bracket = r1 * (dx * nx1 + (r - r1) * nr1) + 0.5 * nr1 * d2
+    bracket = r1 * (dx * nx1 + dr * nr1) + 0.5 * nr1 * d2
     S = r1 * K * inv
     Dl = (E * bracket / d2 - 0.5 * nr1 * K) * inv
     return S, Dl
@@ -102,15 +106,15 @@ _K_SERIES = (math.pi / 2) * _C2  # K(q) = (pi/2) sum c_n^2 q^n
 _KME_Q_SERIES = (math.pi / 2) * _C2 * np.array([2 * n / (2 * n - 1) for n in range(SPLIT_TERMS)])  # K - E
 
 
-def single_double_split(x, r, x1, r1, nx1, nr1):
+def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2."""
-    dx, d2, D = _geometry(x, r, x1, r1)
+    dx, dr, d2, D = _geometry(x, r, x1, r1, delta)
     m1 = d2 / D
     K, E = ellip_ke(m1)
     Kc = _polevl(m1, _K_SERIES[::-1])  # K(1 - m), truncated
     KcmEc = _polevl(m1, _KME_Q_SERIES[::-1])  # K(1 - m) - E(1 - m), truncated
     inv = 1.0 / (math.pi * np.sqrt(D))
-    bracket_over_d2 = (r1 * (dx * nx1 + (r - r1) * nr1) + 0.5 * nr1 * d2) / d2
+    bracket_over_d2 = (r1 * (dx * nx1 + dr * nr1) + 0.5 * nr1 * d2) / d2
     S = r1 * K * inv
     Dl = (E * bracket_over_d2 - 0.5 * nr1 * K) * inv
     QS = r1 * _TWO_OVER_PI * Kc * inv
@@ -151,7 +155,7 @@ def gradient_kernels(x, r, x1, r1):
       density is an azimuthal vortex sheet of strength dphi/ds (Stokes' theorem on the
       closed surface), so that only 1/R^2 kernels appear.
     """
-    dx, d2, D = _geometry(x, r, x1, r1)
+    dx, _, d2, D = _geometry(x, r, x1, r1)
     m1 = d2 / D
     m = 4.0 * r * r1 / D
     K, E = ellip_ke(m1)

@@ -28,7 +28,8 @@ from scipy.optimize import brentq
 from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc
 
-GRADING_RATIO = 0.2  # size ratio between successive graded panels (hp-type grading)
+GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
+JUNCTION_LEVELS = 2  # grading at a curvature jump between tangent segments (nose-shank)
 
 
 @dataclass(frozen=True)
@@ -94,6 +95,26 @@ class PanelSet:
             ddx, ddr = seg.second_derivative(base + dt)
             out += [sg * ddx * half * half, ddr * half * half]
         return tuple(out)
+
+    def relative(self, panel: np.ndarray, u_from: np.ndarray, u_to: np.ndarray):
+        """point(u_to) - point(u_from) on the same panel, free of cancellation: the
+        segment's displacement over the parameter difference (needed where the two points
+        are far closer to each other than to the origin)."""
+        panel, u_from, u_to = np.broadcast_arrays(np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float))
+        dx = np.empty(u_from.shape)
+        dr = np.empty(u_from.shape)
+        seg_of = self.segment_index[panel]
+        for s, seg in enumerate(self.segments):
+            mask = seg_of == s
+            if not mask.any():
+                continue
+            pk = panel[mask]
+            half = 0.5 * (self.db[pk] - self.da[pk])
+            t_from = self.base[pk] + self.da[pk] + half * (u_from[mask] + 1.0)
+            ex, er = seg.displacement(t_from, half * (u_to[mask] - u_from[mask]))
+            dx[mask] = self.sign[pk] * ex
+            dr[mask] = er
+        return dx, dr
 
     @cached_property
     def nodes(self) -> "NodeGeometry":
@@ -265,11 +286,21 @@ def _point(seg: Segment, t: float) -> tuple[float, float]:
 @dataclass(frozen=True)
 class LayoutOptions:
     """Resolution of a layout: ``order`` Gauss points per panel; ``refinement`` scales
-    panel counts; ``levels`` graded panels towards singular points."""
+    panel counts; ``levels`` graded panels towards singular points (each GRADING_RATIO
+    times the next: 12 levels reach 3e-6 of the ungraded panel size)."""
 
     order: int = 8
     refinement: float = 1.0
-    levels: int = 8
+    levels: int = 12
+
+    def __post_init__(self):
+        if not 2 <= self.order <= 16:
+            raise ValueError("order must lie between 2 and 16")
+        if not 0 < self.refinement <= 16:
+            raise ValueError("refinement must lie in (0, 16]")
+        if not 0 <= self.levels <= 18:
+            # below ~0.35^18 of the panel size the geometry runs out of digits
+            raise ValueError("levels must lie between 0 and 18")
 
 
 def body_panels(meridian: Meridian, options: LayoutOptions = LayoutOptions()) -> PanelSet:
@@ -377,13 +408,13 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         if k == 0:
             g0 = lev if tip_conical else 0
         else:
-            g0 = lev if turning[k - 1] else 2  # 2: curvature jump between tangent segments
+            g0 = lev if turning[k - 1] else JUNCTION_LEVELS  # curvature jump between tangent segments
         if cut_here:
             g1 = lev
         elif k < len(segs) - 1:
-            g1 = lev if turning[k] else 2
+            g1 = lev if turning[k] else JUNCTION_LEVELS
         else:
-            g1 = lev if _shoulder_is_corner(nose) else 2
+            g1 = lev if _shoulder_is_corner(nose) else JUNCTION_LEVELS
         p0 = (0.0, 0.0) if k == 0 else _point(seg, seg.t0)
         if cut_here:
             p1 = (-depth, float(seg.point(t1)[1]))
@@ -405,7 +436,7 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     shoulder, then panels growing by a factor 2 (less with refinement) towards x = 0."""
     R, Lh = nose.radius, nose.length
     length = depth - Lh
-    grade = options.levels if _shoulder_is_corner(nose) else 2
+    grade = options.levels if _shoulder_is_corner(nose) else JUNCTION_LEVELS
     growth = 2.0 ** (1.0 / max(options.refinement, 1.0))
     h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
     edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]

@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass
+from dataclasses import dataclass, replace
 from functools import cached_property
 
 import numpy as np
@@ -159,6 +159,7 @@ class PairQuadrature:
     a: np.ndarray
     b: np.ndarray
     lag: np.ndarray
+    target_u: np.ndarray | None = None  # self rules: the target's own panel coordinate
 
     @staticmethod
     def build(target, panel, order, parts) -> "PairQuadrature":
@@ -186,11 +187,15 @@ class PairQuadrature:
 
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
         pairs when the rule carries logarithms (b != 0)."""
-        x, r, xu, ru = ps.evaluate(self.panel[self.pair], self.u)
+        pan = self.panel[self.pair]
+        x, r, xu, ru = ps.evaluate(pan, self.u)
         J = np.hypot(xu, ru)
         t = self.target[self.pair]
+        delta = None
+        if self.target_u is not None:  # target and source on one panel: exact differences
+            delta = ps.relative(pan, self.u, self.target_u[self.pair])
         out = []
-        for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J):
+        for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J, delta):
             if isinstance(ker, tuple):
                 K, Q = ker
                 wk = (self.a * K + self.b * Q) * J
@@ -247,7 +252,8 @@ def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
         b = np.concatenate([sw * lnu + swl, t["lw"][qs], np.zeros_like(t["fw"][qs])], axis=1)
         parts.append((sel, u, a, b, t["L"][qs]))
     own = np.arange(N) // order
-    return PairQuadrature.build(np.arange(N), own, order, parts)
+    rule = PairQuadrature.build(np.arange(N), own, order, parts)
+    return replace(rule, target_u=uq)
 
 
 # ------------------------------------------------------------------------------------
@@ -296,13 +302,13 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
     return AssemblyPlan(self_quadrature(levels, p), near_quadrature(tgt, pan, ustar, du, p))
 
 
-def _layers(X, R, x, r, nx, nr):
-    return single_double(X, R, x, r, nx, nr)
+def _layers(X, R, x, r, nx, nr, delta=None):
+    return single_double(X, R, x, r, nx, nr, delta)
 
 
-def _layers_split(X, R, x, r, nx, nr):
+def _layers_split(X, R, x, r, nx, nr, delta=None):
     with np.errstate(divide="ignore", invalid="ignore"):
-        S, D, QS, QD = single_double_split(X, R, x, r, nx, nr)
+        S, D, QS, QD = single_double_split(X, R, x, r, nx, nr, delta)
     return (S, QS), (D, QD)
 
 
@@ -503,7 +509,7 @@ class SurfaceSolution:
             rule = near_quadrature(tgt, pan, ustar, du, p)
             cols = pan[:, None] * p + np.arange(p)[None, :]
             if gradient:
-                bSx, bSr, bWx, bWr = rule.integrate(ps, xt, rt, lambda X, R, x, r, nx, nr: gradient_kernels(X, R, x, r))
+                bSx, bSr, bWx, bWr = rule.integrate(ps, xt, rt, lambda X, R, x, r, nx, nr, delta: gradient_kernels(X, R, x, r))
                 gx[tgt[:, None], cols] = bWx * omega[cols] - bSx * g[cols]
                 gr[tgt[:, None], cols] = bWr * omega[cols] - bSr * g[cols]
             else:

@@ -26,10 +26,11 @@ from semianalytic.bem.panels import HalfspaceLayout, LayoutOptions, halfspace_la
 from semianalytic.bem.solve import SurfaceSolution, plan_assembly, solve_panels
 from semianalytic.geometry import Nose
 
-# central-difference weights for the first derivative (step h): order -> offsets, weights
+# central stencils (step h): order -> offsets, weights of the first derivative, and weights
+# interpolating the value at the centre (which therefore needs no solve of its own)
 STENCILS = {
-    2: (np.array([-1, 1]), np.array([-0.5, 0.5])),
-    4: (np.array([-2, -1, 1, 2]), np.array([1 / 12, -2 / 3, 2 / 3, -1 / 12])),
+    2: (np.array([-1, 1]), np.array([-0.5, 0.5]), np.array([0.5, 0.5])),
+    4: (np.array([-2, -1, 1, 2]), np.array([1 / 12, -2 / 3, 2 / 3, -1 / 12]), np.array([-1 / 6, 2 / 3, 2 / 3, -1 / 6])),
 }
 STEP = 1e-4  # relative step of the central difference in P (of the local length scale)
 
@@ -77,17 +78,27 @@ def coefficients_at_depth(
 
     Part I, eq. (12): A = int phi n_x dS, C = int n_x dS,
     B = int (|grad phi|^2 + 2 phi'_P) n_x dS, over the submerged surface (full contact;
-    see :mod:`semianalytic.coefficients.contact` for the region l_P of eq. (15)).
+    the region l_P of eq. (15) is checked from the node data, see
+    :meth:`~semianalytic.coefficients.table.CoefficientTable.contact_intervals`).
+
+    The potential at P itself is interpolated from the stencil (error O(h^2), about 1e-8
+    relative with the default step), so each depth costs two solves.
     """
     if depth == nose.length:
         raise ValueError("the depth P = L_h is where the layout changes topology; use a nearby depth")
     layout = halfspace_layout(nose, depth, options)
     h = step if step is not None else _step(nose, depth)
-    offsets, weights = STENCILS[fd_order]
+    offsets, weights, interp = STENCILS[fd_order]
     panels = layout.panels()
     plan = plan_assembly(panels)  # the same rules at every depth of the stencil
-    center = solve_panels(panels, "halfspace", depth=depth, plan=plan)
     sols = [_solve(layout.at_depth(depth + k * h), plan) for k in offsets]
+    center = SurfaceSolution(
+        panels,
+        sum(c * s.phi_nodes for c, s in zip(interp, sols)),
+        -panels.nodes.tr[: panels.n_primary],
+        "halfspace",
+        depth=depth,
+    )
     return _combine(center, sols, weights, h)
 
 

@@ -241,7 +241,7 @@ class CoefficientTable:
                        meta["limits"], z["unknowns"], nodes, meta["options"])
 
 
-def coefficients_at(nose: Nose, depths, order: int = 8, refinement: float = 1.0, levels: int = 8) -> dict:
+def coefficients_at(nose: Nose, depths, order: int = 8, refinement: float = 1.0, levels: int = 12) -> dict:
     """A, B (three readings), C, phi_tip, dA/dP at the given depths (arrays, SI)."""
     opts = LayoutOptions(order, refinement, levels)
     rows = [coefficients_at_depth(nose, float(P), opts) for P in np.atleast_1d(depths)]
@@ -263,7 +263,7 @@ def coefficient_table(
     *,
     order: int = 8,
     refinement: float = 0.5,
-    levels: int = 6,
+    levels: int = 8,
     n_depths: int = 64,
     max_depth_nose_lengths: float = 300.0,
     depths=None,
