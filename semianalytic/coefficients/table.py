@@ -11,6 +11,7 @@ the tail of the table by a least-squares fit in 1/P.
 
 from __future__ import annotations
 
+import bisect
 import hashlib
 import json
 import math
@@ -89,10 +90,18 @@ class CoefficientTable:
                 continue
             splines[name] = PchipInterpolator(P, np.concatenate([[0.0], vals]), extrapolate=False)
         object.__setattr__(self, "_splines", splines)
+        # scalar fast path (the equation of motion calls A, B, C with one depth at a time)
+        object.__setattr__(self, "_breaks", P.tolist())
+        object.__setattr__(self, "_coef", {k: sp.c.T.tolist() for k, sp in splines.items()})
 
     # --- evaluation -----------------------------------------------------------------
 
     def _eval(self, name: str, P):
+        if isinstance(P, float) and 0.0 <= P <= self._breaks[-1]:
+            i = min(max(bisect.bisect_right(self._breaks, P) - 1, 0), len(self._breaks) - 2)
+            c3, c2, c1, c0 = self._coef[name][i]
+            h = P - self._breaks[i]
+            return ((c3 * h + c2) * h + c1) * h + c0
         P = np.asarray(P, dtype=float)
         if np.any(P < 0) or not np.all(np.isfinite(P)):
             raise ValueError("depth P must be finite and >= 0")
