@@ -65,7 +65,9 @@ def test_bernoulli_reading_conserves_energy(table):
     # panel quadrature vs quad + brentq: 1e-10
     assert Pf == pytest.approx(P_energy, rel=1e-10)
     r = solve_motion(tb, M, RHO, RT, U0, rtol=1e-11)
-    assert r.final_depth == pytest.approx(P_energy, rel=1e-8)
+    # time integration across the interpolant's C^1 knots, where the embedded error estimate
+    # cannot see the jumps of the second derivative: measured 1e-8..3e-8, hence 1e-7
+    assert r.final_depth == pytest.approx(P_energy, rel=1e-7)
 
 
 def test_elastic_curve_matches_time_domain_on_the_table(table):
