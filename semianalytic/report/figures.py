@@ -15,6 +15,9 @@ import numpy as np
 from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
+LAYOUT = "constrained"
+LEGEND_LOC = "best"
+
 __all__ = [
     "Series",
     "Points",
@@ -62,7 +65,7 @@ def _draw(ax, series: Sequence[Series], points: Sequence[Points] = ()):
     for p in points:
         ax.plot(np.asarray(p.x), np.asarray(p.y), p.marker, ls="none", label=p.label, ms=5, **p.kwargs)
     if series or points:
-        ax.legend(fontsize=8, loc="best")
+        ax.legend(fontsize=8, loc=LEGEND_LOC)
     ax.grid(True, alpha=0.3)
 
 
@@ -76,7 +79,7 @@ def line_figure(
     size=(6.4, 4.2),
 ) -> Figure:
     """A single-axes plot of curves (and points)."""
-    fig = Figure(figsize=size, layout="constrained")
+    fig = Figure(figsize=size, layout=LAYOUT)
     ax = fig.add_subplot()
     _draw(ax, series, points)
     if logx:
@@ -97,7 +100,7 @@ def panels_figure(
 ) -> Figure:
     """Stacked panels sharing x: ``panels = [(ylabel, [Series, ...]), ...]``."""
     n = len(panels)
-    fig = Figure(figsize=size or (6.4, 2.2 * n + 0.6), layout="constrained")
+    fig = Figure(figsize=size or (6.4, 2.2 * n + 0.6), layout=LAYOUT)
     axes = fig.subplots(n, 1, sharex=sharex, squeeze=False)[:, 0]
     for ax, (ylabel, series) in zip(axes, panels):
         _draw(ax, series)
@@ -116,7 +119,7 @@ def side_by_side_figure(
 ) -> Figure:
     """Panels in one row, each with its own axes: ``[(xlabel, ylabel, [Series, ...]), ...]``."""
     n = len(panels)
-    fig = Figure(figsize=size or (4.6 * n, 3.9), layout="constrained")
+    fig = Figure(figsize=size or (4.6 * n, 3.9), layout=LAYOUT)
     axes = fig.subplots(1, n, squeeze=False)[0]
     for ax, (xlabel, ylabel, series) in zip(axes, panels):
         _draw(ax, series)
@@ -152,7 +155,7 @@ def velocity_field_figure(
     X, R = np.meshgrid(x, r, indexing="ij")
     speed = np.hypot(vx, vr)
     s = 1.0 / length_unit
-    fig = Figure(figsize=(7.2, 4.6), layout="constrained")
+    fig = Figure(figsize=(7.2, 4.6), layout=LAYOUT)
     ax = fig.add_subplot()
     finite = np.isfinite(speed)
     vmax = float(np.nanpercentile(speed[finite], 98)) if finite.any() else 1.0
