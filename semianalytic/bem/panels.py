@@ -29,7 +29,7 @@ from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc
 
 GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
-JUNCTION_LEVELS = 2  # grading at a curvature jump between tangent segments (nose-shank)
+JUNCTION_LEVELS = 4  # grading at a curvature jump between tangent segments (nose-shank)
 
 
 @dataclass(frozen=True)
