@@ -35,7 +35,7 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, BilinearForm
 from skfem.helpers import dot, grad
 
-from fem_check.meshing import DomainMesh, MeshOptions, body_domain, build_mesh, halfspace_domain
+from fem_check.meshing import DomainMesh, MeshOptions, Piece, body_domain, build_mesh, halfspace_domain
 from fem_check.potential import PotentialSolution, element_for, solve_potential
 from semianalytic.geometry import Meridian, Nose
 
@@ -76,6 +76,9 @@ def _boundary_motion(dm: DomainMesh, eps: float) -> tuple[np.ndarray, np.ndarray
             if shallow:
                 w = np.abs(pos[0, nodes]) < 1e-12 * Rf
                 x[w], r[w] = 0.0, rw_new
+                if dm.order == 2:
+                    _recentre_waterline_edges(dm, facets, nodes, x, r, Piece(nose.segments[k], nose.segments[k].t0,
+                                                                           nose.segments[k].t1, P + eps))
         nodes_all.append(nodes)
         new_all.append(np.vstack([x, r]))
     nodes = np.concatenate(nodes_all)
@@ -85,7 +88,22 @@ def _boundary_motion(dm: DomainMesh, eps: float) -> tuple[np.ndarray, np.ndarray
     return nodes, new[:, first]
 
 
-def moved_mesh(dm: DomainMesh, eps: float, _cache: dict | None = None) -> DomainMesh:
+def _recentre_waterline_edges(dm: DomainMesh, facets, nodes, x, r, curve: Piece) -> None:
+    """Put the mid-node of each curved edge ending at the moved waterline vertex back on the moved
+    nose, halfway between the edge's ends (otherwise the waterline vertex slides along x = 0 while
+    the mid-node moves with the body, and the curved edge distorts)."""
+    xy = dm.mesh.doflocs
+    for f in facets:
+        a, b = dm.mesh.facets[:, f]
+        ia, ib = np.searchsorted(nodes, a), np.searchsorted(nodes, b)
+        if not (abs(xy[0, a]) < 1e-12 * dm.domain.far_radius or abs(xy[0, b]) < 1e-12 * dm.domain.far_radius):
+            continue
+        im = np.searchsorted(nodes, dm.mesh.dofs.facet_dofs[0, f])
+        mid = 0.5 * np.array([x[ia] + x[ib], r[ia] + r[ib]])
+        x[im], r[im] = curve.project(mid[None, :])[0]
+
+
+def moved_mesh(dm: DomainMesh, eps: float) -> DomainMesh:
     """The mesh of depth P + eps with the topology of ``dm`` (harmonic extension of the boundary motion)."""
     nodes, new = _boundary_motion(dm, eps)
     basis = Basis(dm.mesh, element_for(dm.order))
@@ -137,7 +155,7 @@ def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh
 
 
 def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None = None,
-                           step: float = 1e-3, far_field: str = "monopole") -> HalfspaceCoefficients:
+                           step: float = 2e-4, far_field: str = "monopole") -> HalfspaceCoefficients:
     """A, B (three readings), C, dA/dP and phi_tip of Part I, eq. (12) by FEM at depth P.
 
     ``step``: the depth step of the shape finite difference, as a fraction of L_h.

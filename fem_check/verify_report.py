@@ -49,6 +49,7 @@ def _body(r: Report, p: dict) -> None:
         h = np.array([c["h_over_d"] for c in conv if c["order"] == 2])
         e2 = [c["error"] for c in conv if c["order"] == 2]
         ax.loglog(h, e2[0] * (h / h[0]) ** 4, "k:", label="h^4")
+        _h_ticks(ax, sorted(set(h.tolist())))
         ax.set_xlabel("h / d")
         ax.set_ylabel("relative error of the added mass")
         ax.legend(fontsize=8)
@@ -64,6 +65,16 @@ def _body(r: Report, p: dict) -> None:
               md_table(["far", "R [m]", "dipole (k=2)", "monopole (k=1)", "Neumann"],
                        [[f["far"], f["far_radius_m"], f["dipole"], f["monopole"], f["neumann"]] for f in ff]), "")
         _far_plot(r, ff, "far", "far radius / max(length, d)", ("dipole", "monopole", "neumann"))
+
+
+def _h_ticks(ax, hs):
+    """Major ticks at the mesh sizes used, no minor labels (they overlap on a short log axis)."""
+    from matplotlib.ticker import FixedLocator, NullFormatter, NullLocator
+
+    ax.xaxis.set_major_locator(FixedLocator(hs))
+    ax.xaxis.set_major_formatter(lambda v, pos: f"{v:g}")
+    ax.xaxis.set_minor_locator(NullLocator())
+    ax.xaxis.set_minor_formatter(NullFormatter())
 
 
 def _f10(v):
@@ -143,6 +154,7 @@ def _halfspace(r: Report, p: dict) -> None:
                 axA.loglog(hh, [max(c["A"], 1e-16) for c in sel], mk, label=f"P{order}, P/L_h={fmt(depth)}")
                 axB.loglog(hh, [max(c["B"], 1e-16) for c in sel], mk, label=f"P{order}, P/L_h={fmt(depth)}")
         for ax, name in ((axA, "A"), (axB, "B (body)")):
+            _h_ticks(ax, sorted({c["h_over_d"] for c in conv}))
             ax.set_xlabel("h / d")
             ax.set_title(f"{name}: abs(FEM/BEM - 1)", fontsize=9)
         axA.legend(fontsize=6)
