@@ -31,22 +31,18 @@ US = 1e6  # s -> us
 
 def coefficients(ctx: Context):
     """The DragCoefficients of this run (memoised): the BEM table, or with
-    ``[run] coefficients = "paper"`` the paper's quoted deep-penetration constants."""
+    ``[run] coefficients = "paper"`` the paper's quoted deep-penetration constants
+    (:func:`semianalytic.penetration.curve.coefficients_for_case`)."""
     if "coefficients" in ctx.memo:
         return ctx.memo["coefficients"]
-    if ctx.run.coefficients == "paper" or not table_available():
-        from semianalytic.penetration.curve import paper_coefficients
-
-        c = paper_coefficients(ctx.case.projectile)
-        why = ("`[run] coefficients = \"paper\"`" if ctx.run.coefficients == "paper"
-               else "the BEM coefficient table is not available in this version")
-        ctx.doc.note(
-            f"The paper's quoted constants Abar, Bbar, Cbar (section 2, Appendix) are used instead of the BEM "
-            f"table ({why}); errata items 2, 2c.",
-            "warning",
-        )
-    else:
+    if ctx.run.coefficients == "bem" and table_available():
         c = _coefficient_table(ctx)
+    else:
+        from semianalytic.penetration.curve import coefficients_for_case
+
+        c, desc, fallback = coefficients_for_case(ctx.case, ctx.run.coefficients, cache_dir=ctx.cache_dir)
+        why = "`[run] coefficients = \"paper\"`" if not fallback else "the BEM table is not available in this version"
+        ctx.doc.note(f"Coefficients: {desc} ({why}); errata items 2, 2c.", "warning")
     ctx.memo["coefficients"] = c
     return c
 
@@ -372,9 +368,10 @@ def _critical_run(ctx: Context) -> None:
         out.update(measured_critical_velocity_m_s=data.critical_velocity, yield_stress_from_critical_velocity_Pa=Y)
     doc.table(["quantity", "value"], rows)
     if data is not None and data.critical_velocity is not None:
+        how = ("this run uses those coefficients, with R_t from eq. (16) unrounded" if ctx.run.coefficients == "paper"
+               else "set `[run] coefficients = \"paper\"` to use those coefficients instead of the BEM table")
         doc.para("The Appendix's printed inputs (Abar = 1.5 mm, Bbar = 0.58, Cbar = 1.00, R_t = 1455 MPa) give "
-                 "Y_p = 2146 MPa, not the printed 2135 (errata item 3); with `[run] coefficients = \"paper\"` this "
-                 "run uses those coefficients.")
+                 f"Y_p = 2146 MPa, not the printed 2135 (errata item 3); {how}.")
     ctx.results["critical_velocity"] = out
 
 

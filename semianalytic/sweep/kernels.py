@@ -54,23 +54,11 @@ def geometry_key(case: Case) -> str:
 
 
 def coefficient_table_for(case: Case, cache_dir=None, progress: bool = False):
-    """The (cached) A, B, C table of the case's nose, in the B reading the case selects."""
-    from semianalytic.coefficients.table import cached_coefficient_table
-    from semianalytic.geometry import nose_from_section
+    """The (cached) A, B, C table of the case's nose, in the B reading the case selects
+    (:func:`semianalytic.penetration.curve.coefficients_for_case` with source "bem")."""
+    from semianalytic.penetration.curve import coefficients_for_case
 
-    nose = nose_from_section(case.require("projectile"))
-    kwargs = dict(
-        order=case.bem.order,
-        n_depths=case.coefficients.depths,
-        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
-        progress=progress,
-    )
-    if case.bem.refinement is not None:  # None: the table's own default
-        kwargs["refinement"] = case.bem.refinement
-    if cache_dir is not None:
-        kwargs["cache_dir"] = cache_dir
-    table = cached_coefficient_table(nose, **kwargs)
-    return table.with_reading(case.coefficients.reading)
+    return coefficients_for_case(case, "bem", cache_dir=cache_dir, progress=progress)[0]
 
 
 def _check_velocities(values: np.ndarray) -> None:
