@@ -6,12 +6,14 @@ default, ``--scheduler tcp://HOST:PORT`` for an existing one, ``--scheduler inli
 dask).  Each finished batch is appended to ``DIR/results.csv`` (or ``DIR/results.parquet/``)
 at once; ``--resume`` skips the finished cases after an interruption.  Examples::
 
-    python -m semianalytic sweep cases/fig15a_ogive.toml --out sweeps/vel \\
-        --vary impact.striking_velocity=400:1800:10 m/s \\
-        --vary target.resistance.yield_stress=250:550:5 MPa
-    python -m semianalytic sweep cases/fig15a_ogive.toml --out sweeps/mc --samples 2000 --seed 7 \\
-        --sample target.resistance.yield_stress=normal(400 MPa, 20 MPa) \\
-        --sample target.density=uniform(2690 kg/m^3, 2730 kg/m^3)
+    python -m semianalytic sweep cases/fig15a_ogive_6061T651.toml --out sweeps/vel \\
+        --vary "impact.striking_velocity=400:1800:10 m/s" \\
+        --vary "target.resistance.yield_stress=250:550:5 MPa"
+    python -m semianalytic sweep cases/fig15a_ogive_6061T651.toml --out sweeps/mc --samples 2000 --seed 7 \\
+        --sample "target.resistance.yield_stress=normal(400 MPa, 20 MPa)" \\
+        --sample "target.density=uniform(2690 kg/m^3, 2730 kg/m^3)"
+
+(quote each KEY=... that contains a space).
 """
 
 from __future__ import annotations
