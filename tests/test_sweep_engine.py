@@ -99,6 +99,10 @@ def test_inline_sweep_matches_direct_calls(tmp_path):
             _direct(row["material.poisson_ratio"], row["material.compressive_strength_Pa"]), rel=1e-12)
     man = json.loads((tmp_path / "sw" / "sweep.json").read_text())
     assert man["analysis"] == "cavity" and man["spec"]["n_samples"] == 3
+    st = json.loads((tmp_path / "sw" / "statistics.json").read_text())["cavity_pressure_Pa"]
+    v = df.cavity_pressure_Pa.to_numpy()
+    assert st["n"] == 12 and st["mean"] == pytest.approx(v.mean(), rel=1e-14)
+    assert st["std"] == pytest.approx(v.std(ddof=1), rel=1e-12) and st["max"] == v.max()
 
 
 def test_interrupted_sweep_resumes_without_loss_or_duplicates(tmp_path):

@@ -74,12 +74,18 @@ def run(args: argparse.Namespace) -> int:
         progress=not args.no_progress, kernel=kernel,
     )
     info = summary.to_json()
+    stats_path = summary.out / "statistics.json"
+    stats = json.loads(stats_path.read_text()) if stats_path.exists() else {}
     if args.json:
-        print(json.dumps(info, indent=2))
+        print(json.dumps({**info, "statistics": stats}, indent=2))
     else:
         print(
             f"{info['n_run']} cases run ({info['n_ok']} ok, {info['n_invalid']} invalid, {info['n_error']} failed), "
             f"{info['n_skipped_finished_before']} finished before; {summary.cases_per_second:.0f} cases/s "
             f"on {info['workers']} worker(s); results: {info['results']}"
         )
+        for col, st in stats.items():
+            if isinstance(st, dict):
+                print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
+                      f"(n = {st['n']})")
     return 0 if summary.n_error == 0 else 1

@@ -36,6 +36,7 @@ from semianalytic.sweep.store import ResultStore, results_path
 
 BASE_COLUMNS = ("case_id", "status", "message")
 MANIFEST = "sweep.json"
+STATISTICS = "statistics.json"  # distribution of every output over the finished cases
 
 
 @dataclass(frozen=True)
@@ -249,7 +250,7 @@ def check_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict)
 
 def _clear_results(out: Path) -> None:
     """--force: remove an earlier sweep's results and manifest (only those files)."""
-    for p in (results_path(out, "csv"), results_path(out, "parquet"), out / MANIFEST):
+    for p in (results_path(out, "csv"), results_path(out, "parquet"), out / MANIFEST, out / STATISTICS):
         if p.is_dir():
             shutil.rmtree(p)
         elif p.exists():
@@ -378,7 +379,28 @@ def run_sweep(
         if cluster is not None:
             cluster.close()
         summary.seconds_total = time.perf_counter() - t0
+    if store.path.exists():
+        atomic_write_json(out / STATISTICS, output_statistics(store, kernel.columns))
     return summary
+
+
+def output_statistics(store: ResultStore, columns) -> dict:
+    """Per output column, over the cases with status ok: n, mean, std, min, 5/50/95 % and max
+    (for a Monte-Carlo study, the distribution of each result)."""
+    df = store.read()
+    ok = df[df["status"] == "ok"]
+    out = {"n_cases": int(len(df)), "n_ok": int(len(ok))}
+    for c in columns:
+        if c not in ok or ok[c].dtype.kind not in "fi":
+            continue
+        v = ok[c].to_numpy(dtype=float)
+        v = v[np.isfinite(v)]
+        if v.size == 0:
+            continue
+        q = np.percentile(v, [5, 50, 95])
+        out[c] = {"n": int(v.size), "mean": float(v.mean()), "std": float(v.std(ddof=1)) if v.size > 1 else 0.0,
+                  "min": float(v.min()), "p05": float(q[0]), "p50": float(q[1]), "p95": float(q[2]), "max": float(v.max())}
+    return out
 
 
 def _record(store: ResultStore, rows: list[dict], summary: SweepSummary, bar, on_batch) -> None:
