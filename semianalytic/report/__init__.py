@@ -11,6 +11,10 @@ Figs. 12-13) and a pyvista render.  Modules:
 - :mod:`~semianalytic.report.html`: the same blocks rendered to a self-contained HTML page;
 - :mod:`~semianalytic.report.figures`: matplotlib (object API) figures;
 - :mod:`~semianalytic.report.vtk`: the velocity field on a revolved grid -> ``.vtu``;
-- :mod:`~semianalytic.report.steps`: one function per analysis;
-- :mod:`~semianalytic.report.run`: the ``run`` command.
+- :mod:`~semianalytic.report.context`: what the steps of one run share;
+- :mod:`~semianalytic.report.steps` (+ :mod:`.steps_part1`, :mod:`.steps_other`): one step per
+  analysis (added mass, coefficients, penetration, critical velocity, validation, velocity
+  field, FEM field, cavity, ballistic limit, nanostrength);
+- :mod:`~semianalytic.report.run`: the ``run`` command;
+- :mod:`~semianalytic.report.benchmark`: run times -> ``reports/bench_run.md``.
 """
