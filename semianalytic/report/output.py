@@ -47,6 +47,9 @@ class StagedDir:
     def __enter__(self) -> "StagedDir":
         self.final.parent.mkdir(parents=True, exist_ok=True)
         self.root = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.partial-", dir=self.final.parent))
+        from semianalytic.io import _umask
+
+        os.chmod(self.root, 0o777 & ~_umask())  # mkdtemp makes 0700; the report folder is for reading
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:

@@ -238,6 +238,9 @@ def write_vtu(mesh, path: str | os.PathLike) -> Path:
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".vtu", dir=path.parent)
     os.close(fd)
+    from semianalytic.io import _umask
+
+    os.chmod(tmp, 0o666 & ~_umask())
     try:
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
         os.replace(tmp, path)
