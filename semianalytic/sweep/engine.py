@@ -339,6 +339,9 @@ def run_sweep(
             return summary
         # shared resources (coefficient tables), one per geometry
         rcases = _resource_cases(case, spec, kernel, pending, draws)
+        if len(rcases) > 20:
+            print(f"warning: {len(rcases)} distinct nose geometries: each needs its own BEM coefficient table "
+                  "(seconds each, cached on disk)", file=sys.stderr)
         if client is None:
             resources = {k: kernel.prepare(c) for k, c in rcases.items()}
             summary.workers = 1
