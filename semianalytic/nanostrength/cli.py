@@ -18,6 +18,7 @@ from pathlib import Path
 from semianalytic.case import load_case
 from semianalytic.errors import InputError
 from semianalytic.io import check_report_target
+from semianalytic.nanostrength import data
 from semianalytic.nanostrength.analysis import Analysis, analyse
 from semianalytic.nanostrength.interplanar import CalibrationError
 
@@ -57,13 +58,15 @@ def _summary(a: Analysis, title: str) -> str:
                      f"{b.e_t:>9.4f} ({c.e_t:.4f})")
     key = f"{o['surface_energy']}/{o['deformation_energy'] if o['surface_energy'] == 'eq16' else 'law'}"
     lines += ["", f"Fracture ({key}): Y_1c [N/m], K_1c [MPa m^1/2]; tension I, compression II",
-              f"{'crystal':<8}{'Y_1c I':>10}{'Y_1c II':>10}{'K_1c I':>10}{'K_1c II':>10}"]
+              f"{'crystal':<8}{'Y_1c I':>10}{'Y_1c II':>10}{'K_1c I':>10}{'K_1c II':>10}   Table 3: Y I, Y II, K I, K II"]
     for name, r in a.crystals.items():
         ft, fc = r.fracture.get(f"{key}/tension"), r.fracture.get(f"{key}/compression")
         if ft is None or fc is None:
             lines.append(f"{name:<8}  (not available with this law)")
             continue
-        lines.append(f"{name:<8}{ft.Y1c:>10.4f}{fc.Y1c:>10.4f}{ft.K1c / 1e6:>10.4f}{fc.K1c / 1e6:>10.4f}")
+        t3 = data.TABLE3.get(name)
+        printed = f"   {t3.Y_t:g}, {t3.Y_c:g}, {t3.K_t:g}, {t3.K_c:g}" if t3 else ""
+        lines.append(f"{name:<8}{ft.Y1c:>10.4f}{fc.Y1c:>10.4f}{ft.K1c / 1e6:>10.4f}{fc.K1c / 1e6:>10.4f}{printed}")
     for s in a.studies:
         lines += ["", f"Study {s.spec.name}: {s.spec.title}",
                   f"{'crystal':<8}{'basis':<14}{'l':>6}{'m=n':>6}{'i':>5}{'Phi_i/Phi_0':>13}{'sigma1 [GPa]':>14}{'sigma2 [GPa]':>14}"

@@ -171,7 +171,7 @@ Delta Phi = Phi(d_max) - Phi(d_0) up to each peak, from the law, against the pri
 """, _table(["crystal", "tension law", "tension printed", "diff", "compression law", "compression printed", "diff",
              "compression lower bound"], drows), f"""
 In tension the law's Delta Phi is about 10 % below the printed one: the paper's curve stores a
-little more energy before its peak than ours (it is closer to linear up to the peak).  In
+little more energy before its peak than ours.  In
 compression the printed Delta Phi is roughly half of the law's.  The last column is the energy
 E d_0 e*^2 (1 - e*)/2 that any curve stores between d_0 and its compressive peak if its stress
 never falls below the initial tangent E|e| there (valid for both stress measures).  Table 2's
@@ -421,8 +421,9 @@ def _closing(doc: _Doc, a: Analysis):
   well some 20 times deeper than Table 1's, no compressive peak).  Table 1 itself (Phi_0, a_0, c_0) cannot be recomputed: the pseudo-potential form factors
   of ref. [9] are not given.
 * **Not reproducible / inconsistent.** The compressive Delta Phi values quoted after eq. (16)
-  (and so Table 3's column II) are incompatible with Table 2 under eq. (14); the law's own
-  Delta Phi differs by about -10 % in tension and +100 % in compression.  Eq. (16) disagrees with
+  (and so Table 3's column II) do not fit Table 2 under eq. (14) (for C, BN and AlN they are
+  below what any curve stiffening up to its compressive peak stores); the law's own Delta Phi
+  differs from the quoted values by about -10 % in tension and +60 to +100 % in compression.  Eq. (16) disagrees with
   eq. (15) by 1/e; Table 3 follows (16).
 * **Assumed.** The odd-l surface energy Phi_1 (r = 5 Phi_0) -- the paper gives none; the figures
   5-7 are analogues computed with the stated parameters (the paper's figures are not in the
