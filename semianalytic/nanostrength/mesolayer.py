@@ -135,9 +135,3 @@ def centre_index(l: int) -> int:
     j = mesolayer_count(l)
     return (j + 1) // 2
 
-
-def depth_from_surface(i, c0: float):
-    """Distance [m] of mesolayer i's middle from free surface 1, (i - 1/2) c_0/3: each structural
-    unit with its gap spans c_0/3 along [111] (6 planes per c_0).  Text after Fig. 7:
-    h_1 = a* sqrt(3) 50/6 = 25 c_0/3 corresponds to i ~ 25."""
-    return (np.asarray(i, dtype=float) - 0.5) * c0 / 3.0
