@@ -211,6 +211,11 @@ def _field_depths(case: Case, run: RunSection) -> list[float]:
     return [0.5 * pr.length]
 
 
+def _depth_tag(P: float) -> str:
+    """File-name tag of a depth: 35.9 mm -> 'P35p9mm'."""
+    return f"P{P * 1e3:.1f}mm".replace(".", "p")
+
+
 def _velocity_field_preflight(case: Case, run: RunSection) -> None:
     case.require("target")
     pr = _projectile(case)
@@ -242,7 +247,7 @@ def _velocity_field_run(ctx: Context) -> None:
             pr.nose, pr.length, P, u, extent=run.field_extent, grid=tuple(run.field_grid),
             **bem_options(case),
         )
-        tag = f"P{P * 1e3:.1f}mm".replace(".", "p")
+        tag = _depth_tag(P)
         rel2, p2 = ctx.vtk_path(f"velocity_meridian_{tag}.vtu")
         rel3, p3 = ctx.vtk_path(f"velocity_3d_{tag}.vtu")
         rels, ps = ctx.vtk_path(f"projectile_{tag}.vtu")
@@ -313,7 +318,7 @@ def _fem_field_run(ctx: Context) -> None:
         sol = solve_potential(dm, "monopole")
         bem = solve_halfspace(pr.nose, P, **bem_options(case))
         mesh = vtk.fem_meridian_mesh(sol, u, bem)
-        tag = f"P{P * 1e3:.1f}mm".replace(".", "p")
+        tag = _depth_tag(P)
         rel, path = ctx.vtk_path(f"fem_potential_{tag}.vtu")
         vtk.write_vtu(mesh, path)
         pts = mesh.points
