@@ -192,7 +192,7 @@ class BemSection(Section):
 
     order: int = Field(default=8, ge=2, le=16, description="Gauss points (unknowns) per panel")
     refinement: float | None = Field(
-        default=None, gt=0.0, le=8.0, description="panel-count multiplier (default: 1 for bodies, 0.5 for tables)"
+        default=None, gt=0.0, le=8.0, description="panel-count multiplier (default: 1 for bodies, 0.3 for tables)"
     )
 
 

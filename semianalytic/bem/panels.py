@@ -29,7 +29,7 @@ from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc
 
 GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
-JUNCTION_LEVELS = 4  # grading at a curvature jump between tangent segments (nose-shank)
+
 
 
 @dataclass(frozen=True)
@@ -293,6 +293,12 @@ class LayoutOptions:
     refinement: float = 1.0
     levels: int = 12
 
+    @property
+    def junction_levels(self) -> int:
+        """Grading at a curvature jump between tangent segments (nose-shank): milder than
+        at corners and tips, where the solution itself is singular."""
+        return self.levels // 3
+
     def __post_init__(self):
         if not 2 <= self.order <= 16:
             raise ValueError("order must lie between 2 and 16")
@@ -408,13 +414,13 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         if k == 0:
             g0 = lev if tip_conical else 0
         else:
-            g0 = lev if turning[k - 1] else JUNCTION_LEVELS  # curvature jump between tangent segments
+            g0 = lev if turning[k - 1] else options.junction_levels  # curvature jump between tangent segments
         if cut_here:
             g1 = lev
         elif k < len(segs) - 1:
-            g1 = lev if turning[k] else JUNCTION_LEVELS
+            g1 = lev if turning[k] else options.junction_levels
         else:
-            g1 = lev if _shoulder_is_corner(nose) else JUNCTION_LEVELS
+            g1 = lev if _shoulder_is_corner(nose) else options.junction_levels
         p0 = (0.0, 0.0) if k == 0 else _point(seg, seg.t0)
         if cut_here:
             p1 = (-depth, float(seg.point(t1)[1]))
@@ -436,7 +442,7 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     shoulder, then panels growing by a factor 2 (less with refinement) towards x = 0."""
     R, Lh = nose.radius, nose.length
     length = depth - Lh
-    grade = options.levels if _shoulder_is_corner(nose) else JUNCTION_LEVELS
+    grade = options.levels if _shoulder_is_corner(nose) else options.junction_levels
     growth = 2.0 ** (1.0 / max(options.refinement, 1.0))
     h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
     edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]

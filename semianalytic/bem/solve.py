@@ -29,7 +29,7 @@ from __future__ import annotations
 
 import functools
 import math
-from dataclasses import dataclass, replace
+from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
@@ -90,7 +90,7 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     inner = np.arange(len(pan))
     if inner.size:
         ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
-        for _ in range(3):  # Newton on (y(u) - x) . y'(u) = 0
+        for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
             x, r, xu, ru, xuu, ruu = ps.evaluate(pi, ui, second=True)
             ex, er = x - xi, r - ri
             f = ex * xu + er * ru
@@ -162,25 +162,28 @@ class PairQuadrature:
     target_u: np.ndarray | None = None  # self rules: the target's own panel coordinate
 
     @staticmethod
-    def build(target, panel, order, parts) -> "PairQuadrature":
+    def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
         """From parts (pair indices (n,), u (n, Q), a (n, Q), b (n, Q), lag) with any Q
-        each; lag is the (n, Q, p) or shared (Q, p) Lagrange matrix, or None."""
+        each; lag is the (n, Q, p) or shared (Q, p) Lagrange matrix, or None.  The pairs
+        are reordered part by part, so that each pair's points are contiguous."""
         if not parts:
-            return PairQuadrature(target, panel, *(np.empty(0, int),) * 2, *(np.empty(0),) * 3, np.empty((0, order)))
+            empty = np.empty(0, int)
+            return PairQuadrature(empty, empty, empty, empty, *(np.empty(0),) * 3, np.empty((0, order)))
         nodes = gauss_legendre(order)[0]
-        pair = np.concatenate([np.repeat(sel, part[1].shape[1]) for sel, *part in parts])
-        flat = [np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3)]
+        order_idx = np.concatenate([sel for sel, *_ in parts])
+        counts = np.concatenate([np.full(len(sel), u.shape[1]) for sel, u, *_ in parts])
+        starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
+        pair = np.repeat(np.arange(len(order_idx)), counts)
+        u, a, b = (np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3))
         lags = []
-        for sel, u, _, _, lag in parts:
+        for sel, uu, _, _, lag in parts:
             if lag is None:
-                lag = lagrange_matrix(nodes, u)
-            lags.append(np.broadcast_to(lag, (*u.shape, order)).reshape(-1, order))
-        order_idx = np.argsort(pair, kind="stable")
-        pair = pair[order_idx]
-        u, a, b = (f[order_idx] for f in flat)
-        lag = np.concatenate(lags)[order_idx]
-        starts = np.searchsorted(pair, np.arange(len(target)))
-        return PairQuadrature(target, panel, pair, starts, u, a, b, lag)
+                lag = lagrange_matrix(nodes, uu)
+            lags.append(np.broadcast_to(lag, (*uu.shape, order)).reshape(-1, order))
+        return PairQuadrature(
+            target[order_idx], panel[order_idx], pair, starts, u, a, b, np.concatenate(lags),
+            None if target_u is None else target_u[order_idx],
+        )
 
     def integrate(self, ps: PanelSet, xt, rt, kernels):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
@@ -252,8 +255,7 @@ def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
         b = np.concatenate([sw * lnu + swl, t["lw"][qs], np.zeros_like(t["fw"][qs])], axis=1)
         parts.append((sel, u, a, b, t["L"][qs]))
     own = np.arange(N) // order
-    rule = PairQuadrature.build(np.arange(N), own, order, parts)
-    return replace(rule, target_u=uq)
+    return PairQuadrature.build(np.arange(N), own, order, parts, target_u=uq)
 
 
 # ------------------------------------------------------------------------------------
@@ -295,9 +297,8 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
     close = np.nonzero(np.hypot(xt - cx[own_panel], rt + cr[own_panel]) < (IMAGE_MARGIN + 1) * ps.lengths[own_panel])[0]
     if close.size:
         _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
-        # one rule for all of them (the most graded): few groups, fast
-        levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN).max()
-        levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN).max()
+        levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
+        levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
     tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
     return AssemblyPlan(self_quadrature(levels, p), near_quadrature(tgt, pan, ustar, du, p))
 
@@ -507,6 +508,7 @@ class SurfaceSolution:
         tgt, pan, ustar, du = near_pairs(ps, xt, rt)
         if tgt.size:
             rule = near_quadrature(tgt, pan, ustar, du, p)
+            tgt, pan = rule.target, rule.panel  # in the rule's order
             cols = pan[:, None] * p + np.arange(p)[None, :]
             if gradient:
                 bSx, bSr, bWx, bWr = rule.integrate(ps, xt, rt, lambda X, R, x, r, nx, nr, delta: gradient_kernels(X, R, x, r))

@@ -215,7 +215,7 @@ def run(args) -> int:
     refinements = REFINEMENTS[2:6] if args.quick else REFINEMENTS
     with _single_threaded_blas():
         rows = convergence_rows(repeats=repeats, refinements=refinements)
-        tables = table_timing(repeats=1 if args.quick else 2, n_depths=16 if args.quick else 64)
+        tables = table_timing(repeats=1 if args.quick else 3, n_depths=16 if args.quick else 64)
     blas = blas_threads(repeats=5 if args.quick else 30)
     written = write_convergence_report(rows, out, True)
     written += write_bench_report(rows, blas, tables, out, True)

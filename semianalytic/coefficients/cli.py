@@ -83,7 +83,7 @@ def _run_projectile(case, args) -> int:
     table = coefficient_table(
         nose,
         order=args.order or case.bem.order,
-        refinement=args.refinement or case.bem.refinement or 0.5,
+        refinement=args.refinement or case.bem.refinement or 0.3,
         n_depths=n_depths,
         max_depth_nose_lengths=max_depth,
         progress=not args.json and sys.stderr.isatty(),
