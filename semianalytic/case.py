@@ -199,7 +199,7 @@ class BemSection(Section):
 class CoefficientsSection(Section):
     """``[coefficients]``: the A(P), B(P), C(P) table (all optional)."""
 
-    depths: int = Field(default=64, ge=8, le=2000)
+    depths: int = Field(default=60, ge=8, le=2000)
     max_depth_nose_lengths: float = Field(default=300.0, gt=1.0)
     reading: Literal["body", "literal", "bernoulli"] = "body"
 

@@ -32,8 +32,10 @@ def test_time_and_depth_integrations_agree_on_the_table(table):
     Pf = final_depth(table, M, RHO, RT, U)
     for u0, p in zip(U, Pf):
         r = solve_motion(table, M, RHO, RT, u0, rtol=1e-11)
-        # adaptive RK across the table's C^1 knots vs panel quadrature aligned with them: 1e-8
-        assert r.final_depth == pytest.approx(p, rel=1e-8)
+        # adaptive RK across the table's C^1 knots (its error estimate cannot see the jumps of
+        # the second derivative there) vs panel quadrature aligned with them: measured up to
+        # ~6e-8 depending on the table, hence 1e-7 (the issue asks for 1e-6)
+        assert r.final_depth == pytest.approx(p, rel=1e-7)
 
 
 class _DerivativeReading:
@@ -75,4 +77,4 @@ def test_elastic_curve_matches_time_domain_on_the_table(table):
     c = penetration_curve(PenetrationSetup(table, M, RHO, RT, rod, 0.29, 1.64e9), [1000.0])
     r = solve_elastic(table, M, RHO, RT, 1000.0, rod, w2="paper", rtol=1e-11)
     assert c["depth_elastic_m"][0] == pytest.approx(r.final_depth, rel=1e-7)  # two methods, 1e-8 each
-    assert c["depth_quasi_rigid_m"][0] == pytest.approx(r.quasi_rigid.final_depth, rel=1e-8)
+    assert c["depth_quasi_rigid_m"][0] == pytest.approx(r.quasi_rigid.final_depth, rel=1e-7)  # as above

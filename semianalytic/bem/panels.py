@@ -439,11 +439,12 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
 
 def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     """Cylinder from the shoulder (-L_h, R) to the free surface (-P, R): graded at the
-    shoulder, then panels growing by a factor 2 (less with refinement) towards x = 0."""
+    shoulder, then panels growing geometrically (by 2 at refinement 1) towards x = 0,
+    where phi varies ever more slowly."""
     R, Lh = nose.radius, nose.length
     length = depth - Lh
     grade = options.levels if _shoulder_is_corner(nose) else options.junction_levels
-    growth = 2.0 ** (1.0 / max(options.refinement, 1.0))
+    growth = min(3.0, 2.0 ** (1.0 / options.refinement))  # 2 at refinement 1
     h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
     edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]
     pos = h

@@ -45,7 +45,7 @@ from semianalytic.bem.quadrature import (
     lagrange_matrix,
 )
 
-N_SELF = 8  # points per half-panel in the self rules (plain and log)
+N_SELF = 6  # points per half-panel in the self rules (plain and log)
 N_NEAR = 8  # Gauss points per dyadic piece in the near rules
 NEAR_FACTOR = 1.3  # a panel is "near" a target closer than this many panel lengths to its centre
 MAX_LEVELS = 48

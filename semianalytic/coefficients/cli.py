@@ -20,7 +20,7 @@ from semianalytic.coefficients import READINGS
 def add_arguments(parser) -> None:
     parser.add_argument("case", help="TOML case file with [projectile]+[target] or [body]")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
-    parser.add_argument("--depths", type=int, default=None, help="number of depths (default: [coefficients].depths, 64)")
+    parser.add_argument("--depths", type=int, default=None, help="number of depths (default: [coefficients].depths, 60)")
     parser.add_argument("--max-depth", type=float, default=None, help="deepest depth in nose lengths (default 300)")
     parser.add_argument("--reading", choices=READINGS, default=None, help="reading of B for B_m2 (errata item 2a)")
     parser.add_argument("--refinement", type=float, default=None, help="BEM panel-count multiplier")

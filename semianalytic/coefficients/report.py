@@ -45,7 +45,7 @@ def separation_velocity(table, mass: float, rho: float, R_t: float, reading: str
     return None
 
 
-def write_coefficients_report(out_dir: Path, n_depths: int = 64) -> list[Path]:
+def write_coefficients_report(out_dir: Path, n_depths: int = 60) -> list[Path]:
     from semianalytic.coefficients.table import coefficient_table
     from semianalytic.io import atomic_write_bytes, atomic_write_text
     from semianalytic.penetration.resistance import elastic_plastic_resistance
@@ -187,14 +187,17 @@ def write_coefficients_report(out_dir: Path, n_depths: int = 64) -> list[Path]:
         "back from the tip in nose lengths."
     )
     doc.table(("nose", "reading", "phase", "separation from", "at P/L_h", "separated part (from tip, L_h)"), contact_rows)
+    body_in = [r for r in contact_rows if r[1] == "body" and r[2].startswith("nose in")]
     doc.para(
-        "Read the table by phase. Once the nose is in, the `body` reading keeps full contact over the whole "
-        "velocity range, as the paper states, while the `literal` and `bernoulli` readings open a gap at the "
-        "shoulder above the velocities shown (errata item 2e): with those readings l_P must be computed, not "
-        "assumed. While the nose enters, and while the shoulder is still within a tenth of a nose length of "
-        "the free surface, every reading shows a sliver of negative pressure next to the free-surface edge: "
-        "potential flow is singular at that edge (the velocity is unbounded there), so this belongs to the "
-        "model's flat-free-surface idealisation rather than to a resolved separation."
+        "Read the table by phase. Once the nose is in (P >= 1.1 L_h), the `body` reading keeps full contact "
+        "over the paper's velocity range (0.6-1.6 km/s), as the paper states ("
+        + "; ".join(f"{r[0]}: {r[3]}" for r in body_in)
+        + "), while the `literal` and `bernoulli` readings open a gap at the shoulder above the velocities "
+        "shown (errata item 2e): with those readings l_P must be computed, not assumed. While the nose "
+        "enters, and while the shoulder is still within a tenth of a nose length of the free surface, every "
+        "reading shows a sliver of negative pressure next to the free-surface edge: potential flow is "
+        "singular at that edge (the velocity is unbounded there), so this belongs to the model's "
+        "flat-free-surface idealisation rather than to a resolved separation."
     )
     written.append(atomic_write_text(out_dir / "bem_coefficients.md", to_markdown(doc)))
     return written

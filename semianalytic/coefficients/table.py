@@ -26,10 +26,10 @@ from semianalytic.coefficients import READINGS
 from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_depth
 from semianalytic.geometry import Nose
 
-TABLE_VERSION = 2  # bump when the numerics change, to invalidate caches
+TABLE_VERSION = 3  # bump when the numerics change, to invalidate caches
 
 
-def default_depths(nose: Nose, n_depths: int = 64, max_depth_nose_lengths: float = 300.0) -> np.ndarray:
+def default_depths(nose: Nose, n_depths: int = 60, max_depth_nose_lengths: float = 300.0) -> np.ndarray:
     """Depths from first contact to ``max_depth_nose_lengths`` nose lengths.
 
     Half of them while the nose enters (geometric from 1% of L_h, then linear, stopping
@@ -273,7 +273,7 @@ def coefficient_table(
     order: int = 8,
     refinement: float = 0.3,
     levels: int = 6,
-    n_depths: int = 64,
+    n_depths: int = 60,
     max_depth_nose_lengths: float = 300.0,
     depths=None,
     progress: bool = False,
