@@ -27,7 +27,6 @@ from __future__ import annotations
 
 import argparse
 import dataclasses
-import json
 import math
 import time
 from dataclasses import dataclass, field
@@ -40,7 +39,6 @@ from skfem import (Basis, BilinearForm, ElementLineP2, ElementTriP2, ElementTriP
 from skfem.helpers import dot
 
 from fem_check.meshing import MeshOptions, annulus_domain, build_mesh
-from semianalytic.errors import InputError
 
 
 CRACK_REGULARISATION = 1e-6  # fraction of the isotropic stiffness added in the 2D cracked zone

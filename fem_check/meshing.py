@@ -40,7 +40,7 @@ import numpy as np
 from skfem import MeshTri1, MeshTri2
 
 from semianalytic.errors import InputError
-from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, SplineCurve
+from semianalytic.geometry import Arc, Line, Meridian, Nose, SplineCurve
 
 MESH_FORMAT_VERSION = 5  # bump when the domain construction changes (invalidates the cache)
 

@@ -9,7 +9,6 @@ Bernoulli numbers: with x = e^-s, I = int_s0^inf s^n/(e^s - 1) ds
 import copy
 import math
 
-import numpy as np
 import pytest
 from scipy import integrate, special
 

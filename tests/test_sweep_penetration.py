@@ -8,8 +8,6 @@ test.  One test runs on a real two-worker LocalCluster.
 
 from __future__ import annotations
 
-import math
-from pathlib import Path
 
 import numpy as np
 import pandas as pd

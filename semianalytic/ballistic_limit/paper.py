@@ -31,7 +31,6 @@ from semianalytic.ballistic_limit.shots import (
     theoretical_limits,
 )
 from semianalytic.ballistic_limit.tables import Table2Row, Table3Row, Table4Cell
-from semianalytic.ballistic_limit.theory import resistance_part4
 
 __all__ = [
     "table2_paper",

@@ -7,11 +7,7 @@ deviations found.
 
 from __future__ import annotations
 
-import argparse
 import math
-import sys
-from dataclasses import replace
-from pathlib import Path
 
 import numpy as np
 from matplotlib.figure import Figure
@@ -35,15 +31,12 @@ from semianalytic.ballistic_limit.paper import (
 from semianalytic.ballistic_limit.shots import empirical_limits
 from semianalytic.ballistic_limit.tables import load_table1, load_table2, load_table3, load_table4, load_table5
 from semianalytic.ballistic_limit.theory import (
-    ballistic_limit,
     depth_at_time,
     stop_time,
-    stopping_thickness,
     velocity_at_time,
 )
-from semianalytic.errors import InputError
-from semianalytic.io import atomic_write_bytes, atomic_write_text, check_report_target
-from semianalytic.report.document import Document, fmt, to_markdown
+from semianalytic.report.output import report_command
+from semianalytic.report.document import Document, to_markdown
 from semianalytic.report.figures import png_bytes
 
 __all__ = ["build", "main"]
@@ -373,22 +366,7 @@ def build() -> tuple[str, dict[str, bytes]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m semianalytic.ballistic_limit.report", description=__doc__)
-    parser.add_argument("--out", default="reports", help="output folder (default reports/)")
-    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
-    args = parser.parse_args(argv)
-    out = Path(args.out)
-    try:
-        target = check_report_target(out / "part4_ballistic_limit.md", args.force)
-        text, figs = build()
-        for name, data in figs.items():
-            atomic_write_bytes(out / name, data)
-        atomic_write_text(target, text)
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    print(f"wrote {target}")
-    return 0
+    return report_command("python -m semianalytic.ballistic_limit.report", __doc__, "part4_ballistic_limit.md", lambda out: build(), argv)
 
 
 if __name__ == "__main__":

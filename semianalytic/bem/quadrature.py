@@ -21,7 +21,6 @@ All rules are built once per order and cached.
 from __future__ import annotations
 
 import functools
-import math
 
 import numpy as np
 

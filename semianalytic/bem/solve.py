@@ -408,9 +408,8 @@ class SurfaceNodes:
 
     @property
     def dphi_dx(self) -> np.ndarray:
-        """x-derivative of phi on the surface: tangential plus normal parts."""
-        tx, tr = -self.nr, self.nx
-        return self.dphi_ds * tx + self.g * self.nx
+        """x-derivative of phi on the surface: tangential plus normal parts (t_x = -n_r)."""
+        return -self.dphi_ds * self.nr + self.g * self.nx
 
 
 @dataclass(frozen=True)

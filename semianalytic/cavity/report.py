@@ -6,9 +6,7 @@ fails, SiC and B4C, the validity limits of errata item 20, and the deviations fo
 
 from __future__ import annotations
 
-import argparse
 import math
-import sys
 import time
 import warnings
 from pathlib import Path
@@ -19,9 +17,8 @@ from matplotlib.figure import Figure
 from semianalytic.case import load_case
 from semianalytic.cavity import BrittleMaterial, fixed_point_iteration, solve_cavity
 from semianalytic.cavity import zones
-from semianalytic.cavity.model import iteration_slope, solve_front_stress_bracket
 from semianalytic.errors import InputError, ModelValidityWarning
-from semianalytic.io import atomic_write_bytes, atomic_write_text, check_report_target
+from semianalytic.report.output import report_command
 from semianalytic.report.document import Document, fmt, to_markdown
 from semianalytic.report.figures import png_bytes
 
@@ -317,22 +314,7 @@ def build(out: Path) -> tuple[str, dict[str, bytes]]:
 
 
 def main(argv: list[str] | None = None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m semianalytic.cavity.report", description=__doc__)
-    parser.add_argument("--out", default="reports", help="output folder (default reports/)")
-    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
-    args = parser.parse_args(argv)
-    out = Path(args.out)
-    try:
-        target = check_report_target(out / "part2_cavity.md", args.force)
-        text, figs = build(out)
-        for name, data in figs.items():
-            atomic_write_bytes(out / name, data)
-        atomic_write_text(target, text)
-    except InputError as exc:
-        print(f"error: {exc}", file=sys.stderr)
-        return 2
-    print(f"wrote {target}")
-    return 0
+    return report_command("python -m semianalytic.cavity.report", __doc__, "part2_cavity.md", build, argv)
 
 
 if __name__ == "__main__":

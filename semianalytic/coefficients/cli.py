@@ -11,7 +11,6 @@ import json
 import math
 import sys
 
-import numpy as np
 
 from semianalytic.case import load_case
 from semianalytic.coefficients import READINGS

@@ -7,7 +7,6 @@ velocity range, and a resolution check of the table.
 
 from __future__ import annotations
 
-import math
 from pathlib import Path
 
 import numpy as np

@@ -283,7 +283,6 @@ crystal its sigma_1 and sigma_2 exceed Table 2 by the same ratio (1.1580 rectang
 parallelogram), which is (1 + 1/8) times eq. (25) or (24) at m = n = 25 -- i.e. i = 2 with
 Phi_1 = Phi_0.
 """)
-    by_name = {s.spec.name: s for s in a.studies}
     for s in a.studies:
         doc.add(f"### {s.spec.title}")
         if s.spec.name == "table5" and a.table5_fits:

@@ -125,3 +125,32 @@ def json_safe(obj: Any) -> Any:
     if obj is None or isinstance(obj, (str, int, bool)):
         return obj
     return json.loads(json.dumps(obj, default=str))
+
+
+def report_command(prog: str, description: str, filename: str, build, argv: list[str] | None = None) -> int:
+    """``main`` shared by the report modules: ``--out DIR [--force]``.
+
+    ``build(out) -> (markdown, {png name: bytes})``; the figures and then the report are
+    written atomically; an existing report is kept unless ``--force`` (exit status 2).
+    """
+    import argparse
+    import sys
+
+    from semianalytic.io import check_report_target
+
+    parser = argparse.ArgumentParser(prog=prog, description=description)
+    parser.add_argument("--out", default="reports", help="output folder (default reports/)")
+    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+    args = parser.parse_args(argv)
+    out = Path(args.out)
+    try:
+        target = check_report_target(out / filename, args.force)
+        text, figs = build(out)
+        for name, data in figs.items():
+            atomic_write_bytes(out / name, data)
+        atomic_write_text(target, text)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2
+    print(f"wrote {target}")
+    return 0

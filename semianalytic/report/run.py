@@ -15,7 +15,6 @@ import json
 import time
 from pathlib import Path
 
-from semianalytic.errors import InputError
 from semianalytic.report.case import ANALYSES
 
 

@@ -166,7 +166,7 @@ def _added_mass_run(ctx: Context) -> None:
     from semianalytic import exact
     from semianalytic.bem import solve_body
     from semianalytic.geometry import body_from_section
-    from semianalytic.report.figures import Points, Series, line_figure
+    from semianalytic.report.figures import Series, line_figure
 
     b = ctx.case.body
     meridian = body_from_section(b)

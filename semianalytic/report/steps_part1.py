@@ -16,7 +16,7 @@ from semianalytic.report.case import RunSection
 from semianalytic.report.context import Context
 from semianalytic.report.document import fmt
 from semianalytic.report.figures import Points, Series, line_figure, panels_figure, side_by_side_figure
-from semianalytic.report.steps import Step, _coefficient_table, _has, _mm, _projectile, register, table_available
+from semianalytic.report.steps import Step, _coefficient_table, _has, _projectile, register, table_available
 
 MM = 1e3  # m -> mm for display
 # Integration tolerance of the report's ODE solves: 1e-9 relative is five orders below the four

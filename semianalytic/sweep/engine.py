@@ -21,9 +21,9 @@ import shutil
 import sys
 import time
 from collections import defaultdict
-from dataclasses import dataclass, field
+from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Iterable, Mapping, Sequence
+from typing import Any, Callable, Mapping
 
 import numpy as np
 
@@ -31,7 +31,7 @@ from semianalytic.case import Case, load_case, parse_case
 from semianalytic.errors import InputError
 from semianalytic.io import atomic_write_json
 from semianalytic.sweep.kernels import Kernel, select_kernel
-from semianalytic.sweep.spec import Axis, SweepSpec, apply_overrides, raw_value
+from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
 from semianalytic.sweep.store import ResultStore, results_path
 
 BASE_COLUMNS = ("case_id", "status", "message")
