@@ -81,7 +81,7 @@ def _geometry(x, r, x1, r1, delta=None):
 
 
 def single_double(x, r, x1, r1, nx1, nr1, delta=None):
-    """Single-layer and double-layer ring kernels.
+    """Single-layer and double-layer ring kernels (Part I, eqs. (20)-(22); errata items 1, 1a).
 
     S = integral over the ring of G r1 dtheta = r1 K(m) / (pi sqrt(D)),
     Dl = integral of dG/dn1 r1 dtheta with n1 = (nx1, nr1) the normal at the source
@@ -143,7 +143,7 @@ def k_minus_e_over_m(m):
 
 
 def gradient_kernels(x, r, x1, r1):
-    """Gradients at the target (x, r) of the single layer and of a vortex ring.
+    """Gradients at the target (x, r) of the single layer and of a vortex ring (Part I, eq. (23)).
 
     Returns (Sx, Sr, Wx, Wr):
 

@@ -107,6 +107,8 @@ def _solve(layout: HalfspaceLayout, plan) -> SurfaceSolution:
 
 
 def _combine(center: SurfaceSolution, sols, weights, h) -> DepthCoefficients:
+    """Part I, eqs. (9), (12): B = int (+-|grad phi|^2 + 2 phi'_P) n_x dS in the three readings,
+    with phi'_P following the body (chain rule for nodes that slide along it) or a target point."""
     s = center.nodes
     phi_nodes = [c.nodes for c in sols]
     dphi_node = sum(w * n.phi for w, n in zip(weights, phi_nodes)) / h
