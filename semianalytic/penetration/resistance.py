@@ -29,6 +29,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
+from typing import TYPE_CHECKING
 from typing import Annotated, Any, Literal, Union
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator
@@ -36,6 +37,9 @@ from scipy import integrate
 
 from semianalytic.errors import InputError
 from semianalytic.units import Length, NonNegativePressure, Pressure
+
+if TYPE_CHECKING:
+    from semianalytic.cavity.material import BrittleMaterial
 
 __all__ = [
     "elastic_plastic_resistance",
@@ -208,31 +212,16 @@ class Part4:
 
 @dataclass(frozen=True)
 class Cavity:
-    """The Part II brittle cavity-expansion pressure (semianalytic.cavity), in Pa."""
+    """The Part II brittle cavity-expansion pressure R_r of Part II, eq. (34), in Pa."""
 
-    youngs_modulus: float
-    poisson_ratio: float
-    tensile_strength: float
-    compressive_strength: float
-    bulk_modulus: float | None = None
-    initial_porosity: float = 0.0
+    material: "BrittleMaterial"
     name = "cavity"
-    equation = "Part II (cavity pressure)"
+    equation = "Part II, eq. (34)"
 
     def pressure(self, diameter: float | None = None) -> float:
-        try:
-            from semianalytic.cavity import BrittleMaterial, solve_cavity
-        except ImportError:
-            raise InputError("target.resistance.model", "the Part II cavity model is not available in this version") from None
-        material = BrittleMaterial(
-            youngs_modulus=self.youngs_modulus,
-            poisson_ratio=self.poisson_ratio,
-            tensile_strength=self.tensile_strength,
-            compressive_strength=self.compressive_strength,
-            bulk_modulus=self.bulk_modulus,
-            initial_porosity=self.initial_porosity,
-        )
-        return float(solve_cavity(material).cavity_pressure)
+        from semianalytic.cavity import solve_cavity
+
+        return float(solve_cavity(self.material).cavity_pressure)
 
 
 @dataclass(frozen=True)
@@ -338,14 +327,16 @@ class CavityInput(_Input):
     _check_nu = field_validator("poisson_ratio")(_nu)
 
     def build(self) -> Cavity:
-        return Cavity(
-            self.youngs_modulus,
-            self.poisson_ratio,
-            self.tensile_strength,
-            self.compressive_strength,
-            self.bulk_modulus,
-            self.initial_porosity,
-        )
+        from semianalytic.cavity.material import BrittleMaterial
+
+        return Cavity(BrittleMaterial(
+            youngs_modulus=self.youngs_modulus,
+            poisson_ratio=self.poisson_ratio,
+            tensile_strength=self.tensile_strength,
+            compressive_strength=self.compressive_strength,
+            bulk_modulus=self.bulk_modulus,
+            initial_porosity=self.initial_porosity,
+        ))
 
 
 class ConstantInput(_Input):
