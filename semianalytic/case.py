@@ -20,9 +20,12 @@ from dataclasses import dataclass, field
 from pathlib import Path
 from typing import Any, Literal, Mapping
 
-from pydantic import BaseModel, ConfigDict, Field, ValidationError, field_validator, model_validator
+from pydantic import BaseModel, Field, field_validator, model_validator
 
 from semianalytic.errors import InputError
+from semianalytic.penetration.case import ResistanceField
+from semianalytic.schema import Section, validate_section
+from semianalytic.schema import pydantic_message as _pydantic_message  # noqa: F401 (old name)
 from semianalytic.units import Angle, Density, Length, Mass, NonNegativeLength, Pressure, Velocity
 
 __all__ = [
@@ -39,12 +42,6 @@ __all__ = [
     "validate_section",
     "SECTIONS",
 ]
-
-
-class Section(BaseModel):
-    """Base of every case-file section: frozen, unknown keys rejected."""
-
-    model_config = ConfigDict(extra="forbid", frozen=True)
 
 
 LengthUnit = Literal["m", "cm", "mm", "um"]
@@ -175,10 +172,11 @@ class ProjectileSection(Section):
 
 
 class TargetSection(Section):
-    """``[target]``: the half-space target.  ``resistance`` is validated by the penetration model."""
+    """``[target]``: the half-space target.  ``resistance``: the schema of
+    :mod:`semianalytic.penetration.case` (a discriminated union on ``model``)."""
 
     density: Density
-    resistance: importlib.import_module("semianalytic.penetration.resistance").ResistanceField | None = None
+    resistance: ResistanceField | None = None
 
 
 class ImpactSection(Section):
@@ -253,33 +251,6 @@ class Case:
         if out is None:
             raise InputError(name, f"the case has no [{name}] section, which this analysis needs")
         return out
-
-
-def _pydantic_message(err: dict) -> str:
-    msg = err.get("msg", "invalid")
-    typ = err.get("type", "")
-    if typ == "missing":
-        return "missing (required)"
-    if typ == "extra_forbidden":
-        return "unknown key"
-    for prefix in ("Value error, ", "Assertion failed, "):
-        if msg.startswith(prefix):
-            msg = msg[len(prefix):]
-    if "input" in err and typ not in ("value_error",) and not isinstance(err["input"], dict):
-        msg = f"{msg}; got {err['input']!r}"
-    return msg
-
-
-def validate_section(name: str, model: type[BaseModel], data: Any) -> Any:
-    """Validate one section's table with ``model``; errors become ``InputError``."""
-    if not isinstance(data, dict):
-        raise InputError(name, f"must be a table [{name}]; got {type(data).__name__}")
-    try:
-        return model.model_validate(data)
-    except ValidationError as exc:
-        err = exc.errors()[0]
-        loc = ".".join(str(p) for p in (name, *err.get("loc", ())))
-        raise InputError(loc, _pydantic_message(err)) from None
 
 
 def _section_model(name: str) -> type[BaseModel]:

@@ -15,6 +15,7 @@ from scipy import integrate, special
 from semianalytic.case import parse_case
 from semianalytic.errors import InputError
 from semianalytic.penetration import resistance as res
+from semianalytic.penetration.case import parse_resistance
 
 Y, E, NU = 400e6, 68.9e9, 0.33
 
@@ -79,7 +80,7 @@ def test_cavity_model_gives_the_part2_example():
     # errata item 19: AD995 with Y_s = 2.62 GPa, theta_0 = 0 gives R_r = 11.6 GPa
     spec = {"model": "cavity", "youngs_modulus": "373.14 GPa", "poisson_ratio": 0.232,
             "tensile_strength": "0.262 GPa", "compressive_strength": "2.62 GPa", "bulk_modulus": "231.8 GPa"}
-    assert res.parse_resistance(spec).pressure() / 1e9 == pytest.approx(11.6, abs=0.05)
+    assert parse_resistance(spec).pressure() / 1e9 == pytest.approx(11.6, abs=0.05)
 
 
 GOOD = {"model": "elastic-plastic", "yield_stress": "400 MPa", "youngs_modulus": "68.9 GPa", "poisson_ratio": 0.33}
@@ -97,7 +98,7 @@ GOOD = {"model": "elastic-plastic", "yield_stress": "400 MPa", "youngs_modulus":
     ],
 )
 def test_each_model_parses(spec, cls):
-    model = res.parse_resistance(spec)
+    model = parse_resistance(spec)
     assert isinstance(model, cls)
     assert model.pressure(7.11e-3) > 0
 
@@ -119,7 +120,7 @@ def test_bad_resistance_names_the_field(patch, field):
     spec = {**GOOD, **patch}
     spec = {k: v for k, v in spec.items() if v is not None}
     with pytest.raises(InputError) as err:
-        res.parse_resistance(spec)
+        parse_resistance(spec)
     assert err.value.field == field
     # and the case loader rejects it up front, naming the key
     case = {"projectile": {"nose": "ogive", "crh": 3.0, "diameter": "7.11 mm", "shank_length": "59.3 mm", "density": "7830 kg/m^3"},

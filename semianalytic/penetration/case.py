@@ -1,4 +1,10 @@
-"""``[data]``: experimental data a penetration case is compared with.
+"""The penetration case sections: ``[target.resistance]`` and ``[data]``.
+
+``[target.resistance]`` is a pydantic discriminated union on its ``model`` key; each input
+validates units and ranges and ``build()`` gives the frozen SI model of
+:mod:`semianalytic.penetration.resistance` (see its table of models and keys).
+
+``[data]``: experimental data a penetration case is compared with.
 
 Either a CSV file of shots (striking velocity, depth of penetration, optionally the measured
 projectile mass), or a measured critical impact velocity (the Appendix's inverse problem), or
@@ -23,12 +29,27 @@ both.  Example (the Piekutowski et al. 1999 shots bundled in ``cases/``)::
 
 from __future__ import annotations
 
-from pydantic import Field, model_validator
+import math
+from typing import Annotated, Any, Literal, Union
 
-from semianalytic.case import Section
-from semianalytic.units import Pressure, Velocity
+from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator, model_validator
 
-__all__ = ["DataSection"]
+from semianalytic.errors import InputError
+from semianalytic.penetration.resistance import (
+    MODELS,
+    Brittle,
+    Cavity,
+    Constant,
+    ElasticPlastic,
+    Hardening,
+    Limestone,
+    Part4,
+    Resistance,
+)
+from semianalytic.schema import Section, pydantic_message
+from semianalytic.units import Length, NonNegativePressure, Pressure, Velocity
+
+__all__ = ["DataSection", "ResistanceSpec", "ResistanceField", "parse_resistance", "MODELS"]
 
 _NAME = r"^[A-Za-z0-9_.-]+$"
 
@@ -65,3 +86,172 @@ class DataSection(Section):
         for key, kind in (("velocity_unit", "velocity"), ("depth_unit", "length"), ("mass_unit", "mass")):
             parse_quantity(f"1 {getattr(self, key)}", kind, f"data.{key}")
         return self
+
+
+# --------------------------------------------------------------------------------------
+# case-file input: a discriminated union on ``model``
+
+
+class _Input(BaseModel):
+    model_config = ConfigDict(extra="forbid", frozen=True)
+
+
+def _nu(v):
+    if not (-1.0 < v < 0.5):
+        raise ValueError(f"must lie in (-1, 0.5); got {v!r}")
+    return v
+
+
+class ElasticPlasticInput(_Input):
+    model: Literal["elastic-plastic"]
+    yield_stress: Pressure
+    youngs_modulus: Pressure
+    poisson_ratio: float
+    _check_nu = field_validator("poisson_ratio")(_nu)
+
+    def build(self) -> ElasticPlastic:
+        if not self.youngs_modulus > 3 * self.yield_stress * (1 - self.poisson_ratio):
+            raise InputError("target.resistance.youngs_modulus", "eq. (16) needs E > 3 Y (1 - nu) (a positive logarithm)")
+        return ElasticPlastic(self.yield_stress, self.youngs_modulus, self.poisson_ratio)
+
+
+class BrittleInput(_Input):
+    model: Literal["brittle"]
+    compressive_strength: Pressure
+    tensile_strength: Pressure
+    youngs_modulus: Pressure
+    poisson_ratio: float
+    alpha: float = Field(gt=0.0, description="characteristic of the fractured medium (dimensionless)")
+    _check_nu = field_validator("poisson_ratio")(_nu)
+
+    def build(self) -> Brittle:
+        if not (1 - self.poisson_ratio) * math.sqrt(self.tensile_strength / (2 * self.compressive_strength)) < 1:
+            raise InputError(
+                "target.resistance.tensile_strength",
+                "eq. (17) needs (1 - nu) sqrt(tensile_strength / (2 compressive_strength)) < 1",
+            )
+        return Brittle(self.compressive_strength, self.tensile_strength, self.youngs_modulus, self.poisson_ratio, self.alpha)
+
+
+class HardeningInput(_Input):
+    model: Literal["hardening"]
+    yield_stress: Pressure
+    youngs_modulus: Pressure
+    hardening_exponent: float = Field(ge=0.0, lt=1.0, description="n of the power law, 0 <= n < 1")
+
+    def build(self) -> Hardening:
+        if not self.youngs_modulus > 1.5 * self.yield_stress:
+            raise InputError("target.resistance.youngs_modulus", "eq. (18) needs E > 3Y/2")
+        return Hardening(self.yield_stress, self.youngs_modulus, self.hardening_exponent)
+
+
+class LimestoneInput(_Input):
+    model: Literal["limestone"]
+    psi: NonNegativePressure = 607e6
+    phi: NonNegativePressure = 86e6
+    reference_diameter: Length = 25.4e-3
+
+    def build(self) -> Limestone:
+        return Limestone(self.psi, self.phi, self.reference_diameter)
+
+
+class Part4Input(_Input):
+    model: Literal["part4"]
+    yield_stress: Pressure
+    youngs_modulus: Pressure
+
+    def build(self) -> Part4:
+        if not self.youngs_modulus > 1.5 * self.yield_stress:
+            raise InputError("target.resistance.youngs_modulus", "Part IV, eq. (6) needs E > 3Y/2")
+        return Part4(self.yield_stress, self.youngs_modulus)
+
+
+class CavityInput(_Input):
+    model: Literal["cavity"]
+    youngs_modulus: Pressure
+    poisson_ratio: float
+    tensile_strength: Pressure
+    compressive_strength: Pressure
+    bulk_modulus: Pressure | None = None
+    initial_porosity: float = Field(default=0.0, ge=0.0, lt=1.0)
+    _check_nu = field_validator("poisson_ratio")(_nu)
+
+    def build(self) -> Cavity:
+        from semianalytic.cavity.material import BrittleMaterial
+
+        return Cavity(BrittleMaterial(
+            youngs_modulus=self.youngs_modulus,
+            poisson_ratio=self.poisson_ratio,
+            tensile_strength=self.tensile_strength,
+            compressive_strength=self.compressive_strength,
+            bulk_modulus=self.bulk_modulus,
+            initial_porosity=self.initial_porosity,
+        ))
+
+
+class ConstantInput(_Input):
+    model: Literal["constant"]
+    value: Pressure
+
+    def build(self) -> Constant:
+        return Constant(self.value)
+
+
+ResistanceSpec = Annotated[
+    Union[
+        ElasticPlasticInput, BrittleInput, HardeningInput, LimestoneInput, Part4Input, CavityInput, ConstantInput
+    ],
+    Field(discriminator="model"),
+]
+"""The ``[target.resistance]`` table (a pydantic discriminated union on ``model``)."""
+
+
+
+def _builds(spec):
+    """Case-load check: the inputs must give a model (e.g. eq. (16)'s logarithm positive)."""
+    try:
+        spec.build()
+    except InputError as exc:
+        raise ValueError(f"{exc.field.rsplit('.', 1)[-1]}: {exc.message}") from None
+    return spec
+
+
+ResistanceField = Annotated[ResistanceSpec, AfterValidator(_builds)]
+"""The annotation of ``TargetSection.resistance`` in :mod:`semianalytic.case`."""
+
+_ADAPTER = TypeAdapter(ResistanceSpec)
+
+
+def _message(err: dict) -> str:
+    if err.get("type") in ("union_tag_invalid", "union_tag_not_found"):
+        inp = err.get("input")
+        got = f"; got {inp.get('model')!r}" if isinstance(inp, dict) and "model" in inp else ""
+        return f"'model' must be one of {', '.join(MODELS)}{got}"
+    return pydantic_message(err)
+
+
+def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
+    """Validate a ``[target.resistance]`` table and build its model (SI).
+
+    Raises :class:`InputError` naming the field (``target.resistance.yield_stress``) and what
+    was expected.  An already-parsed input model is accepted too.
+    """
+    if isinstance(data, (ElasticPlasticInput, BrittleInput, HardeningInput, LimestoneInput, Part4Input, CavityInput, ConstantInput)):
+        spec = data
+    else:
+        if not isinstance(data, dict):
+            raise InputError(field, f"must be a table with a 'model' key ({', '.join(MODELS)})")
+        try:
+            spec = _ADAPTER.validate_python(data)
+        except ValidationError as exc:
+            err = exc.errors()[0]
+            loc = [str(p) for p in err.get("loc", ())]
+            if loc and loc[0] in MODELS:  # drop the union tag from the path
+                loc = loc[1:]
+            if err.get("type") in ("union_tag_invalid", "union_tag_not_found"):
+                loc = ["model"]
+            raise InputError(".".join([field, *loc]), _message(err)) from None
+    try:
+        return spec.build()
+    except InputError as exc:
+        raise InputError(exc.field.replace("target.resistance", field, 1), exc.message) from None
