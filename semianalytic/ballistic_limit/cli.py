@@ -11,9 +11,8 @@ from __future__ import annotations
 import argparse
 import json
 import math
-from pathlib import Path
 
-__all__ = ["add_arguments", "run", "evaluate_case"]
+__all__ = ["add_arguments", "run"]
 
 COLUMNS = [("V_R1_m_s", "V(R1)"), ("V_R2_m_s", "V(R2)"), ("V_R3_m_s", "V(R3)"),
            ("V_eq7_m_s", "V(7)"), ("V_eq8_m_s", "V(8)"), ("V_eq9_m_s", "V(9)")]
@@ -24,50 +23,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print one JSON object (keys carry units)")
 
 
-def evaluate_case(case) -> dict:
-    """All shots of a loaded case, evaluated; a JSON-ready dict."""
-    from semianalytic.ballistic_limit.shots import critical_values, empirical_limits, theoretical_limits
-    from semianalytic.ballistic_limit.tables import load_shots
-    from semianalytic.errors import InputError
-
-    section = case.require("ballistic_limit")
-    shots = []
-    if section.table is not None:
-        base = case.path.parent if case.path is not None else Path.cwd()
-        path = (base / section.table).resolve()
-        if not path.is_file():
-            raise InputError("ballistic_limit.table", f"file {section.table!r} not found next to the case file")
-        shots += load_shots(path)
-    shots += [s.to_shot(section.projectile_density) for s in section.shots]
-    rows = []
-    for shot in shots:
-        row = {"name": shot.name}
-        if shot.measured is not None:
-            row["measured_V_m_s"] = shot.measured
-            if shot.measured_qualifier:
-                row["measured_qualifier"] = shot.measured_qualifier
-        row.update(theoretical_limits(shot, section.hardness))
-        row.update(empirical_limits(shot, section.constants, section.areal_mass))
-        crit = [critical_values(shot, v, section.constants) for v in section.critical_velocities]
-        if any(crit):
-            row["critical"] = [c for c in crit if c]
-        rows.append(row)
-    return {
-        "case": case.title,
-        "hardness_rule": section.hardness,
-        "areal_mass_rule": section.areal_mass,
-        "constants": section.constants.to_json(),
-        "projectile_density_kg_m3": section.projectile_density,
-        "rows": rows,
-    }
-
-
 def _fmt(value) -> str:
     return "-" if value is None or not math.isfinite(value) else f"{value:.0f}"
 
 
 def run(args) -> int:
     from semianalytic.case import load_case
+
+    from semianalytic.ballistic_limit.evaluate import evaluate_case
 
     case = load_case(args.case)
     result = evaluate_case(case)

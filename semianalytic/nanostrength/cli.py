@@ -16,11 +16,9 @@ import time
 from pathlib import Path
 
 from semianalytic.case import load_case
-from semianalytic.errors import InputError
 from semianalytic.io import check_report_target
 from semianalytic.nanostrength import data
-from semianalytic.nanostrength.analysis import Analysis, analyse
-from semianalytic.nanostrength.interplanar import CalibrationError
+from semianalytic.nanostrength.analysis import Analysis, analyse_section
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
@@ -28,21 +26,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the results as JSON (units in the keys)")
     parser.add_argument("--report", metavar="DIR", help="write DIR/<case stem>.md and its PNG figures")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
-
-
-def compute(section) -> Analysis:
-    """Run the analysis of a validated ``[nanostrength]`` section; a crystal the law cannot be
-    calibrated to is an InputError naming it."""
-    crystals = section.crystals()
-    custom = [c.name for c in section.crystal]
-    try:
-        out = analyse(crystals, section.studies(), law=section.law, measure=section.stress_measure,
-                      odd_surface_ratio=section.odd_surface_ratio)
-    except CalibrationError as exc:
-        field = f"nanostrength.crystal.{custom.index(exc.crystal)}" if exc.crystal in custom else "nanostrength.materials"
-        raise InputError(field, str(exc)) from None
-    out.options.update({"surface_energy": section.surface_energy, "deformation_energy": section.deformation_energy})
-    return out
 
 
 def _summary(a: Analysis, title: str) -> str:
@@ -89,7 +72,7 @@ def run(args: argparse.Namespace) -> int:
     stem = Path(args.case).stem
     if args.report:
         check_report_target(Path(args.report) / f"{stem}.md", args.force)
-    analysis = compute(section)
+    analysis = analyse_section(section)
     if args.report:
         from semianalytic.nanostrength.report import build_report, write_report
 

@@ -8,7 +8,11 @@ Modules: :mod:`.resistance`, :mod:`.motion`, :mod:`.rod`, :mod:`.elastic`, :mod:
 imports :mod:`.resistance` while it loads).
 """
 
-__all__ = ["sweep_support"]
+__all__ = ["sweep_support", "W1_MODELS"]
+
+# lateral-compression energy W1 of eq. (28): closed forms in P (also in the vectorised curve);
+# here so that the command's --help needs no numpy
+W1_MODELS = ("neglect", "bound", "static")
 
 
 def sweep_support(case, coefficients, striking_velocities, full: bool = False):

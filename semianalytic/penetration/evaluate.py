@@ -1,0 +1,76 @@
+"""All Part I results of one case for the ``penetrate`` command: final depth and time of the
+rigid, quasi-rigid and elastic projectiles (eq. (11); eqs. (26), (29)/(30'); errata item 5),
+the critical impact velocity U_sC (eqs. (33)/(36)), the peer models and, with a ``[data]``
+section, the dynamic yield stress from a measured U_sC (Appendix) and the measured depths.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+
+import numpy as np
+
+from semianalytic.errors import InputError
+
+__all__ = ["evaluate_case"]
+
+
+def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None) -> dict:
+    """All results of one case as a JSON-able dict (SI units in the keys)."""
+    from semianalytic.penetration import critical as crit
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+    from semianalytic.penetration.motion import deep_coefficients
+    from semianalytic.penetration.resistance import resistance_from_case
+    from semianalytic.penetration.validation import error_statistics, load_shots, peer_depths, predict_shots
+
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+    if setup.rod is None:
+        raise InputError("projectile.youngs_modulus", "missing: the elastic projectile needs it (e.g. '210 GPa')")
+    data = case.section("data")
+    out: dict = {"case": str(case.path) if case.path else case.title, "title": case.title}
+    if data is not None and data.critical_velocity is not None:
+        phi = setup.phi
+        psec = case.projectile
+        if psec.buckling == "johnson-euler":
+            lam = crit.slenderness(setup.rod.length, setup.rod.diameter)
+            phi = lambda Y: float(crit.johnson_euler_phi(lam, psec.youngs_modulus, Y))  # noqa: E731
+        Y_inv = crit.yield_stress_from_critical_velocity(data.critical_velocity, setup.critical_inputs(), phi)
+        out["measured_critical_velocity_m_s"] = data.critical_velocity
+        out["yield_stress_from_critical_velocity_Pa"] = Y_inv
+        if setup.yield_stress is None:
+            setup = dataclasses.replace(setup, yield_stress=Y_inv)
+            if psec.buckling != "none":
+                setup = dataclasses.replace(setup, phi=phi(Y_inv) if callable(phi) else phi)
+    if setup.yield_stress is None:
+        raise InputError("projectile.yield_stress", "missing: U_sC needs the dynamic yield stress (e.g. '1.5 GPa') "
+                         "or a measured [data] critical_velocity")
+    U = np.asarray(case.impact.striking_velocities if velocities is None else velocities, float)
+    res = penetration_curve(setup, U, w1=w1)
+    A, B, C = deep_coefficients(coefficients)
+    area = math.pi * setup.rod.diameter**2 / 4
+    resistance = resistance_from_case(case)
+    out.update(
+        {
+            "resistance_model": resistance.name,
+            "resistance_equation": resistance.equation,
+            "resistance_Pa": setup.resistance_pa,
+            "mass_kg": setup.mass,
+            "length_m": setup.rod.length,
+            "yield_stress_Pa": setup.yield_stress,
+            "buckling_factor": setup.phi,
+            "deep_A_bar_m": A / area,
+            "deep_B_bar": B / area,
+            "deep_C_bar": C / area,
+            "w1": w1,
+        }
+    )
+    for key, val in res.items():
+        out[key] = np.asarray(val).tolist()
+    pe = peer_depths(case, setup, U)
+    out["depth_forrestal_m"] = pe["forrestal"].tolist()
+    out["depth_chen_li_m"] = pe["chen_li"].tolist()
+    if data is not None and data.file is not None:
+        rows = predict_shots(case, coefficients, load_shots(case), w1=w1)
+        out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}
+    return out
