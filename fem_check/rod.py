@@ -236,11 +236,10 @@ def driven_study(case, rod: Rod, n_elements: int = 400, courant: float = 2**-0.5
 def _coefficients_for(nose):
     """Drag coefficients for the nose: the BEM table if it exists, else the paper's constants."""
     try:
-        from semianalytic.coefficients.table import cached_coefficient_table
+        import semianalytic.coefficients.table  # noqa: F401 (the BEM table is available)
+        from semianalytic.cache import cached_coefficient_table
 
-        from fem_check.meshing import cache_dir
-
-        return cached_coefficient_table(nose, cache_dir=cache_dir() / "bem_tables"), "BEM table (body reading)"
+        return cached_coefficient_table(nose), "BEM table (body reading)"
     except ImportError:
         from semianalytic.coefficients import ConstantCoefficients
 

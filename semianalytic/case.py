@@ -208,7 +208,7 @@ SECTIONS: dict[str, str] = {
     "ballistic_limit": "semianalytic.ballistic_limit.case:BallisticLimitSection",
     "nanostrength": "semianalytic.nanostrength.case:NanostrengthSection",
     "data": "semianalytic.penetration.case:DataSection",
-    "run": "semianalytic.report.case:RunSection",
+    "run": "semianalytic.run.case:RunSection",
 }
 
 _CORE = {

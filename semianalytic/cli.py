@@ -23,7 +23,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "ballistic-limit": ("semianalytic.ballistic_limit.cli", "ballistic limit velocity (Part IV)"),
     "fit-constants": ("semianalytic.ballistic_limit.fit_cli", "refit the empirical constants C1, C2, C3 (Part IV, eqs. 7-9)"),
     "nanostrength": ("semianalytic.nanostrength.cli", "theoretical strength of diamond-like nanoparticles (Part III)"),
-    "run": ("semianalytic.report.run", "run everything a case asks for and write a report"),
+    "run": ("semianalytic.run.cli", "run everything a case asks for and write a report"),
     "sweep": ("semianalytic.sweep.cli", "parallel parameter sweeps and Monte-Carlo studies"),
     "demo": ("semianalytic.demo", "run the main job on a bundled case and say where its report is"),
 }

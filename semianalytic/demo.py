@@ -20,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args: argparse.Namespace) -> int:
     from semianalytic.errors import InputError
-    from semianalytic.report.run import run_case
+    from semianalytic.run.pipeline import run_case
 
     if not CASE.is_file():
         raise InputError("case", f"the bundled demo case {CASE} is missing (run from a checkout of the project)")

@@ -18,6 +18,7 @@ import pytest
 pv = pytest.importorskip("pyvista")
 
 from semianalytic import exact  # noqa: E402
+from semianalytic.bem import field as bemfield  # noqa: E402
 from semianalytic.report import vtk  # noqa: E402
 
 A = 1.0  # sphere radius
@@ -39,8 +40,8 @@ def _exact_velocity_3d(p):
 def sphere_files(tmp_path_factory):
     d = tmp_path_factory.mktemp("vtk")
     inside = lambda x, r: x**2 + r**2 <= A**2 * (1 + 1e-9)  # noqa: E731
-    g = vtk.meridian_grid(-3.0, 3.0, 3.0, 41, 21, inside)
-    f = vtk.evaluate_field(
+    g = bemfield.meridian_grid(-3.0, 3.0, 3.0, 41, 21, inside)
+    f = bemfield.evaluate_field(
         g,
         lambda p: np.column_stack(exact.sphere_gradient(p[:, 0], p[:, 1], A)),
         U,
@@ -92,7 +93,7 @@ def test_bem_field_in_the_file(tmp_path):
 
     nose = ogive_nose(7.11e-3, 3.0)
     length, P, u = 71.1e-3, 35.9e-3, 900.0
-    field, sol = vtk.projectile_field(nose, length, P, u, extent=1.5, grid=(13, 7), order=6)
+    field, sol = bemfield.projectile_field(nose, length, P, u, extent=1.5, grid=(13, 7), order=6)
     path = vtk.write_vtu(vtk.revolved_mesh(field, 8), tmp_path / "f.vtu")
     mesh = pv.read(path)
     p = np.asarray(mesh.points)
@@ -108,7 +109,7 @@ def test_bem_field_in_the_file(tmp_path):
     # same BEM, same points: equal to round-off of the float64 write/read (1e-10 relative)
     np.testing.assert_allclose(v[pick], ref, rtol=1e-10, atol=1e-10 * np.abs(ref).max())
     # no node inside the projectile or the hole
-    inside = vtk.projectile_inside(nose, length, P)
+    inside = bemfield.projectile_inside(nose, length, P)
     assert not np.any(inside(p[:, 0], np.hypot(p[:, 1], p[:, 2])))
 
 
@@ -116,16 +117,19 @@ def test_fem_field_file(tmp_path):
     """fem_check's FEM potential written as .vtu: read back, it holds the FEM nodal values, and
     near the nose it agrees with the BEM (an independent method) to the FEM's accuracy."""
     pytest.importorskip("fem_check.potential")
+    from fem_check.api import potential_field
     from fem_check.meshing import MeshOptions, build_mesh, halfspace_domain
     from fem_check.potential import solve_potential
 
     from semianalytic.bem import solve_halfspace
     from semianalytic.geometry import ogive_nose
+    from semianalytic.run.fields import bem_at_vertices
 
     nose, P, u = ogive_nose(7.11e-3, 3.0), 35.9e-3, 900.0
     opts = MeshOptions(h=0.16, far=8.0)
     sol = solve_potential(build_mesh(halfspace_domain(nose, P, opts), opts), "monopole")
-    path = vtk.write_vtu(vtk.fem_meridian_mesh(sol, u, solve_halfspace(nose, P)), tmp_path / "fem.vtu")
+    fem = potential_field(sol)
+    path = vtk.write_vtu(vtk.fem_meridian_mesh(fem, u, bem_at_vertices(fem, solve_halfspace(nose, P))), tmp_path / "fem.vtu")
     mesh = pv.read(path)
     vert = sol.basis.nodal_dofs[0]
     shift = np.array([getattr(sol, "shift", 0.0), 0.0])  # fem_check may work in tip-centred x

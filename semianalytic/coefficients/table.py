@@ -12,11 +12,9 @@ the tail of the table by a least-squares fit in 1/P.
 from __future__ import annotations
 
 import bisect
-import hashlib
 import json
 import math
 from dataclasses import dataclass, field, replace
-from pathlib import Path
 
 import numpy as np
 from scipy.interpolate import PchipInterpolator
@@ -214,8 +212,8 @@ class CoefficientTable:
 
     # --- persistence ------------------------------------------------------------------
 
-    def to_npz(self, path: str | Path) -> None:
-        from semianalytic.io import atomic_write_bytes
+    def to_npz_bytes(self) -> bytes:
+        """The table as the bytes of an ``.npz`` archive (persisted by :mod:`semianalytic.cache`)."""
         import io
 
         keys = list(self.nodes[0])
@@ -233,11 +231,12 @@ class CoefficientTable:
             **{f"v_{k}": v for k, v in self.values.items()},
             **{f"n_{k}": np.concatenate([n[k] for n in self.nodes]) for k in keys},
         )
-        atomic_write_bytes(path, buf.getvalue())
+        return buf.getvalue()
 
     @classmethod
-    def from_npz(cls, path: str | Path) -> "CoefficientTable":
-        with np.load(path, allow_pickle=False) as z:
+    def from_npz(cls, source) -> "CoefficientTable":
+        """The table from an ``.npz`` archive (a path or a binary file object)."""
+        with np.load(source, allow_pickle=False) as z:
             meta = json.loads(str(z["meta"]))
             if meta.get("version") != TABLE_VERSION:
                 raise ValueError("coefficient table cache has another version")
@@ -303,37 +302,3 @@ def coefficient_table(
         nodes=tuple(r.nodes for r in rows),
         options={"order": order, "refinement": refinement, "levels": levels},
     )
-
-
-def table_key(nose: Nose, **options) -> str:
-    """Content hash of the geometry and the numerical options (the cache key)."""
-    payload = json.dumps(
-        {"nose": [nose.kind, nose.diameter, nose.length, _jsonable(nose.parameters)], "options": options,
-         "version": TABLE_VERSION},
-        sort_keys=True,
-    )
-    return hashlib.sha256(payload.encode()).hexdigest()[:20]
-
-
-def _jsonable(obj):
-    if isinstance(obj, dict):
-        return {k: _jsonable(v) for k, v in sorted(obj.items())}
-    if isinstance(obj, (list, tuple)):
-        return [_jsonable(v) for v in obj]
-    if isinstance(obj, float):
-        return repr(obj)
-    return obj
-
-
-def cached_coefficient_table(nose: Nose, cache_dir: str | Path = ".cache/coefficients", **options) -> CoefficientTable:
-    """:func:`coefficient_table`, cached on disk under a content hash of geometry and options."""
-    cache_dir = Path(cache_dir)
-    path = cache_dir / f"{table_key(nose, **{k: v for k, v in options.items() if k != 'progress'})}.npz"
-    if path.exists():
-        try:
-            return CoefficientTable.from_npz(path)
-        except (ValueError, KeyError, OSError):
-            pass
-    table = coefficient_table(nose, **options)
-    table.to_npz(path)
-    return table

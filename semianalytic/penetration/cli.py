@@ -39,7 +39,7 @@ def add_arguments(parser) -> None:
     )
     parser.add_argument("--w1", choices=W1_MODELS, default="neglect",
                         help="lateral-compression energy W1 of eq. (28) (default: neglect, as the paper)")
-    parser.add_argument("--cache-dir", default=None, help="folder of the cached coefficient tables")
+    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
     parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
@@ -111,7 +111,7 @@ def _print_text(result: dict, desc: str, file=None) -> None:
 
 def run(args) -> int:
     from semianalytic.io import check_report_target
-    from semianalytic.penetration.curve import coefficients_for_case
+    from semianalytic.cache import coefficients_for_case
     from semianalytic.penetration.evaluate import evaluate_case
 
     cases = _load(args.cases)

@@ -35,7 +35,7 @@ from semianalytic.penetration.elastic import (
 from semianalytic.penetration.motion import DepthProfile, deep_coefficients, depth_profile
 from semianalytic.penetration.rod import Rod
 
-__all__ = ["PenetrationSetup", "penetration_curve", "sweep_support", "paper_coefficients", "coefficients_for_case"]
+__all__ = ["PenetrationSetup", "penetration_curve", "sweep_support", "paper_coefficients"]
 
 
 # The deep-penetration coefficients the paper quotes (section 2 and Appendix; errata item 2):
@@ -304,46 +304,3 @@ def sweep_support(case, coefficients, striking_velocities, full: bool = False) -
     if full:
         keys += ["depth_quasi_rigid_m", "depth_elastic_m", "depth_elastic_exact_rod_m"]
     return {k: res[k] for k in keys}
-
-
-def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False):
-    """(coefficients, description, fallback) for a case.
-
-    ``source="bem"``: the BEM table of the case's nose (cached on disk), in the B reading of
-    ``[coefficients] reading`` (errata item 2a); ``"paper"``: the paper's quoted constants
-    (:func:`paper_coefficients`).  ``fallback`` is True when "bem" was asked for but the table
-    module is not available (then the paper's constants are used).
-    """
-    psec = case.require("projectile")
-    if source == "paper":
-        return paper_coefficients(psec), "the paper's quoted deep-penetration Abar, Bbar, Cbar (constant in P)", False
-    if source != "bem":
-        raise InputError("coefficients", f"must be 'bem' or 'paper'; got {source!r}")
-    try:
-        from semianalytic.coefficients.table import cached_coefficient_table
-    except ImportError:
-        return (
-            paper_coefficients(psec),
-            "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",
-            True,
-        )
-    from semianalytic.geometry import nose_from_section
-
-    kwargs = dict(
-        order=case.bem.order,
-        n_depths=case.coefficients.depths,
-        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
-        progress=progress,
-    )
-    refinement = getattr(case.bem, "refinement", None)
-    if refinement is not None:  # else the table's own default
-        kwargs["refinement"] = refinement
-    if cache_dir is not None:
-        kwargs["cache_dir"] = cache_dir
-    table = cached_coefficient_table(nose_from_section(psec), **kwargs).with_reading(case.coefficients.reading)
-    ref = f"refinement {refinement:g}" if refinement is not None else "default refinement"
-    desc = (
-        f"BEM table (order {case.bem.order}, {ref}, {case.coefficients.depths} depths "
-        f"to {case.coefficients.max_depth_nose_lengths:g} nose lengths, B reading '{case.coefficients.reading}')"
-    )
-    return table, desc, False

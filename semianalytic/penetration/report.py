@@ -128,7 +128,7 @@ class _Context:
         self.rows = OrderedDict()
 
     def coefficients(self, case):
-        from semianalytic.penetration.curve import coefficients_for_case
+        from semianalytic.cache import coefficients_for_case
 
         key = id(case)
         if key not in self._coef:

@@ -1,16 +1,12 @@
-"""Velocity fields as VTK unstructured grids (``.vtu``, written with meshio) and an
-off-screen pyvista render.
+"""Velocity fields already computed, as VTK unstructured grids (``.vtu``, written with meshio),
+and an off-screen pyvista render.  Nothing here computes a field.
 
-The field is Part I, eq. (8)/(23): ``v = -u grad(phi)`` with phi from the BEM
-(:func:`semianalytic.bem.solve_halfspace`), on a grid of the meridian half-plane (x, r)
-around the projectile at depth P (target frame: free surface x = 0, tip at x = P; Figs.
-12-13).  Nodes inside the projectile or the entry hole are left out (their cells too).
-The grid is written twice: as the meridian plane (quads, z = 0, velocity (v_x, v_r, 0)) and
-revolved about the x axis (hexahedra, wedges on the axis) with the 3D velocity
-``(v_x, v_r cos(theta), v_r sin(theta))`` at ``(x, r cos(theta), r sin(theta))``.
-
-Everything here takes the field as a callable ``gradient(points (M, 2)) -> (M, 2)``, so the
-same code exports an exact solution (tests) or a FEM field.
+The BEM field comes as a :class:`semianalytic.bem.field.FieldOnGrid` (Part I, eq. (8)/(23)
+on a grid of the meridian half-plane; nodes inside the projectile or the entry hole are NaN
+and left out with their cells).  It is written twice: as the meridian plane (quads, z = 0,
+velocity (v_x, v_r, 0)) and revolved about the x axis (hexahedra, wedges on the axis) with the
+3D velocity ``(v_x, v_r cos(theta), v_r sin(theta))`` at ``(x, r cos(theta), r sin(theta))``.
+The FEM field comes as fem_check's :class:`fem_check.api.PotentialField` (vertex values).
 """
 
 from __future__ import annotations
@@ -18,90 +14,22 @@ from __future__ import annotations
 import math
 import os
 import tempfile
-from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
 
+if TYPE_CHECKING:
+    from semianalytic.bem.field import FieldOnGrid
+
 __all__ = [
-    "MeridianGrid",
-    "FieldOnGrid",
-    "meridian_grid",
-    "evaluate_field",
     "meridian_mesh",
     "revolved_mesh",
     "revolved_surface",
     "write_vtu",
-    "projectile_inside",
-    "projectile_field",
     "fem_meridian_mesh",
     "render_png",
 ]
-
-
-@dataclass(frozen=True)
-class MeridianGrid:
-    """Tensor grid of the meridian half-plane; ``fluid[i, j]`` marks nodes in the target."""
-
-    x: np.ndarray  # (nx,) [m]
-    r: np.ndarray  # (nr,) [m], r[0] = 0 (the axis)
-    fluid: np.ndarray  # (nx, nr) bool
-
-    @property
-    def points(self) -> np.ndarray:
-        """All nodes as (nx*nr, 2) of (x, r), x slowest."""
-        X, R = np.meshgrid(self.x, self.r, indexing="ij")
-        return np.column_stack([X.ravel(), R.ravel()])
-
-
-@dataclass(frozen=True)
-class FieldOnGrid:
-    """Velocity (and potential) at the grid nodes; NaN outside the fluid.  SI units."""
-
-    grid: MeridianGrid
-    vx: np.ndarray  # (nx, nr) [m/s]
-    vr: np.ndarray  # (nx, nr) [m/s]
-    phi: np.ndarray | None  # (nx, nr) unit-speed potential [m]
-    speed_u: float  # projectile speed u [m/s] used in v = -u grad(phi)
-    depth: float | None = None  # P [m]
-
-
-def meridian_grid(x0: float, x1: float, r1: float, nx: int, nr: int, inside: Callable | None = None) -> MeridianGrid:
-    """Grid on [x0, x1] x [0, r1]; ``inside(x, r) -> bool array`` marks non-fluid nodes."""
-    if not (x1 > x0 and r1 > 0 and nx >= 2 and nr >= 2):
-        raise ValueError("empty grid")
-    x = np.linspace(x0, x1, nx)
-    r = np.linspace(0.0, r1, nr)
-    X, R = np.meshgrid(x, r, indexing="ij")
-    fluid = np.ones_like(X, dtype=bool) if inside is None else ~np.asarray(inside(X, R), dtype=bool)
-    return MeridianGrid(x, r, fluid)
-
-
-def evaluate_field(
-    grid: MeridianGrid,
-    gradient: Callable[[np.ndarray], np.ndarray],
-    u: float,
-    potential: Callable[[np.ndarray], np.ndarray] | None = None,
-    depth: float | None = None,
-    chunk: int = 2000,
-) -> FieldOnGrid:
-    """v = -u grad(phi) (Part I, eq. (8)/(23)) at the fluid nodes, in chunks of points."""
-    pts = grid.points
-    mask = grid.fluid.ravel()
-    vx = np.full(len(pts), np.nan)
-    vr = np.full(len(pts), np.nan)
-    ph = np.full(len(pts), np.nan) if potential is not None else None
-    idx = np.flatnonzero(mask)
-    for s in range(0, len(idx), chunk):
-        sel = idx[s : s + chunk]
-        g = np.asarray(gradient(pts[sel]), dtype=float)
-        vx[sel] = -u * g[:, 0]
-        vr[sel] = -u * g[:, 1]
-        if potential is not None:
-            ph[sel] = np.asarray(potential(pts[sel]), dtype=float)
-    shape = grid.fluid.shape
-    return FieldOnGrid(grid, vx.reshape(shape), vr.reshape(shape), None if ph is None else ph.reshape(shape), u, depth)
 
 
 def _quad_cells(fluid: np.ndarray) -> np.ndarray:
@@ -251,120 +179,36 @@ def write_vtu(mesh, path: str | os.PathLike) -> Path:
 
 
 # --------------------------------------------------------------------------------------
-# the projectile in the target
-
-
-def projectile_inside(nose, length: float, depth: float, tol: float = 1e-9):
-    """``inside(x, r)`` for the projectile of total ``length`` (nose + shank) with its tip at
-    x = depth, and the entry hole behind it (x < depth - length, r < d/2): the non-fluid part."""
-    prof = np.vstack([seg_pts for seg_pts in _nose_profile(nose)])
-    s_back = -prof[:, 0]  # distance behind the tip
-    order = np.argsort(s_back, kind="stable")
-    s_back, r_prof = s_back[order], prof[order, 1]
-    R = 0.5 * nose.diameter
-    L_h = nose.length
-
-    def inside(x, r):
-        x, r = np.asarray(x, float), np.asarray(r, float)
-        s = depth - x
-        rp = np.where(s <= L_h, np.interp(s, s_back, r_prof), R)
-        body = (s >= -tol * R) & (s <= length) & (r <= rp * (1 + tol) + tol * R)
-        hole = (x >= 0) & (s > length) & (r <= R * (1 + tol))
-        return body | hole
-
-    return inside
-
-
-def _nose_profile(nose, n: int = 400):
-    for seg in nose.segments:
-        t = np.linspace(seg.t0, seg.t1, n)
-        x, r = seg.point(t)
-        yield np.column_stack([np.asarray(x, float) * np.ones_like(t), np.asarray(r, float) * np.ones_like(t)])
-
-
-def projectile_outline(nose, length: float, depth: float) -> np.ndarray:
-    """Closed meridian outline (x, r) of the projectile in the target frame (tip at x = depth)."""
-    prof = np.vstack(list(_nose_profile(nose, 120)))
-    R = 0.5 * nose.diameter
-    tail = np.array([[-length, R], [-length, 0.0]])
-    out = np.vstack([prof, tail])
-    out[:, 0] += depth
-    return out
-
-
-def field_window(nose, length: float, depth: float, extent: float) -> tuple[float, float, float]:
-    """(x0, x1, r1): ``extent`` diameters around the nose, clipped to the target x >= 0."""
-    d = nose.diameter
-    x0 = max(0.0, depth - nose.length - extent * d)
-    x1 = depth + extent * d
-    r1 = max(extent * d, 0.75 * d)
-    return x0, x1, r1
-
-
-def projectile_field(
-    nose,
-    length: float,
-    depth: float,
-    u: float,
-    *,
-    extent: float = 2.0,
-    grid: tuple[int, int] = (49, 25),
-    order: int = 8,
-    refinement: float | None = None,
-    solution=None,
-):
-    """BEM velocity field around the projectile at depth P: Part I, eq. (23).
-
-    Returns ``(field, solution)``; ``solution`` is the :func:`semianalytic.bem.solve_halfspace`
-    result (pass one in to reuse it).
-    """
-    from semianalytic.bem import solve_halfspace
-
-    opts = {"order": order} if refinement is None else {"order": order, "refinement": refinement}
-    sol = solution if solution is not None else solve_halfspace(nose, depth, **opts)
-    x0, x1, r1 = field_window(nose, length, depth, extent)
-    g = meridian_grid(x0, x1, r1, grid[0], grid[1], projectile_inside(nose, length, depth))
-    return evaluate_field(g, sol.gradient, u, sol.potential, depth=depth), sol
+# FEM fields of fem_check
 
 
 # --------------------------------------------------------------------------------------
 # FEM fields of fem_check
 
 
-def fem_meridian_mesh(solution, u: float, reference=None, exclude_tags=("body", "wall")):
-    """A fem_check :class:`~fem_check.potential.PotentialSolution` in the meridian plane as a
-    meshio mesh: the mesh's vertices (x, r, 0), its triangles, point data ``phi`` (FEM, unit
-    speed) [m], ``velocity`` = -u grad(phi) (L2 projection of the FEM gradient onto the FEM
-    space, Part I eq. (8)) [m/s] and ``speed``.  With ``reference`` (a BEM solution with
-    ``potential(points)``), also ``phi_bem`` and ``phi_difference`` = FEM - BEM at the vertices
-    off the surfaces in ``exclude_tags`` (NaN on them: the BEM field is singular there).
+def fem_meridian_mesh(field, u: float, phi_reference=None):
+    """A FEM potential field in the meridian plane as a meshio mesh.
+
+    ``field``: vertex values of fem_check (:class:`fem_check.api.PotentialField`: ``points``
+    (n, 2) in the target frame [m], ``triangles``, ``phi`` (unit speed) [m], ``gradient`` (n, 2)).
+    Point data: ``phi``, ``velocity`` = -u grad(phi) (Part I, eq. (8)) [m/s] and ``speed``;
+    with ``phi_reference`` (n,) (e.g. the BEM potential at the same vertices, NaN where not
+    defined), also ``phi_bem`` and ``phi_difference`` = FEM - reference.
     """
     import meshio
 
-    basis = solution.basis
-    vert = basis.nodal_dofs[0]
-    # fem_check may solve in x - shift (tip-centred); the file is in the target frame
-    shift = float(getattr(solution, "shift", 0.0))
-    pts2 = basis.doflocs[:, vert].T + np.array([shift, 0.0])
-    tri = solution.dm.mesh.t[:3].T
-    ip = basis.interpolate(solution.phi)
-    gx = basis.project(ip.grad[0])[vert]
-    gr = basis.project(ip.grad[1])[vert]
-    phi = solution.phi[vert]
-    vel = np.column_stack([-u * gx, -u * gr, np.zeros(len(vert))])
+    pts2 = np.asarray(field.points, float)
+    phi = np.asarray(field.phi, float)
+    grad = np.asarray(field.gradient, float)
+    vel = np.column_stack([-u * grad[:, 0], -u * grad[:, 1], np.zeros(len(phi))])
     pdata = {"phi": phi, "velocity": vel, "speed": np.hypot(vel[:, 0], vel[:, 1])}
-    if reference is not None:
-        on = np.zeros(len(vert), dtype=bool)
-        for tag in exclude_tags:
-            if tag in solution.dm.boundaries:
-                nodes = solution.dm.facet_nodes(solution.dm.boundaries[tag])
-                on[nodes[nodes < len(vert)]] = True
-        ref = np.full(len(vert), np.nan)
-        ref[~on] = reference.potential(pts2[~on])
+    if phi_reference is not None:
+        ref = np.asarray(phi_reference, float)
         pdata["phi_bem"] = ref
         pdata["phi_difference"] = phi - ref
-    pts = np.column_stack([pts2, np.zeros(len(vert))])
-    return meshio.Mesh(pts, [("triangle", tri)], point_data=pdata, field_data={"speed_u_m_s": np.array([u])})
+    pts = np.column_stack([pts2, np.zeros(len(phi))])
+    return meshio.Mesh(pts, [("triangle", np.asarray(field.triangles))], point_data=pdata,
+                       field_data={"speed_u_m_s": np.array([u])})
 
 
 # --------------------------------------------------------------------------------------

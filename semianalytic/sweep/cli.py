@@ -44,7 +44,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "default: a local cluster")
     parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--batch-size", type=int, default=None, help="cases per task (default: automatic)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache (default: the project's)")
+    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted sweep in --out")
     parser.add_argument("--force", action="store_true", help="discard existing results in --out")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")

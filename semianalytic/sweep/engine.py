@@ -6,7 +6,7 @@ dask; for small runs and tests).  The client process is the only writer of the r
 file, so appends never interleave.  Shared resources (coefficient tables) are prepared once
 per geometry, before the batches run, and sent to the workers with the tasks; the tables
 themselves are cached on disk by the content hash of the geometry and the BEM options
-(:func:`semianalytic.coefficients.table.cached_coefficient_table`), so a velocity sweep solves
+(:func:`semianalytic.cache.cached_coefficient_table`), so a velocity sweep solves
 the BEM once, and a second sweep on the same geometry not at all.
 """
 

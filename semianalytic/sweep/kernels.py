@@ -55,8 +55,8 @@ def geometry_key(case: Case) -> str:
 
 def coefficient_table_for(case: Case, cache_dir=None, progress: bool = False):
     """The (cached) A, B, C table of the case's nose, in the B reading the case selects
-    (:func:`semianalytic.penetration.curve.coefficients_for_case` with source "bem")."""
-    from semianalytic.penetration.curve import coefficients_for_case
+    (:func:`semianalytic.cache.coefficients_for_case` with source "bem")."""
+    from semianalytic.cache import coefficients_for_case
 
     return coefficients_for_case(case, "bem", cache_dir=cache_dir, progress=progress)[0]
 

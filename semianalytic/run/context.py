@@ -8,10 +8,10 @@ from dataclasses import dataclass, field
 from typing import Any
 
 from semianalytic.case import Case
-from semianalytic.report.case import RunSection
 from semianalytic.report.document import Document
 from semianalytic.report.figures import png_bytes
 from semianalytic.report.output import StagedDir
+from semianalytic.run.case import RunSection
 
 
 @dataclass

@@ -12,11 +12,11 @@ import numpy as np
 
 from semianalytic.case import Case
 from semianalytic.errors import InputError
-from semianalytic.report.case import RunSection
-from semianalytic.report.context import Context
 from semianalytic.report.document import fmt
 from semianalytic.report.figures import Points, Series, line_figure, panels_figure, side_by_side_figure
-from semianalytic.report.steps import Step, _coefficient_table, _has, _projectile, register, table_available
+from semianalytic.run.case import RunSection
+from semianalytic.run.context import Context
+from semianalytic.run.registry import Step, _coefficient_table, _has, _projectile, register, table_available
 
 MM = 1e3  # m -> mm for display
 # Integration tolerance of the report's ODE solves: 1e-9 relative is five orders below the four
@@ -32,13 +32,13 @@ US = 1e6  # s -> us
 def coefficients(ctx: Context):
     """The DragCoefficients of this run (memoised): the BEM table, or with
     ``[run] coefficients = "paper"`` the paper's quoted deep-penetration constants
-    (:func:`semianalytic.penetration.curve.coefficients_for_case`)."""
+    (:func:`semianalytic.cache.coefficients_for_case`)."""
     if "coefficients" in ctx.memo:
         return ctx.memo["coefficients"]
     if ctx.run.coefficients == "bem" and table_available():
         c = _coefficient_table(ctx)
     else:
-        from semianalytic.penetration.curve import coefficients_for_case
+        from semianalytic.cache import coefficients_for_case
 
         c, desc, fallback = coefficients_for_case(ctx.case, ctx.run.coefficients, cache_dir=ctx.cache_dir)
         why = "`[run] coefficients = \"paper\"`" if not fallback else "the BEM table is not available in this version"

@@ -1,5 +1,5 @@
 """Part III and Part IV steps of a ``run``: the ballistic limit velocity (Part IV, through
-:func:`semianalytic.ballistic_limit.cli.evaluate_case`) and the theoretical strength of
+:func:`semianalytic.ballistic_limit.evaluate.evaluate_case`) and the theoretical strength of
 nanoparticles (Part III, through :mod:`semianalytic.nanostrength`)."""
 
 from __future__ import annotations
@@ -9,11 +9,11 @@ import math
 import numpy as np
 
 from semianalytic.case import Case
-from semianalytic.report.case import RunSection
-from semianalytic.report.context import Context
 from semianalytic.report.document import fmt
 from semianalytic.report.figures import Points, Series, line_figure
-from semianalytic.report.steps import Step, _has, register
+from semianalytic.run.case import RunSection
+from semianalytic.run.context import Context
+from semianalytic.run.registry import Step, _has, register
 
 # --------------------------------------------------------------------------------------
 # Part IV: ballistic limit velocity
@@ -29,7 +29,7 @@ _BL_COLUMNS = [
 
 
 def _bl_evaluate(case: Case) -> dict:
-    from semianalytic.ballistic_limit.cli import evaluate_case
+    from semianalytic.ballistic_limit.evaluate import evaluate_case
 
     return evaluate_case(case)
 
@@ -93,7 +93,7 @@ def _bl_run(ctx: Context) -> None:
     ctx.results["ballistic_limit"] = res
 
 
-register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.ballistic_limit.cli",),
+register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.ballistic_limit.evaluate",),
               _has("ballistic_limit"), _bl_preflight, _bl_run))
 
 
@@ -108,11 +108,11 @@ def _nano_preflight(case: Case, run: RunSection) -> None:
 
 
 def _nano_run(ctx: Context) -> None:
-    from semianalytic.nanostrength.cli import compute
+    from semianalytic.nanostrength.analysis import analyse_section
     from semianalytic.nanostrength.report import build_report
 
     section = ctx.case.require("nanostrength")
-    a = compute(section)
+    a = analyse_section(section)
     o = a.options
     doc = ctx.doc
     doc.heading("Theoretical strength of diamond-like crystals and nanoparticles (Part III)")
@@ -158,5 +158,5 @@ def _nano_run(ctx: Context) -> None:
     ctx.results["nanostrength"] = a.to_json()
 
 
-register(Step("nanostrength", "Theoretical strength", ("nanostrength",), ("semianalytic.nanostrength.cli",),
+register(Step("nanostrength", "Theoretical strength", ("nanostrength",), ("semianalytic.nanostrength.analysis",),
               _has("nanostrength"), _nano_preflight, _nano_run))

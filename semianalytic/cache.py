@@ -1,0 +1,126 @@
+"""The per-user cache of coefficient tables A(P), B(P), C(P) (one idea: build once, reuse).
+
+A table is stored as ``<key>.npz`` where the key is a content hash of
+
+- the geometry (nose kind, diameter, nose length and every shape parameter),
+- the numerical options (order, refinement, levels, depths, ...) and
+- the code version (:data:`semianalytic.coefficients.table.TABLE_VERSION`, bumped when the
+  numerics change),
+
+so a changed nose, option or numerics never reads a stale table.  The folder is, in order:
+an explicit ``cache_dir`` (the commands' ``--cache-dir``), ``$SEMIANALYTIC_CACHE_DIR``, or
+the per-user cache folder of platformdirs (``~/.cache/semianalytic`` on Linux), sub-folder
+``coefficients``.  Commands never write a cache into the working directory.  Files are
+written atomically; an unreadable or other-version file is rebuilt.
+
+Used alike by the ``run`` pipeline, the sweeps, the ``penetrate`` command and fem_check.
+"""
+
+from __future__ import annotations
+
+import hashlib
+import json
+import os
+from pathlib import Path
+
+__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case"]
+
+CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
+
+
+def cache_root() -> Path:
+    """``$SEMIANALYTIC_CACHE_DIR`` if set, else the per-user cache folder (platformdirs)."""
+    env = os.environ.get(CACHE_ENV)
+    if env:
+        return Path(env).expanduser()
+    from platformdirs import user_cache_dir
+
+    return Path(user_cache_dir("semianalytic", appauthor=False))
+
+
+def table_dir(cache_dir: str | os.PathLike | None = None) -> Path:
+    """The folder of the coefficient tables: ``cache_dir`` as given, else ``cache_root()/coefficients``."""
+    return Path(cache_dir).expanduser() if cache_dir is not None else cache_root() / "coefficients"
+
+
+def _jsonable(obj):
+    if isinstance(obj, dict):
+        return {k: _jsonable(v) for k, v in sorted(obj.items())}
+    if isinstance(obj, (list, tuple)):
+        return [_jsonable(v) for v in obj]
+    if isinstance(obj, float):
+        return repr(obj)
+    return obj
+
+
+def table_key(nose, **options) -> str:
+    """Content hash of the geometry, the numerical options and the code version (the cache key)."""
+    from semianalytic.coefficients.table import TABLE_VERSION
+
+    payload = json.dumps(
+        {"nose": [nose.kind, nose.diameter, nose.length, _jsonable(nose.parameters)], "options": options,
+         "version": TABLE_VERSION},
+        sort_keys=True,
+    )
+    return hashlib.sha256(payload.encode()).hexdigest()[:20]
+
+
+def cached_coefficient_table(nose, cache_dir: str | os.PathLike | None = None, **options):
+    """:func:`semianalytic.coefficients.table.coefficient_table`, read from the cache when there,
+    else built and stored (atomically) under :func:`table_key`."""
+    from semianalytic.coefficients.table import CoefficientTable, coefficient_table
+    from semianalytic.io import atomic_write_bytes
+
+    path = table_dir(cache_dir) / f"{table_key(nose, **{k: v for k, v in options.items() if k != 'progress'})}.npz"
+    if path.exists():
+        try:
+            return CoefficientTable.from_npz(path)
+        except (ValueError, KeyError, OSError):
+            pass  # another version or a damaged file: rebuild
+    table = coefficient_table(nose, **options)
+    atomic_write_bytes(path, table.to_npz_bytes())
+    return table
+
+
+def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False):
+    """(coefficients, description, fallback) for a case.
+
+    ``source="bem"``: the BEM table of the case's nose (cached on disk), in the B reading of
+    ``[coefficients] reading`` (errata item 2a); ``"paper"``: the paper's quoted constants
+    (:func:`semianalytic.penetration.curve.paper_coefficients`).  ``fallback`` is True when "bem" was asked for but the table
+    module is not available (then the paper's constants are used).
+    """
+    from semianalytic.errors import InputError
+    from semianalytic.penetration.curve import paper_coefficients
+
+    psec = case.require("projectile")
+    if source == "paper":
+        return paper_coefficients(psec), "the paper's quoted deep-penetration Abar, Bbar, Cbar (constant in P)", False
+    if source != "bem":
+        raise InputError("coefficients", f"must be 'bem' or 'paper'; got {source!r}")
+    try:
+        import semianalytic.coefficients.table  # noqa: F401
+    except ImportError:
+        return (
+            paper_coefficients(psec),
+            "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",
+            True,
+        )
+    from semianalytic.geometry import nose_from_section
+
+    kwargs = dict(
+        order=case.bem.order,
+        n_depths=case.coefficients.depths,
+        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
+        progress=progress,
+    )
+    refinement = getattr(case.bem, "refinement", None)
+    if refinement is not None:  # else the table's own default
+        kwargs["refinement"] = refinement
+    table = cached_coefficient_table(nose_from_section(psec), cache_dir, **kwargs).with_reading(case.coefficients.reading)
+    ref = f"refinement {refinement:g}" if refinement is not None else "default refinement"
+    desc = (
+        f"BEM table (order {case.bem.order}, {ref}, {case.coefficients.depths} depths "
+        f"to {case.coefficients.max_depth_nose_lengths:g} nose lengths, B reading '{case.coefficients.reading}')"
+    )
+    return table, desc, False

@@ -1,0 +1,39 @@
+"""``python -m semianalytic run CASE.toml --out DIR [--force]``: every analysis the case asks
+for, into one folder (:func:`semianalytic.run.pipeline.run_case`): ``results.json``,
+``report.md``, ``report.html`` with PNG figures and ``vtk/*.vtu`` fields.
+"""
+
+from __future__ import annotations
+
+import argparse
+import json
+from pathlib import Path
+
+from semianalytic.run.case import ANALYSES
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("case", help="case file (TOML)")
+    parser.add_argument("--out", required=True, help="output folder (created; replaced only with --force)")
+    parser.add_argument("--force", action="store_true", help="replace an existing output folder")
+    parser.add_argument("--only", action="append", choices=ANALYSES, default=None, metavar="ANALYSIS",
+                        help=f"run only these analyses (repeatable; one of: {', '.join(ANALYSES)})")
+    parser.add_argument("--no-render", action="store_true", help="skip the pyvista render (VTK files are still written)")
+    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--json", action="store_true", help="print results.json to stdout as well")
+
+
+def run(args: argparse.Namespace) -> int:
+    from semianalytic.run.pipeline import run_case
+
+    out = Path(args.out)
+    results = run_case(
+        args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir
+    )
+    if args.json:
+        print(json.dumps(results, indent=2, default=str))
+    else:
+        for name, why in results["skipped"].items():
+            print(f"skipped {name}: {why}")
+        print(f"report: {(out / 'report.html').resolve()}")
+    return 0
