@@ -33,11 +33,29 @@ KINDS: dict[str, tuple[str, str, str]] = {
 }
 
 
+def _import_pint():
+    """pint without its optional dask support: pint.compat imports dask.base whenever dask is
+    installed (about 80 ms at every start-up), and the product never hands dask arrays to pint.
+    dask is hidden only while pint loads; importing dask later works as usual."""
+    import sys
+
+    if "pint" in sys.modules or "dask" in sys.modules:
+        import pint
+
+        return pint
+    sys.modules["dask"] = None  # find_spec("dask") -> None, "import dask" -> ImportError
+    try:
+        import pint
+    finally:
+        if sys.modules.get("dask", 0) is None:
+            del sys.modules["dask"]
+    return pint
+
+
 @functools.cache
 def registry():
     """The pint unit registry (built once, on first use: it takes a moment)."""
-    import pint
-
+    pint = _import_pint()
     ureg = pint.UnitRegistry()
     ureg.formatter.default_format = "~P"
     return ureg

@@ -3,16 +3,13 @@ the equation of motion (11), the elastic projectile (eqs. (24)-(30')), the criti
 velocity (eqs. (31)-(36)), peer models and the validation against experiments.
 
 Modules: :mod:`.resistance`, :mod:`.motion`, :mod:`.rod`, :mod:`.elastic`, :mod:`.critical`,
-:mod:`.peers`, :mod:`.curve` (all models for many striking velocities), :mod:`.validation`,
-:mod:`.case`, :mod:`.cli`, :mod:`.report`.  Importing this package is cheap (the case module
-imports :mod:`.resistance` while it loads).
+:mod:`.peers`, :mod:`.curve` (all models for many striking velocities), :mod:`.validation`
+(models); :mod:`.case` (the ``[target.resistance]`` and ``[data]`` schemas), :mod:`.options`;
+:mod:`.evaluate` (everything ``penetrate`` prints), :mod:`.cli`, :mod:`.report`.  Importing this
+package is cheap.
 """
 
-__all__ = ["sweep_support", "W1_MODELS"]
-
-# lateral-compression energy W1 of eq. (28): closed forms in P (also in the vectorised curve);
-# here so that the command's --help needs no numpy
-W1_MODELS = ("neglect", "bound", "static")
+__all__ = ["sweep_support"]
 
 
 def sweep_support(case, coefficients, striking_velocities, full: bool = False):

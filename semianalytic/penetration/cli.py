@@ -29,7 +29,7 @@ JSON_KEYS = (
 
 
 def add_arguments(parser) -> None:
-    from semianalytic.penetration import W1_MODELS
+    from semianalytic.penetration.options import W1_MODELS
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target], [impact]")
     parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
