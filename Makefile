@@ -18,7 +18,9 @@ $(VENV)/.installed: pyproject.toml
 demo: $(VENV)/.installed
 	$(PY) -m semianalytic demo
 
+# The import contracts of pyproject.toml (layers, pure models, fem_check kept apart), then the suite.
 test: $(VENV)/.installed
+	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile
 
 # Long convergence studies and benchmarks; they write into reports/.
