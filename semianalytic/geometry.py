@@ -19,7 +19,6 @@ from dataclasses import dataclass, field
 from functools import cached_property
 
 import numpy as np
-from scipy.interpolate import CubicSpline
 
 from semianalytic.errors import InputError
 
@@ -123,6 +122,8 @@ class SplineCurve:
 
     @cached_property
     def _splines(self):
+        from scipy.interpolate import CubicSpline  # imported when a table shape needs it (start-up time)
+
         x, r = np.array(self.xs), np.array(self.rs)
         s = np.concatenate([[0.0], np.cumsum(np.hypot(np.diff(x), np.diff(r)))])
         return s, CubicSpline(s, x), CubicSpline(s, r)
