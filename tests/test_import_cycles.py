@@ -36,6 +36,16 @@ def test_no_module_imports_itself_back(graph):
     assert not cycles, "import cycles: " + "; ".join(" -> ".join(c) for c in cycles[:5])
 
 
+def test_registered_sections_do_not_import_the_case_module(graph):
+    """semianalytic.case loads the sections of SECTIONS by name (importlib, invisible to the
+    graph); none of them may import semianalytic.case back (that would be a hidden cycle)."""
+    from semianalytic.case import SECTIONS
+
+    for name, target in SECTIONS.items():
+        module = target.partition(":")[0]
+        assert graph.find_shortest_chain(importer=module, imported="semianalytic.case") is None, name
+
+
 def test_the_check_is_imported_only_through_its_api_by_the_pipeline(graph):
     importers = {
         (a, b)

@@ -38,7 +38,7 @@ from pydantic import BeforeValidator, Field, field_validator, model_validator
 
 from semianalytic.ballistic_limit.empirical import PAPER_CONSTANTS, EmpiricalConstants
 from semianalytic.ballistic_limit.shots import PAPER_PROJECTILE_DENSITY, Layer, Shot
-from semianalytic.case import Section
+from semianalytic.schema import Section
 from semianalytic.units import Density, Length, Mass, Pressure, Velocity, registry
 
 __all__ = ["BallisticLimitSection", "ShotSection", "LayerSection"]

@@ -18,7 +18,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator
 
-from semianalytic.case import Section
+from semianalytic.schema import Section
 from semianalytic.units import Pressure
 
 __all__ = ["MaterialSection"]

@@ -41,7 +41,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator, model_validator
 
-from semianalytic.case import Section
+from semianalytic.schema import Section
 from semianalytic.nanostrength import data, mesolayer
 from semianalytic.nanostrength.analysis import StudySpec
 from semianalytic.nanostrength.crystal import Crystal, paper_crystal

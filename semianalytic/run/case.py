@@ -24,7 +24,7 @@ from typing import Literal
 
 from pydantic import Field, field_validator
 
-from semianalytic.case import Section
+from semianalytic.schema import Section
 from semianalytic.units import Length, Velocity
 
 ANALYSES = (
