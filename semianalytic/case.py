@@ -106,6 +106,7 @@ class ProjectileSection(Section):
     youngs_modulus: Pressure | None = None
     poisson_ratio: float | None = None
     yield_stress: Pressure | None = None
+    dynamic_yield_stress: Pressure | None = None  # Y_p of the eroding rod (Alekseevskii-Tate); default: yield_stress
     buckling: Literal["none", "johnson-euler", "table"] = "none"
     buckling_table: list[tuple[float, float]] | None = None
 

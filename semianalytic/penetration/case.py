@@ -94,6 +94,8 @@ class DataSection(Section):
 
 class _Input(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
+    # R_t of the eroding rod (Alekseevskii-Tate, penetration.regime); default: the model's R_t at the projectile's diameter
+    eroding_resistance: Pressure | None = None
 
 
 def _nu(v):

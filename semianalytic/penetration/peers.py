@@ -163,6 +163,9 @@ def tate_penetration(length: float, rod_density: float, rod_strength: float, tar
         a = math.sqrt(2.0 * R_t / rho_t)
         T = 2.0 * rho_p * length / (rho_t * a) * math.atan(V / a)
         return TateResult(P, length, T, False, math.nan)
+    v_stall = math.sqrt(2.0 * (R_t - Y_p) / rho_p) if R_t > Y_p else 0.0
+    if V <= v_stall:  # the target never yields (u = 0): the rod erodes on the surface, no penetration
+        return TateResult(0.0, length * math.exp(-rho_p * V**2 / (2.0 * Y_p)), length * rho_p * V / Y_p, True, 0.0)
 
     def rhs(t, y):
         v, L, _ = y

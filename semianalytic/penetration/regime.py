@@ -1,0 +1,223 @@
+"""One depth curve over the whole velocity range: rigid, deforming and eroding projectiles.
+
+Regimes of a projectile of dynamic yield stress Y_p striking a target of resistance R_t at U_s:
+
+* ``rigid``      U_s < U_y: the projectile stays elastic; Part I's rigid/elastic projectile
+                 (eq. (11); eqs. (26), (29)/(30')) gives the depth.  U_y is the critical impact
+                 velocity U_sC of Part I, eqs. (33)/(36): the axial stress at the start reaches Y_p.
+* ``deforming``  U_y <= U_s < U_e: the nose yields (mushrooms, bends, the rod may turn round)
+                 but the projectile is not consumed.  No model of the band is claimed: the depth
+                 lies between the eroding rod's (a projectile that loses mass as it penetrates)
+                 and the Part I one (a nose that keeps its shape penetrates deepest).  The
+                 regime-aware depth reports the Part I depth, the upper bound (the safe side for
+                 a protection designer), flagged outside its validity; the eroding depth is
+                 reported beside it as the lower bound.
+* ``eroding``    U_s >= U_e: the Alekseevskii-Tate eroding rod (below) gives the depth.
+
+Erosion onset U_e.  The Alekseevskii-Tate rod of the projectile's mass erodes to a residual
+length L_r(U_s) that falls as U_s grows.  The projectile counts as eroding once the model
+consumes it down to less than its nose length l_n: the whole shank has flowed away and what is
+left is a stub, not a penetrator that keeps its identity.  U_e is the lowest U_s >= U_y with
+L_r(U_s) <= l_n (erosion needs a yielding nose, so never below U_y):
+
+    L_r(U_e) = l_n,   U_e = max(U_y, U_e).
+
+Alekseevskii-Tate (Alekseevskii 1966, Tate 1967; Part IV, eq. (1) for the rigid phase):
+rho_p L dv/dt = -Y_p, dL/dt = -(v - u), dP/dt = u,
+(1/2) rho_p (v - u)^2 + Y_p = (1/2) rho_t u^2 + R_t.  With v as the independent variable
+(dt = -rho_p L dv / Y_p) it is a quadrature, used here for all striking velocities at once:
+
+    ln(L_0 / L(v)) = k [I(U_s) - I(v)],    I(v) = int (w - u(w)) dw,   k = rho_p / Y_p
+    P_erosion(U_s) = k L_0 int_{v_e}^{U_s} u(w) exp(-k [I(U_s) - I(w)]) dw
+
+where v_e ends erosion: u = v at v_e = sqrt(2 (Y_p - R_t)/rho_t) if Y_p > R_t (the residual
+rod then penetrates rigidly, P += rho_p L_r / rho_t ln(1 + rho_t v_e^2 / (2 R_t)), Part IV
+eq. (3)), or u = 0 at v_e = sqrt(2 (R_t - Y_p)/rho_p) if Y_p < R_t (the rest erodes on the
+crater floor).  The rod is the cylinder of the projectile's mass and diameter (mass is what
+erodes; for the Piekutowski ogive this is 65.6 mm against the 71.1 mm overall length).
+:func:`semianalytic.penetration.peers.tate_penetration` (time integration) is the check.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+from scipy.integrate import cumulative_simpson
+from scipy.interpolate import CubicSpline
+
+from semianalytic.errors import InputError
+from semianalytic.penetration.peers import tate_interface_velocity
+
+__all__ = [
+    "REGIMES",
+    "ErodingDepth",
+    "eroding_rod_length",
+    "eroding_depth",
+    "erosion_onset_velocity",
+    "classify_regimes",
+    "regime_depth",
+]
+
+REGIMES = ("rigid", "deforming", "eroding")
+
+_GX, _GW = np.polynomial.legendre.leggauss(16)
+
+
+@dataclass(frozen=True)
+class ErodingDepth:
+    """Alekseevskii-Tate outcome per striking velocity (arrays, SI): depth [m], residual rod
+    length [m], the velocity v_e at which erosion ends [m/s] and whether the rod eroded."""
+
+    depth: np.ndarray
+    residual_length: np.ndarray
+    erosion_end_velocity: float
+    eroded: np.ndarray
+
+
+def eroding_rod_length(length: float, nose_length: float, diameter: float, density: float, mass: float | None = None) -> float:
+    """Length [m] of the eroding cylinder: the projectile's mass on its diameter, m / (rho_p pi d^2/4);
+    without a mass, the overall length.  Raises InputError if the rod is not longer than its nose."""
+    for key, val in (("length", length), ("diameter", diameter), ("density", density)):
+        if not (math.isfinite(val) and val > 0):
+            raise InputError(f"projectile.{key}", f"must be positive; got {val!r}")
+    if not nose_length < length:
+        raise InputError("projectile.length", f"the rod ({length * 1e3:.4g} mm) must be longer than its nose "
+                                              f"({nose_length * 1e3:.4g} mm)")
+    if mass is None:
+        return float(length)
+    if not (math.isfinite(mass) and mass > 0):
+        raise InputError("projectile.mass", f"must be positive; got {mass!r}")
+    return float(mass / (density * math.pi * diameter**2 / 4.0))
+
+
+def _erosion_end(rho_p: float, Y_p: float, rho_t: float, R_t: float) -> float:
+    """v_e: u = v (Y_p > R_t) or u = 0 (Y_p < R_t) (module docstring)."""
+    if Y_p > R_t:
+        return math.sqrt(2.0 * (Y_p - R_t) / rho_t)
+    return math.sqrt(2.0 * (R_t - Y_p) / rho_p)
+
+
+def _check_strengths(target_resistance: float, rod_strength: float, target_density: float, density: float):
+    for key, val in (("target.resistance.eroding_resistance", target_resistance),
+                     ("projectile.dynamic_yield_stress", rod_strength),
+                     ("target.density", target_density), ("projectile.density", density)):
+        if not (math.isfinite(val) and val > 0):
+            raise InputError(key, f"must be positive; got {val!r}")
+
+
+class _Quadrature:
+    """I(v) = int_{v_e}^v (w - u(w)) dw on one grid up to the largest velocity (cubic spline)."""
+
+    def __init__(self, v_e, v_max, rho_p, Y_p, rho_t, R_t, n_grid=2048):
+        self.v_e = v_e
+        self.args = (rho_p, Y_p, rho_t, R_t)
+        # grid clustered at v_e, where u(w) has a square-root behaviour for Y_p < R_t
+        s = np.linspace(0.0, 1.0, n_grid + 1)
+        w = v_e + (v_max - v_e) * s**2
+        f = w - tate_interface_velocity(np.maximum(w, 1e-9 * v_max), *self.args)
+        I = cumulative_simpson(f * 2.0 * (v_max - v_e) * s, x=s, initial=0.0)
+        self.spline = CubicSpline(s, I)
+        self.span = v_max - v_e
+
+    def I(self, v):
+        return self.spline(np.sqrt(np.clip((np.asarray(v, float) - self.v_e) / self.span, 0.0, 1.0)))
+
+
+def eroding_depth(striking_velocity, *, length: float, nose_length: float, diameter: float, density: float,
+                  target_density: float, target_resistance: float, rod_strength: float,
+                  mass: float | None = None) -> ErodingDepth:
+    """Alekseevskii-Tate depth of penetration of an eroding rod (module docstring), vectorised.
+
+    Inputs (SI): striking velocities U_s [m/s]; the projectile's overall length, nose length,
+    diameter, density rho_p and optionally its mass (the rod is the cylinder of that mass); the
+    target's density rho_t and eroding resistance R_t [Pa]; the rod's dynamic yield stress
+    Y_p [Pa].  Below v_e (Y_p > R_t) the rod does not erode: rigid penetration, Part IV eq. (3).
+    """
+    _check_strengths(target_resistance, rod_strength, target_density, density)
+    U = np.atleast_1d(np.asarray(striking_velocity, float))
+    if U.size == 0 or np.any(~np.isfinite(U)) or np.any(U <= 0):
+        raise InputError("impact.striking_velocities", "must be positive (m/s)")
+    L0 = eroding_rod_length(length, nose_length, diameter, density, mass)
+    rho_p, Y_p, rho_t, R_t = density, rod_strength, target_density, target_resistance
+    k = rho_p / Y_p
+    v_e = _erosion_end(rho_p, Y_p, rho_t, R_t)
+    depth = np.zeros(U.shape)
+    residual = np.full(U.shape, L0)
+    eroded = U > v_e
+    if Y_p > R_t:  # rigid rod below v_e, Part IV eq. (3)
+        low = ~eroded
+        depth[low] = rho_p * L0 / rho_t * np.log1p(rho_t * U[low] ** 2 / (2.0 * R_t))
+    else:  # u = 0 below v_e: the rod erodes on the surface without penetrating, L = L0 exp(-k U^2/2)
+        low = ~eroded
+        residual[low] = L0 * np.exp(-0.5 * k * U[low] ** 2)
+    if np.any(eroded):
+        Ue = U[eroded]
+        q = _Quadrature(v_e, float(Ue.max()), rho_p, Y_p, rho_t, R_t)
+        IU = q.I(Ue)
+        # P = k L0 int_{v_e}^{U} u(w) exp(-k (I(U) - I(w))) dw; w = v_e + (U - v_e) s^2 (Gauss on 8 panels)
+        edges = np.linspace(0.0, 1.0, 9)
+        s = (edges[:-1, None] + 0.5 * (edges[1:] - edges[:-1])[:, None] * (_GX + 1.0)[None, :]).ravel()
+        ws = (0.5 * (edges[1:] - edges[:-1])[:, None] * _GW[None, :]).ravel()
+        span = (Ue - v_e)[:, None]
+        w = v_e + span * s[None, :] ** 2
+        u = tate_interface_velocity(np.maximum(w, 1e-9 * Ue.max()), rho_p, Y_p, rho_t, R_t)
+        integrand = u * np.exp(-k * (IU[:, None] - q.I(w))) * 2.0 * span * s[None, :]
+        depth[eroded] = k * L0 * np.sum(ws[None, :] * integrand, axis=1)
+        Lr = L0 * np.exp(-k * IU)
+        residual[eroded] = Lr
+        if Y_p > R_t:  # the residual rod penetrates rigidly from v_e (Part IV eqs. (2)-(3))
+            depth[eroded] += rho_p * Lr / rho_t * math.log1p(rho_t * v_e**2 / (2.0 * R_t))
+    return ErodingDepth(depth, residual, v_e, eroded)
+
+
+def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length: float, diameter: float,
+                           density: float, target_density: float, target_resistance: float, rod_strength: float,
+                           mass: float | None = None) -> float:
+    """U_e [m/s]: the lowest U_s >= U_y at which the eroding rod is consumed down to its nose
+    length (module docstring).  NaN if U_y is NaN (no yielding predicted)."""
+    _check_strengths(target_resistance, rod_strength, target_density, density)
+    if not math.isfinite(yield_velocity):
+        return math.nan
+    L0 = eroding_rod_length(length, nose_length, diameter, density, mass)
+    rho_p, Y_p, rho_t, R_t = density, rod_strength, target_density, target_resistance
+    v_e = _erosion_end(rho_p, Y_p, rho_t, R_t)
+    # L_r(U) = L0 exp(-k I(U)) = l_n  <=>  I(U) = ln(L0 / l_n) / k, I increasing
+    target = math.log(L0 / nose_length) * Y_p / rho_p if nose_length > 0 else math.inf
+    if not math.isfinite(target):
+        return math.inf
+    v_hi = max(2.0 * v_e, 1000.0)
+    while True:
+        q = _Quadrature(v_e, v_hi, rho_p, Y_p, rho_t, R_t)
+        if float(q.I(v_hi)) >= target:
+            break
+        v_hi *= 2.0
+        if v_hi > 1e6:
+            return math.inf
+    s = q.spline.solve(target, extrapolate=False)
+    s = s[(s >= 0) & (s <= 1)]
+    onset = v_e + q.span * float(s.min()) ** 2
+    return float(max(onset, yield_velocity))
+
+
+def classify_regimes(striking_velocity, yield_velocity: float, erosion_velocity: float) -> list[str]:
+    """Regime per striking velocity: rigid below U_y, eroding from U_e, deforming between."""
+    U = np.atleast_1d(np.asarray(striking_velocity, float))
+    out = []
+    for v in U:
+        if not (math.isfinite(yield_velocity) and v >= yield_velocity):
+            out.append("rigid")
+        elif math.isfinite(erosion_velocity) and v >= erosion_velocity:
+            out.append("eroding")
+        else:
+            out.append("deforming")
+    return out
+
+
+def regime_depth(regimes, part1_depth, eroding_depth_m) -> np.ndarray:
+    """The regime-aware depth: Part I's in the rigid regime and (as the upper bound) in the
+    deforming band, the eroding rod's in the eroding regime."""
+    p1 = np.asarray(part1_depth, float)
+    er = np.asarray(eroding_depth_m, float)
+    return np.where(np.asarray(regimes) == "eroding", er, p1)
