@@ -47,5 +47,10 @@ def validate_section(name: str, model: type[BaseModel], data: Any) -> Any:
         return model.model_validate(data)
     except ValidationError as exc:
         err = exc.errors()[0]
-        loc = ".".join(str(p) for p in (name, *err.get("loc", ())))
-        raise InputError(loc, pydantic_message(err)) from None
+        parts, node = [name], data
+        for p in err.get("loc", ()):
+            if isinstance(node, dict) and p not in node and node.get("model") == p:
+                continue  # the tag of a discriminated union (e.g. [target.resistance] model), not a key
+            parts.append(str(p))
+            node = node.get(p) if isinstance(node, dict) else None
+        raise InputError(".".join(parts), pydantic_message(err)) from None

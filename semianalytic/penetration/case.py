@@ -25,6 +25,7 @@ both.  Example (the Piekutowski et al. 1999 shots bundled in ``cases/``)::
     cavity_B = 0.983
     cavity_C = 0.940
     critical_velocity = "1000 m/s"        # optional: a measured U_sC -> dynamic yield stress
+    response_column = "regime"            # optional: recorded response per shot (regime confusion table)
 """
 
 from __future__ import annotations
@@ -73,6 +74,7 @@ class DataSection(Section):
     cavity_B: float | None = Field(default=None, ge=0)
     cavity_C: float | None = Field(default=None, ge=0)
     critical_velocity: Velocity | None = None
+    response_column: str | None = Field(default=None, description="column of the recorded response (rigid, curved, eroded, ...)")
 
     @model_validator(mode="after")
     def _complete(self):

@@ -25,6 +25,11 @@ JSON_KEYS = (
     "depth_elastic_exact_rod_m",
     "critical_velocity_m_s",
     "yields",
+    "regime",
+    "depth_m",
+    "depth_eroding_m",
+    "transition_velocity_m_s",
+    "valid",
 )
 
 
@@ -43,6 +48,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
     parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+    parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
+                        default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
+                        "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
 
 
 def _load(paths):
@@ -82,12 +90,16 @@ def _print_text(result: dict, desc: str, file=None) -> None:
         f"  U_sC = {_fmt(Uc, 1, 0)} m/s (eqs. (33)/(36); Y_p = {result['yield_stress_Pa'] / 1e6:.0f} MPa, "
         f"buckling factor {result['buckling_factor']:.3f}); W1: {result['w1']}"
     )
+    p(f"  regimes: rigid below U_sC = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, eroding from U_e = "
+      f"{_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s (Alekseevskii-Tate, Y_p = "
+      f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa), "
+      f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
     head = (
         f"  {'U_s':>7} | {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} | {'elastic exact rod':>17} |"
-        f" {'Forrestal':>9} | {'Chen-Li':>8} | yields"
+        f" {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8} | {'regime':>9} | {'depth':>7} | yields"
     )
     p(head)
-    p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} |")
+    p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8} | {'':>9} | {'P mm':>7} |")
     n = len(result["striking_velocity_m_s"])
     for i in range(n):
         r = {k: result[k][i] for k in (
@@ -100,6 +112,7 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             f" {_fmt(r['depth_elastic_m'], 1e3):>7} {_fmt(r['stop_time_elastic_s'], 1e6):>7} |"
             f" {_fmt(r['depth_elastic_exact_rod_m'], 1e3):>8} {_fmt(r['stop_time_elastic_exact_rod_s'], 1e6):>8} |"
             f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
+            f" {_fmt(result['depth_eroding_m'][i], 1e3):>8} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} |"
             f" {'YES (outside the model)' if r['yields'] else 'no'}"
         )
     val = result.get("validation")
@@ -125,8 +138,10 @@ def run(args) -> int:
         if fallback:
             print("warning: the BEM coefficient table is not available in this version; using the paper's quoted "
                   "constant Abar, Bbar, Cbar instead", file=sys.stderr)
-        results.append(evaluate_case(case, coefficients, w1=args.w1))
+        results.append(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model))
         descs.append(desc)
+        for line in results[-1]["warnings"]:
+            print(f"{line} [{case.path or case.title}]", file=sys.stderr)
     if args.json:
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
         print(json.dumps(objs[0] if len(objs) == 1 else {"cases": objs}, indent=1, allow_nan=True))

@@ -16,13 +16,15 @@ from semianalytic.errors import InputError
 __all__ = ["evaluate_case"]
 
 
-def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None) -> dict:
-    """All results of one case as a JSON-able dict (SI units in the keys)."""
+def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, part1_model: str | None = None) -> dict:
+    """All results of one case as a JSON-able dict (SI units in the keys).  The regime-aware
+    keys (regime, depth_m, depth_eroding_m, transition_velocity_m_s, valid, warnings) come from
+    :func:`.regime_setup.regime_prediction` with the Part I model ``part1_model``."""
     from semianalytic.penetration import critical as crit
     from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
     from semianalytic.penetration.motion import deep_coefficients
     from semianalytic.penetration.resistance import resistance_from_case
-    from semianalytic.penetration.validation import error_statistics, load_shots, peer_depths, predict_shots
+    from semianalytic.penetration.validation import error_statistics, load_shots, peer_depths, predict_shots, rigid_regime_shots
 
     setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
     if setup.rod is None:
@@ -70,7 +72,10 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None) -
     pe = peer_depths(case, setup, U)
     out["depth_forrestal_m"] = pe["forrestal"].tolist()
     out["depth_chen_li_m"] = pe["chen_li"].tolist()
+    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, regime_prediction
+
+    out.update(regime_prediction(case, setup, U, res, pe, part1_model=part1_model or DEFAULT_PART1_MODEL))
     if data is not None and data.file is not None:
-        rows = predict_shots(case, coefficients, load_shots(case), w1=w1)
+        rows = predict_shots(case, coefficients, rigid_regime_shots(case, load_shots(case)), w1=w1)
         out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}
     return out

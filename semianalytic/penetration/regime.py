@@ -187,17 +187,20 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
     target = math.log(L0 / nose_length) * Y_p / rho_p if nose_length > 0 else math.inf
     if not math.isfinite(target):
         return math.inf
-    v_hi = max(2.0 * v_e, 1000.0)
+    v_hi = max(2.0 * v_e, 4000.0)
     while True:
-        q = _Quadrature(v_e, v_hi, rho_p, Y_p, rho_t, R_t)
+        q = _Quadrature(v_e, v_hi, rho_p, Y_p, rho_t, R_t, n_grid=512)
         if float(q.I(v_hi)) >= target:
             break
         v_hi *= 2.0
         if v_hi > 1e6:
             return math.inf
-    s = q.spline.solve(target, extrapolate=False)
-    s = s[(s >= 0) & (s <= 1)]
-    onset = v_e + q.span * float(s.min()) ** 2
+    # I is increasing: invert on the grid, then Newton on the spline
+    x = q.spline.x
+    s = float(np.interp(target, q.spline(x), x))
+    for _ in range(4):
+        s -= (float(q.spline(s)) - target) / float(q.spline(s, 1))
+    onset = v_e + q.span * s**2
     return float(max(onset, yield_velocity))
 
 

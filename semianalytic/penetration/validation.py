@@ -20,7 +20,7 @@ from semianalytic.errors import InputError
 from semianalytic.penetration import peers
 from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
-__all__ = ["MODEL_LABELS", "Shot", "load_shots", "peer_inputs", "predict_shots", "error_statistics"]
+__all__ = ["MODEL_LABELS", "Shot", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
 
 # column key -> label (the Part I models first, then the peers)
 MODEL_LABELS = {
@@ -50,8 +50,9 @@ def _unit_scale(unit: str, kind: str, field: str) -> float:
     return parse_quantity(f"1 {unit}", kind, field)
 
 
-def load_shots(case) -> list[Shot]:
-    """The shots of the case's ``[data]`` CSV in SI units (rows with a depth, kept by ``select``)."""
+def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
+    """The shots of the case's ``[data]`` CSV in SI units (rows with a depth, kept by ``select``;
+    with ``require_depth=False`` also the rows without one, depth NaN)."""
     import pandas as pd
 
     data = case.require("data")
@@ -77,19 +78,28 @@ def load_shots(case) -> list[Shot]:
     m_scale = _unit_scale(data.mass_unit, "mass", "data.mass_unit")
     shots = []
     for i, row in df.iterrows():
-        if row[data.depth_column].strip() == "":
+        no_depth = row[data.depth_column].strip() == ""
+        if no_depth and require_depth:
             continue  # no depth printed (e.g. only a channel length)
         try:
             V = float(row[data.velocity_column]) * v_scale
-            P = float(row[data.depth_column]) * d_scale
+            P = math.nan if no_depth else float(row[data.depth_column]) * d_scale
             m = float(row[data.mass_column]) * m_scale if data.mass_column else None
         except ValueError:
             raise InputError("data.file", f"row {i + 1} of {path.name} has a non-numeric value") from None
-        if not (V > 0 and P > 0 and (m is None or m > 0)):
+        if not (V > 0 and (P > 0 or no_depth) and (m is None or m > 0)):
             raise InputError("data.file", f"row {i + 1} of {path.name}: velocity, depth and mass must be positive")
         shot_id = str(row[data.id_column]) if data.id_column else str(i + 1)
         shots.append(Shot(shot_id, V, P, m, dict(row)))
     return shots
+
+
+def rigid_regime_shots(case, shots: list[Shot]) -> list[Shot]:
+    """The shots whose recorded response (``[data] response_column``) is ``rigid``; all shots
+    when the data name no response column (the case's ``select`` then says which are rigid)."""
+    data = case.section("data")
+    col = data.response_column if data is not None else None
+    return shots if not col else [s for s in shots if s.row.get(col) == "rigid"]
 
 
 def peer_inputs(case, setup: PenetrationSetup):

@@ -1,0 +1,336 @@
+"""The regime-aware prediction of a case (the glue between the case and :mod:`.regime`).
+
+* :func:`eroding_inputs`: the eroding rod's SI inputs from ``[projectile]`` and
+  ``[target.resistance]``, with the stated defaults: ``[projectile] dynamic_yield_stress``
+  (Y_p of the eroding rod) defaults to ``[projectile] yield_stress`` (the Y_p of U_sC, eqs.
+  (33)/(36)); ``[target.resistance] eroding_resistance`` (R_t of the eroding rod) defaults to
+  the R_t of the case's resistance model at the projectile's diameter (the R_t of Part I).
+* :func:`regime_prediction`: per striking velocity the regime, the regime-aware depth, the
+  eroding depth, the transition velocities, per model the validity (``valid``) and the
+  warnings ``penetrate`` prints on stderr.
+* :func:`predict_regimes`, :func:`confusion`, :func:`leave_one_out_eroding`: the shots of a
+  ``[data]`` file (all recorded responses) against the predicted regimes and the eroding depths.
+
+The data's responses map onto the regimes by :data:`RESPONSE_REGIME`: rigid -> rigid; curved,
+exited, turned_around, broken -> deforming (the projectile yielded, bent or broke but did not
+erode); eroded, broken_eroding -> eroding.
+"""
+
+from __future__ import annotations
+
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from semianalytic.errors import InputError
+from semianalytic.penetration import regime as rg
+
+__all__ = [
+    "RESPONSE_REGIME",
+    "PART1_MODELS",
+    "DEFAULT_PART1_MODEL",
+    "VALIDITY_MODELS",
+    "ErodingInputs",
+    "eroding_inputs",
+    "regime_prediction",
+    "predict_regimes",
+    "confusion",
+    "leave_one_out_eroding",
+]
+
+RESPONSE_REGIME = {
+    "rigid": "rigid",
+    "curved": "deforming",
+    "exited": "deforming",
+    "turned_around": "deforming",
+    "broken": "deforming",
+    "eroded": "eroding",
+    "broken_eroding": "eroding",
+}
+
+PART1_MODELS = ("rigid", "quasi_rigid", "elastic", "elastic_exact_rod")
+DEFAULT_PART1_MODEL = "elastic_exact_rod"  # the physically consistent Part I projectile (errata item 5)
+# models whose depths carry a validity flag: the rigid-projectile family and the eroding rod
+VALIDITY_MODELS = (*PART1_MODELS, "forrestal", "chen_li", "eroding")
+_LABEL = {
+    "rigid": "rigid projectile (eq. (11))",
+    "quasi_rigid": "quasi-rigid projectile (eqs. (11)+(26))",
+    "elastic": "elastic projectile, paper's W2 (eqs. (29), (30'))",
+    "elastic_exact_rod": "elastic projectile, exact-rod W2 (errata 5)",
+    "forrestal": "Forrestal (rigid projectile, cavity expansion)",
+    "chen_li": "Chen & Li (rigid projectile)",
+    "eroding": "eroding rod (Alekseevskii-Tate)",
+}
+
+
+@dataclass(frozen=True)
+class ErodingInputs:
+    """SI inputs of :func:`semianalytic.penetration.regime.eroding_depth` (mass per shot)."""
+
+    length: float
+    nose_length: float
+    diameter: float
+    density: float
+    target_density: float
+    target_resistance: float
+    rod_strength: float
+    defaults: tuple[str, ...] = ()
+
+    def kwargs(self, **override) -> dict:
+        d = dict(length=self.length, nose_length=self.nose_length, diameter=self.diameter, density=self.density,
+                 target_density=self.target_density, target_resistance=self.target_resistance,
+                 rod_strength=self.rod_strength)
+        d.update(override)
+        return d
+
+
+def eroding_inputs(case, setup) -> ErodingInputs:
+    """The eroding rod of a case (defaults in the module docstring; ``defaults`` says which were used)."""
+    from semianalytic.geometry import nose_from_section, projectile_from_section
+
+    psec = case.require("projectile")
+    projectile = projectile_from_section(psec)
+    nose = nose_from_section(psec)
+    density = psec.density if psec.density is not None else setup.mass / projectile.volume()
+    used = []
+    Y_p = psec.dynamic_yield_stress
+    if Y_p is None:
+        Y_p = setup.yield_stress
+        if Y_p is None:
+            raise InputError("projectile.dynamic_yield_stress", "missing: the eroding rod needs its dynamic yield stress "
+                                                                "(e.g. '1.6 GPa'; default: projectile.yield_stress)")
+        used.append(f"projectile.dynamic_yield_stress not given: the eroding rod uses Y_p = projectile.yield_stress "
+                    f"= {Y_p / 1e6:.0f} MPa (default)")
+    R_t = getattr(case.target.resistance, "eroding_resistance", None)
+    if R_t is None:
+        R_t = setup.resistance_pa
+        used.append(f"target.resistance.eroding_resistance not given: the eroding rod uses the Part I R_t = "
+                    f"{R_t / 1e6:.0f} MPa (default)")
+    if not nose.length < projectile.length:
+        raise InputError("projectile.length", "the rod must be longer than its nose")
+    return ErodingInputs(float(projectile.length), float(nose.length), float(psec.diameter), float(density),
+                         float(case.target.density), float(R_t), float(Y_p), tuple(used))
+
+
+def _velocities(U, mask) -> str:
+    return ", ".join(f"{u:.0f}" for u in np.asarray(U)[mask])
+
+
+def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
+                      part1_model: str = DEFAULT_PART1_MODEL) -> dict:
+    """Regime-aware results at the striking velocities ``U`` (``curve`` from penetration_curve,
+    ``peers`` the Forrestal / Chen-Li depths): JSON-able dict with ``regime``, ``depth_m``,
+    ``depth_eroding_m``, ``transition_velocity_m_s`` (U_y = U_sC, rigid -> deforming),
+    ``erosion_velocity_m_s`` (U_e, -> eroding), ``residual_length_eroding_m``, ``part1_model``,
+    ``eroding_inputs``, ``valid`` (per model, a list of booleans) and ``warnings`` (lines)."""
+    if part1_model not in PART1_MODELS:
+        raise InputError("--part1-model", f"must be one of {', '.join(PART1_MODELS)}; got {part1_model!r}")
+    U = np.atleast_1d(np.asarray(U, float))
+    ei = eroding_inputs(case, setup)
+    U_y = float(curve["critical_velocity_m_s"][0])
+    U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
+    er = rg.eroding_depth(U, **ei.kwargs(mass=setup.mass))
+    regimes = rg.classify_regimes(U, U_y, U_e)
+    part1 = np.asarray(curve[f"depth_{part1_model}_m"], float)
+    depth = rg.regime_depth(regimes, part1, er.depth)
+    reg = np.asarray(regimes)
+    rigid_ok = reg == "rigid"
+    valid = {k: rigid_ok.tolist() for k in PART1_MODELS}
+    if peers is not None:
+        valid.update({k: rigid_ok.tolist() for k in ("forrestal", "chen_li")})
+    valid["eroding"] = (reg == "eroding").tolist()
+    warnings = []
+    if np.any(~rigid_ok):
+        why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))")
+        for k in valid:
+            if k != "eroding":
+                warnings.append(f"{_LABEL[k]}: depth outside the model's validity at U_s = {_velocities(U, ~rigid_ok)} m/s; {why}")
+    if np.any(reg != "eroding"):
+        why = (f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
+               "rigid or deforming, not eroding" if math.isfinite(U_e) else "no erosion predicted")
+        warnings.append(f"{_LABEL['eroding']}: depth outside the model's validity at U_s = "
+                        f"{_velocities(U, reg != 'eroding')} m/s; {why}")
+    if np.any(reg == "deforming"):
+        warnings.append(f"regime-aware depth_m at U_s = {_velocities(U, reg == 'deforming')} m/s (deforming band "
+                        f"{U_y:.0f} <= U_s < {U_e:.0f} m/s): no model holds; the {_LABEL[part1_model]} depth is given "
+                        "as the upper bound, depth_eroding_m is the lower bound")
+    notes = list(ei.defaults) if np.any(reg != "rigid") else []
+    return {
+        "regime": regimes,
+        "depth_m": depth.tolist(),
+        "depth_eroding_m": er.depth.tolist(),
+        "residual_length_eroding_m": er.residual_length.tolist(),
+        "transition_velocity_m_s": U_y,
+        "erosion_velocity_m_s": U_e,
+        "part1_model": part1_model,
+        "eroding_inputs": {"rod_strength_Pa": ei.rod_strength, "target_resistance_Pa": ei.target_resistance,
+                           "rod_length_m": rg.eroding_rod_length(ei.length, ei.nose_length, ei.diameter, ei.density, setup.mass)},
+        "valid": valid,
+        "warnings": [f"warning: {w}" for w in warnings] + [f"note: {n}" for n in notes],
+    }
+
+
+def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PART1_MODEL) -> list[dict]:
+    """Per shot (each with its own mass): recorded response and regime, predicted regime, the
+    regime-aware, Part I and eroding depths and the measured depth (NaN where the data give only
+    a channel length)."""
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+    data = case.require("data")
+    col = data.response_column
+    base = PenetrationSetup.from_case(case, coefficients)
+    rows = []
+    for shot in shots:
+        setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
+        curve = penetration_curve(setup, [shot.velocity])
+        pred = regime_prediction(case, setup, [shot.velocity], curve, part1_model=part1_model)
+        response = shot.row.get(col, "") if col else ""
+        if col and response not in RESPONSE_REGIME:
+            raise InputError("data.response_column", f"shot {shot.id}: response {response!r} is not one of "
+                                                     f"{', '.join(RESPONSE_REGIME)}")
+        rows.append({
+            "shot": shot.id,
+            "velocity_m_s": shot.velocity,
+            "mass_kg": setup.mass,
+            "measured_m": shot.depth,
+            "response": response,
+            "recorded_regime": RESPONSE_REGIME.get(response),
+            "predicted_regime": pred["regime"][0],
+            "depth_m": pred["depth_m"][0],
+            "part1_m": float(curve[f"depth_{part1_model}_m"][0]),
+            "rigid_m": float(curve["depth_rigid_m"][0]),
+            "eroding_m": pred["depth_eroding_m"][0],
+            "transition_velocity_m_s": pred["transition_velocity_m_s"],
+            "erosion_velocity_m_s": pred["erosion_velocity_m_s"],
+        })
+    return rows
+
+
+def confusion(rows) -> dict[str, dict[str, int]]:
+    """Counts {recorded regime: {predicted regime: n}} over the shots with a recorded response."""
+    out = {r: {p: 0 for p in rg.REGIMES} for r in rg.REGIMES}
+    for row in rows:
+        if row["recorded_regime"] is not None:
+            out[row["recorded_regime"]][row["predicted_regime"]] += 1
+    return out
+
+
+def fit_eroding_parameters(ei: ErodingInputs, shots, start=None) -> tuple[float, float]:
+    """(R_t, Y_p) [Pa] of the eroding rod by least squares on log depth over ``shots``
+    (objects with velocity, depth, mass), from ``start`` (default: the case's values)."""
+    from scipy.optimize import least_squares
+
+    x0 = np.log(start if start is not None else (ei.target_resistance, ei.rod_strength))
+
+    def resid(x):
+        R, Y = np.exp(x)
+        return np.array([math.log(float(rg.eroding_depth(s.velocity, **ei.kwargs(target_resistance=R, rod_strength=Y, mass=s.mass)).depth[0]))
+                         - math.log(s.depth) for s in shots])
+
+    sol = least_squares(resid, x0, bounds=(np.log([1e7, 1e7]), np.log([2e10, 2e10])), x_scale=1.0, diff_step=1e-4)
+    return tuple(float(v) for v in np.exp(sol.x))
+
+
+def leave_one_out_eroding(ei: ErodingInputs, shots) -> list[dict]:
+    """Leave-one-out: for each shot, (R_t, Y_p) fitted on the others and the predicted depth."""
+    out = []
+    for i, s in enumerate(shots):
+        rest = [t for j, t in enumerate(shots) if j != i]
+        R, Y = fit_eroding_parameters(ei, rest)
+        P = float(rg.eroding_depth(s.velocity, **ei.kwargs(target_resistance=R, rod_strength=Y, mass=s.mass)).depth[0])
+        out.append({"shot": s.id, "velocity_m_s": s.velocity, "measured_m": s.depth, "predicted_m": P,
+                    "target_resistance_Pa": R, "rod_strength_Pa": Y, "error": (P - s.depth) / s.depth})
+    return out
+
+
+def recorded_transitions(rows) -> dict[str, float]:
+    """From the shots (sorted by velocity): the last rigid and first non-rigid velocity, the last
+    non-eroding and first eroding one (NaN where the data have none)."""
+    rows = sorted(rows, key=lambda r: r["velocity_m_s"])
+    nan = math.nan
+
+    def first(pred):
+        return next((r["velocity_m_s"] for r in rows if pred(r)), nan)
+
+    def last(pred):
+        return next((r["velocity_m_s"] for r in reversed(rows) if pred(r)), nan)
+
+    return {
+        "last_rigid_m_s": last(lambda r: r["recorded_regime"] == "rigid"),
+        "first_non_rigid_m_s": first(lambda r: r["recorded_regime"] != "rigid"),
+        "last_non_eroding_m_s": last(lambda r: r["recorded_regime"] != "eroding"),
+        "first_eroding_m_s": first(lambda r: r["recorded_regime"] == "eroding"),
+    }
+
+
+def transition_check(predicted: float, below: float, above: float, tolerance: float = 0.10) -> dict:
+    """Whether a predicted transition lies between the recorded ``below`` and ``above`` velocities,
+    or within ``tolerance`` (relative) of the nearer one; the signed distance relative to it."""
+    if not (math.isfinite(predicted) and math.isfinite(below) and math.isfinite(above)):
+        return {"between": False, "within_tolerance": False, "distance": math.nan}
+    if below <= predicted <= above:
+        return {"between": True, "within_tolerance": True, "distance": 0.0}
+    ref = below if predicted < below else above
+    d = (predicted - ref) / ref
+    return {"between": False, "within_tolerance": abs(d) <= tolerance, "distance": d}
+
+
+def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MODEL, velocities=None,
+                      loo: bool = True) -> dict:
+    """Everything the regimes report shows for one case with a ``[data]`` file and a
+    ``response_column``: the shots (all responses) against the predicted regimes, the confusion
+    counts, the recorded and predicted transitions, per recorded regime the errors of the
+    regime-aware depth, the leave-one-out eroding fit on the eroding shots and the curves at
+    ``velocities`` (for the mean shot mass)."""
+    import dataclasses
+
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+    from semianalytic.penetration.validation import load_shots
+
+    shots = load_shots(case, require_depth=False)
+    rows = predict_regimes(case, coefficients, shots, part1_model=part1_model)
+    masses = [r["mass_kg"] for r in rows]
+    setup = PenetrationSetup.from_case(case, coefficients, mass=float(np.mean(masses)) if masses else None)
+    U = np.linspace(300.0, 3200.0, 146) if velocities is None else np.asarray(velocities, float)
+    curve = penetration_curve(setup, U)
+    pred = regime_prediction(case, setup, U, curve, part1_model=part1_model)
+    rec = recorded_transitions(rows)
+    errors = {}
+    for reg in rg.REGIMES:
+        sel = [r for r in rows if r["recorded_regime"] == reg and math.isfinite(r["measured_m"])]
+        if sel:
+            e = np.array([(r["depth_m"] - r["measured_m"]) / r["measured_m"] for r in sel])
+            e1 = np.array([(r["part1_m"] - r["measured_m"]) / r["measured_m"] for r in sel])
+            e2 = np.array([(r["eroding_m"] - r["measured_m"]) / r["measured_m"] for r in sel])
+            errors[reg] = {"n": len(sel), "mean": float(e.mean()), "mean_abs": float(np.abs(e).mean()),
+                           "max_abs": float(np.abs(e).max()), "part1_mean_abs": float(np.abs(e1).mean()),
+                           "eroding_mean_abs": float(np.abs(e2).mean())}
+    out = {
+        "rows": rows,
+        "confusion": confusion(rows),
+        "recorded": rec,
+        "yield_check": transition_check(pred["transition_velocity_m_s"], rec["last_rigid_m_s"], rec["first_non_rigid_m_s"]),
+        "erosion_check": transition_check(pred["erosion_velocity_m_s"], rec["last_non_eroding_m_s"], rec["first_eroding_m_s"]),
+        "errors": errors,
+        "curve": {"U": U, "rigid": curve["depth_rigid_m"], "part1": np.asarray(curve[f"depth_{part1_model}_m"]),
+                  "depth": np.asarray(pred["depth_m"]), "eroding": np.asarray(pred["depth_eroding_m"]),
+                  "regime": pred["regime"]},
+        "prediction": {k: pred[k] for k in ("transition_velocity_m_s", "erosion_velocity_m_s", "eroding_inputs", "part1_model")},
+        "mass_kg": setup.mass,
+    }
+    eroded = [s for s, r in zip(shots, rows) if r["recorded_regime"] == "eroding" and math.isfinite(s.depth)]
+    if loo and len(eroded) >= 3:
+        ei = eroding_inputs(case, setup)
+        loo_rows = leave_one_out_eroding(ei, eroded)
+        R, Y = fit_eroding_parameters(ei, eroded)
+        default = [(r["eroding_m"] - r["measured_m"]) / r["measured_m"] for r in rows
+                   if r["recorded_regime"] == "eroding" and math.isfinite(r["measured_m"])]
+        out["eroding_fit"] = {
+            "loo": loo_rows,
+            "loo_mean_abs": float(np.mean([abs(r["error"]) for r in loo_rows])),
+            "all_shots": {"target_resistance_Pa": R, "rod_strength_Pa": Y},
+            "default_mean_abs": float(np.mean(np.abs(default))),
+        }
+        del dataclasses
+    return out
