@@ -140,11 +140,12 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     if peers is not None:
         valid.update({k: rigid_ok.tolist() for k in ("forrestal", "chen_li")})
     valid["eroding"] = (reg == "eroding").tolist()
+    valid["regime_aware"] = (reg != "deforming").tolist()  # depth_m: no model holds in the deforming band
     warnings = []
     if np.any(~rigid_ok):
         why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))")
         for k in valid:
-            if k != "eroding":
+            if k not in ("eroding", "regime_aware"):
                 warnings.append(f"{_LABEL[k]}: depth outside the model's validity at U_s = {_velocities(U, ~rigid_ok)} m/s; {why}")
     if np.any(reg != "eroding"):
         why = (f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
@@ -283,8 +284,6 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
     counts, the recorded and predicted transitions, per recorded regime the errors of the
     regime-aware depth, the leave-one-out eroding fit on the eroding shots and the curves at
     ``velocities`` (for the mean shot mass)."""
-    import dataclasses
-
     from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
     from semianalytic.penetration.validation import load_shots
 
@@ -319,6 +318,12 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
         "prediction": {k: pred[k] for k in ("transition_velocity_m_s", "erosion_velocity_m_s", "eroding_inputs", "part1_model")},
         "mass_kg": setup.mass,
     }
+    mid = 0.5 * (rec["last_rigid_m_s"] + rec["first_non_rigid_m_s"])
+    if math.isfinite(mid) and setup.rod is not None:  # the Appendix's inverse problem at the recorded transition
+        from semianalytic.penetration.critical import yield_stress_from_critical_velocity
+
+        out["recorded_transition_m_s"] = mid
+        out["yield_stress_for_recorded_transition_Pa"] = yield_stress_from_critical_velocity(mid, setup.critical_inputs(), setup.phi)
     eroded = [s for s, r in zip(shots, rows) if r["recorded_regime"] == "eroding" and math.isfinite(s.depth)]
     if loo and len(eroded) >= 3:
         ei = eroding_inputs(case, setup)
@@ -332,5 +337,4 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
             "all_shots": {"target_resistance_Pa": R, "rod_strength_Pa": Y},
             "default_mean_abs": float(np.mean(np.abs(default))),
         }
-        del dataclasses
     return out

@@ -395,7 +395,7 @@ def _regimes_section(doc, ctx, w, part1_model):
         "(lower bound) and the Part I depth, which `depth_m` reports as the upper bound (flagged invalid). "
         "Recorded responses map onto regimes as: "
         + ", ".join(f"{k} -> {v}" for k, v in RESPONSE_REGIME.items()) + ". Each shot is computed with its own mass.")
-    conf_rows, trans_rows, err_rows, loo_tables = [], [], [], []
+    conf_rows, trans_rows, err_rows, loo_tables, notes = [], [], [], [], []
     total = agree = 0
     for case in cases:
         mat = _material(case)
@@ -424,7 +424,7 @@ def _regimes_section(doc, ctx, w, part1_model):
             ax.text(0.5 * (lo + hi), 0.97, r, transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=8)
         top = max(float(np.nanmax([r["measured_m"] for r in res["rows"]] + [0.0])) * MM * 1.6, 200.0)
         ax.set_ylim(0, top)
-        ax.legend(fontsize=7, loc="center right")
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 0.93))
         doc.image(w.figure(f"depth_velocity_{mat}", fig),
                   f"{case.title}: all shots (markers: recorded response), the regime-aware curve (solid) for the mean "
                   f"shot mass {res['mass_kg'] * 1e3:.2f} g, regimes shaded (U_sC = {Uy:.0f} m/s, U_e = {Ue:.0f} m/s), "
@@ -445,6 +445,12 @@ def _regimes_section(doc, ctx, w, part1_model):
         for r, e in res["errors"].items():
             err_rows.append([mat, r, e["n"], f"{e['mean'] * 100:+.1f}", f"{e['mean_abs'] * 100:.1f}", f"{e['max_abs'] * 100:.1f}",
                              f"{e['part1_mean_abs'] * 100:.1f}", f"{e['eroding_mean_abs'] * 100:.1f}"])
+        if not yc["within_tolerance"] and "yield_stress_for_recorded_transition_Pa" in res:
+            notes.append(f"{mat}: U_sC = {Uy:.0f} m/s misses the recorded transition ({yc['distance'] * 100:+.0f} %). "
+                         f"Eq. (33) gives U_sC^2 proportional to Ybar_p - Rbar_t, so it is very sensitive to the case's "
+                         f"Y_p = {ctx.setup(case).yield_stress / 1e6:.0f} MPa against R_t = {pred['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa: "
+                         f"the Y_p that puts U_sC at the recorded {res['recorded_transition_m_s']:.0f} m/s (the Appendix's "
+                         f"inverse problem) is {res['yield_stress_for_recorded_transition_Pa'] / 1e6:.0f} MPa.")
         fit = res.get("eroding_fit")
         if fit:
             loo_tables.append((mat, fit, pred["eroding_inputs"]))
@@ -462,6 +468,8 @@ def _regimes_section(doc, ctx, w, part1_model):
                "U_e (erosion onset) [m/s]", "recorded last non-eroding / first eroding [m/s]", "U_e against them"], trans_rows,
               caption="Predicted transitions against the recorded responses. Target (issue 17): between the last rigid "
                       "and the first non-rigid shot, or within 10 % of it.")
+    for note in notes:
+        doc.note(note, "warning")
     doc.table(["projectile", "recorded regime", "n", "mean error [%]", "mean |error| [%]", "max |error| [%]",
                f"{part1_model} alone: mean |error| [%]", "eroding rod alone: mean |error| [%]"], err_rows,
               caption="Per recorded regime: error (predicted - measured)/measured of the regime-aware depth, and of "
