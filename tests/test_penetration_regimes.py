@@ -111,6 +111,9 @@ def test_transition_velocity_target(validations):
     v = validations["var4340"]
     assert v["recorded"]["last_rigid_m_s"] == 1237.0 and v["recorded"]["first_non_rigid_m_s"] == 1365.0
     assert v["yield_check"]["within_tolerance"]
+    # the predicted depth drop (U_e) falls where the measured depth falls most: 277 mm at 1493 m/s -> 105 mm at 1585 m/s
+    assert (v["recorded"]["depth_drop_below_m_s"], v["recorded"]["depth_drop_above_m_s"]) == (1493.0, 1585.0)
+    assert v["drop_check"]["between"]
 
 
 def test_eroding_depths_against_measured(validations):

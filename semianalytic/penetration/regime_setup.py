@@ -257,7 +257,12 @@ def recorded_transitions(rows) -> dict[str, float]:
     def last(pred):
         return next((r["velocity_m_s"] for r in reversed(rows) if pred(r)), nan)
 
+    measured = [r for r in rows if math.isfinite(r["measured_m"])]
+    drops = [(a["measured_m"] - b["measured_m"], a["velocity_m_s"], b["velocity_m_s"]) for a, b in zip(measured, measured[1:])]
+    drop = max(drops) if drops else (nan, nan, nan)
     return {
+        "depth_drop_below_m_s": drop[1],  # the largest fall of the measured depth between consecutive shots
+        "depth_drop_above_m_s": drop[2],
         "last_rigid_m_s": last(lambda r: r["recorded_regime"] == "rigid"),
         "first_non_rigid_m_s": first(lambda r: r["recorded_regime"] != "rigid"),
         "last_non_eroding_m_s": last(lambda r: r["recorded_regime"] != "eroding"),
@@ -311,6 +316,7 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
         "recorded": rec,
         "yield_check": transition_check(pred["transition_velocity_m_s"], rec["last_rigid_m_s"], rec["first_non_rigid_m_s"]),
         "erosion_check": transition_check(pred["erosion_velocity_m_s"], rec["last_non_eroding_m_s"], rec["first_eroding_m_s"]),
+        "drop_check": transition_check(pred["erosion_velocity_m_s"], rec["depth_drop_below_m_s"], rec["depth_drop_above_m_s"]),
         "errors": errors,
         "curve": {"U": U, "rigid": curve["depth_rigid_m"], "part1": np.asarray(curve[f"depth_{part1_model}_m"]),
                   "depth": np.asarray(pred["depth_m"]), "eroding": np.asarray(pred["depth_eroding_m"]),

@@ -438,10 +438,11 @@ def _regimes_section(doc, ctx, w, part1_model):
         for rec, row in conf.items():
             conf_rows.append([mat, rec] + [str(row[p]) for p in ("rigid", "deforming", "eroding")])
         rec = res["recorded"]
-        yc, ec = res["yield_check"], res["erosion_check"]
+        yc, ec, dc = res["yield_check"], res["erosion_check"], res["drop_check"]
         verdict = lambda chk: "between" if chk["between"] else (f"{chk['distance'] * 100:+.1f} % ({'within' if chk['within_tolerance'] else 'outside'} 10 %)")  # noqa: E731
         trans_rows.append([mat, f"{Uy:.0f}", f"{rec['last_rigid_m_s']:.0f} / {rec['first_non_rigid_m_s']:.0f}", verdict(yc),
-                           f"{Ue:.0f}", f"{rec['last_non_eroding_m_s']:.0f} / {rec['first_eroding_m_s']:.0f}", verdict(ec)])
+                           f"{Ue:.0f}", f"{rec['last_non_eroding_m_s']:.0f} / {rec['first_eroding_m_s']:.0f}", verdict(ec),
+                           f"{rec['depth_drop_below_m_s']:.0f} / {rec['depth_drop_above_m_s']:.0f}", verdict(dc)])
         for r, e in res["errors"].items():
             err_rows.append([mat, r, e["n"], f"{e['mean'] * 100:+.1f}", f"{e['mean_abs'] * 100:.1f}", f"{e['max_abs'] * 100:.1f}",
                              f"{e['part1_mean_abs'] * 100:.1f}", f"{e['eroding_mean_abs'] * 100:.1f}"])
@@ -465,9 +466,11 @@ def _regimes_section(doc, ctx, w, part1_model):
               caption=f"Regime confusion table (rows: the data's recorded response mapped to a regime; columns: the "
                       f"prediction). Agreement {agree} of {total} shots ({agree / max(total, 1) * 100:.0f} %).")
     doc.table(["projectile", "U_sC (yield onset) [m/s]", "recorded last rigid / first non-rigid [m/s]", "U_sC against them",
-               "U_e (erosion onset) [m/s]", "recorded last non-eroding / first eroding [m/s]", "U_e against them"], trans_rows,
+               "U_e (erosion onset) [m/s]", "recorded last non-eroding / first eroding [m/s]", "U_e against them",
+               "largest measured depth drop between [m/s]", "U_e against it"], trans_rows,
               caption="Predicted transitions against the recorded responses. Target (issue 17): between the last rigid "
-                      "and the first non-rigid shot, or within 10 % of it.")
+                      "and the first non-rigid shot, or within 10 % of it. The depth drop is the largest fall of the "
+                      "measured depth between two consecutive shots, where the regime-aware curve drops at U_e.")
     for note in notes:
         doc.note(note, "warning")
     doc.table(["projectile", "recorded regime", "n", "mean error [%]", "mean |error| [%]", "max |error| [%]",
