@@ -245,3 +245,14 @@ def test_cli_rod_shorter_than_nose(tmp_path, capsys):
     p.write_text(text)
     code, out, err = _run(capsys, p, "--json", "--coefficients", "paper")
     assert code == 2 and "projectile.length" in err
+
+
+def test_cli_regimes_case_json(capsys, validations):
+    """penetrate --json on the bundled regimes case: the rigid-model statistics use only the shots
+    recorded rigid (7 VAR 4340 shots) and the regime block equals the report's computation."""
+    code, out, err = _run(capsys, CASES / "piekutowski1999_var4340_regimes.toml", "--json")
+    assert code == 0, err
+    res = json.loads(out)
+    assert res["validation"]["statistics"]["rigid"]["n"] == 7
+    assert res["validation"]["regimes"]["confusion"] == validations["var4340"]["confusion"]
+    assert res["regime"] == ["rigid", "rigid", "deforming", "eroding", "eroding", "eroding"]  # 0.5 ... 3 km/s

@@ -78,4 +78,9 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
     if data is not None and data.file is not None:
         rows = predict_shots(case, coefficients, rigid_regime_shots(case, load_shots(case)), w1=w1)
         out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}
+        if data.response_column:  # every shot: recorded against predicted regime (issue 12, item 4)
+            from semianalytic.penetration.regime_setup import regime_validation
+
+            rv = regime_validation(case, coefficients, part1_model=part1_model or DEFAULT_PART1_MODEL, velocities=U, loo=False)
+            out["validation"]["regimes"] = {k: rv[k] for k in ("rows", "confusion", "recorded", "yield_check", "erosion_check", "errors")}
     return out
