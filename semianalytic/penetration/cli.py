@@ -7,6 +7,12 @@ projectile yields: the model is outside its validity).  With a ``[data]`` sectio
 dynamic yield stress from a measured U_sC (Appendix) and/or the comparison with measured
 depths.  ``--json`` prints the same as JSON (lists over velocity); ``--report DIR`` writes the
 markdown report with plots (:mod:`semianalytic.penetration.report`).
+
+Regimes (:mod:`semianalytic.penetration.regime`): ``regime`` per velocity (rigid, deforming,
+eroding), ``depth_m`` (the Part I model ``--part1-model`` below the erosion onset, the
+Alekseevskii-Tate eroding rod above), ``depth_eroding_m``, ``transition_velocity_m_s`` (U_sC),
+``erosion_velocity_m_s``, ``valid`` (per model, a list of booleans); every depth outside its
+model's validity is warned on stderr, naming the model and the reason.
 """
 
 from __future__ import annotations
