@@ -256,3 +256,16 @@ def test_cli_regimes_case_json(capsys, validations):
     assert res["validation"]["statistics"]["rigid"]["n"] == 7
     assert res["validation"]["regimes"]["confusion"] == validations["var4340"]["confusion"]
     assert res["regime"] == ["rigid", "rigid", "deforming", "eroding", "eroding", "eroding"]  # 0.5 ... 3 km/s
+
+
+@pytest.mark.slow  # the whole report (numerics, timings, leave-one-out): ~20 s; the pieces are tested above
+def test_cli_regimes_report(tmp_path, capsys):
+    """penetrate --report on the regimes case writes validation_regimes.md with the full-range
+    figure, the confusion table and the per-regime error table (paper coefficients)."""
+    code, out, err = _run(capsys, CASES / "piekutowski1999_var4340_regimes.toml", "--coefficients", "paper",
+                          "--report", tmp_path)
+    assert code == 0, err
+    text = (tmp_path / "validation_regimes.md").read_text()
+    for part in ("Regime confusion table", "Per recorded regime", "leave-one-out", "validation_regimes_depth_velocity_VAR4340.png"):
+        assert part in text
+    assert (tmp_path / "validation_regimes_depth_velocity_VAR4340.png").stat().st_size > 10000

@@ -81,6 +81,6 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
         if data.response_column:  # every shot: recorded against predicted regime (issue 12, item 4)
             from semianalytic.penetration.regime_setup import regime_validation
 
-            rv = regime_validation(case, coefficients, part1_model=part1_model or DEFAULT_PART1_MODEL, velocities=U, loo=False)
+            rv = regime_validation(case, coefficients, part1_model=part1_model or DEFAULT_PART1_MODEL, velocities=U, loo=False, w1=w1)
             out["validation"]["regimes"] = {k: rv[k] for k in ("rows", "confusion", "recorded", "yield_check", "erosion_check", "errors")}
     return out

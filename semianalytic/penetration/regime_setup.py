@@ -172,7 +172,7 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     }
 
 
-def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PART1_MODEL) -> list[dict]:
+def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PART1_MODEL, w1: str = "neglect") -> list[dict]:
     """Per shot (each with its own mass): recorded response and regime, predicted regime, the
     regime-aware, Part I and eroding depths and the measured depth (NaN where the data give only
     a channel length)."""
@@ -184,7 +184,7 @@ def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PAR
     rows = []
     for shot in shots:
         setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
-        curve = penetration_curve(setup, [shot.velocity])
+        curve = penetration_curve(setup, [shot.velocity], w1=w1)
         pred = regime_prediction(case, setup, [shot.velocity], curve, part1_model=part1_model)
         response = shot.row.get(col, "") if col else ""
         if col and response not in RESPONSE_REGIME:
@@ -283,7 +283,7 @@ def transition_check(predicted: float, below: float, above: float, tolerance: fl
 
 
 def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MODEL, velocities=None,
-                      loo: bool = True) -> dict:
+                      loo: bool = True, w1: str = "neglect") -> dict:
     """Everything the regimes report shows for one case with a ``[data]`` file and a
     ``response_column``: the shots (all responses) against the predicted regimes, the confusion
     counts, the recorded and predicted transitions, per recorded regime the errors of the
@@ -293,11 +293,11 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
     from semianalytic.penetration.validation import load_shots
 
     shots = load_shots(case, require_depth=False)
-    rows = predict_regimes(case, coefficients, shots, part1_model=part1_model)
+    rows = predict_regimes(case, coefficients, shots, part1_model=part1_model, w1=w1)
     masses = [r["mass_kg"] for r in rows]
     setup = PenetrationSetup.from_case(case, coefficients, mass=float(np.mean(masses)) if masses else None)
     U = np.linspace(300.0, 3200.0, 146) if velocities is None else np.asarray(velocities, float)
-    curve = penetration_curve(setup, U)
+    curve = penetration_curve(setup, U, w1=w1)
     pred = regime_prediction(case, setup, U, curve, part1_model=part1_model)
     rec = recorded_transitions(rows)
     errors = {}

@@ -399,7 +399,7 @@ def _regimes_section(doc, ctx, w, part1_model):
     total = agree = 0
     for case in cases:
         mat = _material(case)
-        res = regime_validation(case, ctx.coefficients(case)[0], part1_model=part1_model)
+        res = regime_validation(case, ctx.coefficients(case)[0], part1_model=part1_model, w1=ctx.w1)
         c = res["curve"]
         U = c["U"]
         pred = res["prediction"]
