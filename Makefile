@@ -10,6 +10,11 @@ export PYVISTA_OFF_SCREEN ?= true
 
 .PHONY: demo test bench reports clean
 
+# The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
+# executable_path (never `playwright install`: no browser download); installed here when missing.
+export CHROMIUM ?= /usr/bin/chromium
+SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
+
 $(VENV)/.installed: pyproject.toml
 	test -x $(PY) || python3 -m venv $(VENV)
 	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
@@ -19,9 +24,13 @@ demo: $(VENV)/.installed
 	$(PY) -m semianalytic demo
 
 # The import contracts of pyproject.toml (layers, pure models, fem_check kept apart), then the suite.
-test: $(VENV)/.installed
+test: $(VENV)/.installed $(CHROMIUM)
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile
+
+$(CHROMIUM):
+	$(SUDO) apt-get update
+	$(SUDO) apt-get install -y chromium
 
 # Long convergence studies and benchmarks; they write into reports/.
 bench: $(VENV)/.installed
