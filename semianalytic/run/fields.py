@@ -85,12 +85,12 @@ def body_fitted_points(nose, length: float, depth: float, extent: float, n_theta
     d = nose.diameter
     inside = projectile_inside(nose, length, depth)
     x1, r1 = depth + extent * d, max(extent * d, 0.75 * d)
-    xc = depth - 0.5 * min(nose.length, depth)
+    xc = depth - 0.5 * min(max(nose.length, 0.5 * d), depth)
     # body radius at the free surface: the last ray ends just above it (a zero-length ray would
     # give degenerate cells)
     r_surf = float(_ray_exit(lambda x, r: inside(np.zeros_like(r), r), 0.0, np.array([0.5 * np.pi]),
                              np.array([r1]))[0])
-    theta_max = math.atan2(r_surf + 2e-3 * d, -xc)
+    theta_max = math.atan2(r_surf + 1e-5 * d, -xc)
     fine = np.linspace(0.0, theta_max, 4001)
     rho_w = _window_exit(xc, x1, r1, fine)
     rho_b = _ray_exit(inside, xc, fine, rho_w)
@@ -101,6 +101,17 @@ def body_fitted_points(nose, length: float, depth: float, extent: float, n_theta
         arc.append(s / s[-1])
     blend = (fine / theta_max + arc[0] + arc[1]) / 3.0
     theta = np.interp(np.linspace(0.0, 1.0, n_theta), blend, fine)
+    # a ray through each corner of the window and each junction of the nose's meridian (the
+    # shoulder, a flat face's edge), so that the grid lines follow them instead of cutting them
+    junctions = [(float(seg.point(seg.t1)[0]) + depth, float(seg.point(seg.t1)[1])) for seg in nose.segments]
+    corners = [math.atan2(r1, x1 - xc), math.atan2(r1, -xc)]
+    corners += [math.atan2(r, x - xc) for x, r in junctions if x > 0.0 and r > 0.0]
+    for corner in corners:
+        if 0.0 < corner < theta_max:
+            k = 1 + int(np.argmin(np.abs(theta[1:-1] - corner)))
+            theta[k] = corner
+    theta = np.unique(theta)
+    n_theta = len(theta)
     rho_w = _window_exit(xc, x1, r1, theta)
     rho_b = _ray_exit(inside, xc, theta, rho_w)
     # grading towards the body: fraction (e^(beta t) - 1)/(e^beta - 1)
@@ -108,7 +119,8 @@ def body_fitted_points(nose, length: float, depth: float, extent: float, n_theta
     frac = np.expm1(2.5 * t) / np.expm1(2.5)
     gap = 1e-3 * d  # first node off the surface (the boundary integrals are singular on it)
     for _ in range(30):
-        rho = (rho_b + gap)[:, None] + (rho_w - rho_b - gap)[:, None] * frac[None, :]
+        off = np.minimum(gap, 0.25 * (rho_w - rho_b))  # short rays near the free surface's corner
+        rho = (rho_b + off)[:, None] + (rho_w - rho_b - off)[:, None] * frac[None, :]
         X = xc + rho * np.cos(theta)[:, None]
         Rr = rho * np.sin(theta)[:, None]
         Rr[0, :] = 0.0  # the axis ray exactly on the axis
@@ -143,7 +155,8 @@ def body_fitted_field(nose, length: float, depth: float, u: float, *, extent: fl
     pts, quads, window, r_surf = body_fitted_points(nose, length, depth, extent, n_theta, n_rho)
     g = np.vstack([sol.gradient(pts[k:k + 2000]) for k in range(0, len(pts), 2000)])
     phi = np.concatenate([sol.potential(pts[k:k + 2000]) for k in range(0, len(pts), 2000)])
-    field = BodyFittedField(pts, quads, -u * g[:, 0], -u * g[:, 1], phi, u, depth, (n_theta, n_rho), window, r_surf)
+    field = BodyFittedField(pts, quads, -u * g[:, 0], -u * g[:, 1], phi, u, depth, (len(pts) // n_rho, n_rho), window,
+                           r_surf)
     return field, sol
 
 

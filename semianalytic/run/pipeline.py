@@ -47,7 +47,7 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     with StagedDir(out, force) as staged:
         title = case.title or Path(case_path).stem
         ctx = Context(case, staged, run_section, Document(f"Report: {title}"), render=render, cache_dir=cache_dir)
-        introduction(ctx, identity, steps, skipped, out)
+        introduction(ctx, identity, steps, skipped, _command(identity, out, case_path))
         for step in steps:
             t = time.perf_counter()
             step.run(ctx)
@@ -63,7 +63,7 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
             # the case by file name and content hash: no output carries a machine path
             "case": {"path": identity["file"], "file": identity["file"], "sha256": identity["sha256"],
                      "title": case.title, "reproduces": case.reproduces},
-            "generated_by": {"command": _command(identity, out), "version": version()},
+            "generated_by": {"command": _command(identity, out, case_path), "version": version()},
             "analyses": ctx.results,
             "skipped": skipped,
             "timings_s": ctx.timings,
@@ -82,20 +82,28 @@ def _staged_bytes(staged, rel: str) -> bytes | None:
     return p.read_bytes() if p.is_file() else None
 
 
-def _command(identity: dict, out) -> str:
-    """The command that made the report, with the case and the output folder by name only."""
-    return f"python -m semianalytic run {identity['file']} --out {Path(out).name}"
+def _shown(path, name: str) -> str:
+    """A path as a report may show it: relative as given (e.g. ``cases/x.toml``), else ``name``
+    only (an absolute path, or one climbing with '..', would name the machine's folders)."""
+    p = Path(path)
+    return p.as_posix() if not p.is_absolute() and ".." not in p.parts else name
+
+
+def _command(identity: dict, out, case_path) -> str:
+    """The command that made the report, without the machine's folders."""
+    return f"python -m semianalytic run {_shown(case_path, identity['file'])} --out {_shown(out, Path(out).name)}"
 
 
 # --------------------------------------------------------------------------------------
 # introduction
 
 
-def introduction(ctx: Context, identity: dict, steps: list[Step], skipped: dict[str, str], out=None) -> None:
+def introduction(ctx: Context, identity: dict, steps: list[Step], skipped: dict[str, str],
+                 command: str | None = None) -> None:
     case = ctx.case
     d = ctx.doc
-    if out is not None:
-        d.para(generated_by(_command(identity, out)))
+    if command is not None:
+        d.para(generated_by(command))
     d.para(f"Case file: `{identity['file']}` (sha256 `{identity['sha256'][:12]}`).")
     if case.reproduces:
         d.para(f"Reproduces: {case.reproduces}.")
