@@ -19,7 +19,7 @@ import numpy as np
 import pytest
 
 from semianalytic.bem.field import projectile_inside, projectile_outline
-from semianalytic.geometry import cone_nose, flat_nose, ogive_nose, sphere_nose
+from semianalytic.geometry import cone_nose, flat_nose, ogive_nose, sphere_nose, table_nose
 from semianalytic.report.figures import speed_scale, velocity_field_figure
 from semianalytic.run.fields import body_fitted_field, body_fitted_points
 
@@ -29,6 +29,9 @@ NOSES = {
     "ogive": ogive_nose(D, 3.0),
     "cone": cone_nose(D, math.radians(20.0)),
     "flat": flat_nose(D),
+    "flat-rounded": flat_nose(D, 0.2 * D),
+    # a blunted tangent profile through user points (x back from the tip, r)
+    "table": table_nose([(0.0, 0.0), (0.2 * D, 0.25 * D), (0.6 * D, 0.42 * D), (1.2 * D, 0.5 * D)], D),
 }
 
 

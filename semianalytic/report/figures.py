@@ -201,7 +201,7 @@ def velocity_field_figure(
     tri_all = np.vstack([tris, mirror[tris[:, ::-1]]])
     speed = np.hypot(vx, vr)
     speed2 = np.concatenate([speed, speed])
-    norm, extend, scale_text = speed_scale(speed)
+    norm, extend, scale_text = speed_scale(speed[np.unique(q)])  # the nodes drawn
     tri = Triangulation(xy[:, 0], xy[:, 1], tri_all)
 
     _, x1, r1 = window

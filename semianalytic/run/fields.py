@@ -139,6 +139,10 @@ def body_fitted_points(nose, length: float, depth: float, extent: float, n_theta
     area = 0.5 * np.sum(p[:, :, 0] * np.roll(p[:, :, 1], -1, axis=1) - np.roll(p[:, :, 0], -1, axis=1) * p[:, :, 1],
                         axis=1)
     quads[area < 0] = quads[area < 0][:, ::-1]
+    # a table nose that is not star-shaped from the centre: drop the cells that would reach into it
+    bad = np.asarray(inside(points[:, 0], points[:, 1]), bool)
+    if bad.any():
+        quads = quads[~bad[quads].any(axis=1)]
     return points, quads, (0.0, x1, r1), r_surf
 
 
@@ -213,7 +217,8 @@ def _velocity_field_run(ctx: Context) -> None:
         vtk.write_vtu(vtk.revolved_mesh(field, run.field_segments), p3)
         outline = projectile_outline(pr.nose, pr.length, P)
         vtk.write_vtu(vtk.revolved_surface(outline, 4 * run.field_segments), ps)
-        speed = np.hypot(field.vx, field.vr)
+        drawn = np.unique(field.quads)
+        speed = np.hypot(field.vx, field.vr)[drawn]
         fig, scale = velocity_field_figure(
             field.points, field.quads, field.vx, field.vr, outline, field.window, field.surface_radius,
             f"Target velocity |v| (Part I, eq. (23)) at depth P = {P * 1e3:.1f} mm, projectile speed u = {fmt(u)} m/s",
