@@ -105,6 +105,11 @@ def test_field_meets_the_boundary_condition_on_the_wetted_surface(sphere_field):
     shank = (x < centre - 0.5 * R) & (x > 2 * R)
     assert shank.sum() >= 3
     np.testing.assert_allclose(f.vr[inner][shank], 0.0, atol=0.01 * u)
+    # the free surface x = 0: dphi/dn = 0 there (the mirror method of Part I, eqs. (20)-(22)),
+    # v_x = 0 by the symmetry of body and image: round-off only
+    free = np.abs(f.points[:, 0]) < 1e-12 * D
+    assert free.sum() >= 3
+    np.testing.assert_allclose(f.vx[free], 0.0, atol=1e-9 * u)
     # the stagnation point at the tip moves with the body: |v| = u (the true maximum there)
     assert abs(np.hypot(f.vx, f.vr).max() - u) < 0.01 * u
 

@@ -229,7 +229,7 @@ def _velocity_field_run(ctx: Context) -> None:
             f"Speed |v| of the target material around the {case.projectile.nose} nose at P = {P * 1e3:.1f} mm "
             f"(cf. Part I, Figs. 12-13) on the body-fitted grid ({n_theta} x {n_rho} nodes), window x = 0 to "
             f"{x1:.1f} mm, |r| <= {r1:.1f} mm, mirrored about the axis. The free surface x = 0 is inside the window "
-            "(blue line); the wetted surface (the submerged projectile, x >= 0, where eq. (7) holds) is orange; "
+            "(blue line; dphi/dn = 0 there in the mirror method of eqs. (20)-(22), so v is tangential to it); the wetted surface (the submerged projectile, x >= 0, where eq. (7) holds) is orange; "
             f"white lines are streamlines of v. Colour: {scale}.",
         )
         if ctx.render:
