@@ -26,6 +26,7 @@ __all__ = [
     "panels_figure",
     "side_by_side_figure",
     "velocity_field_figure",
+    "speed_scale",
     "meridian_outline",
 ]
 
@@ -136,52 +137,115 @@ def meridian_outline(profile_xr: np.ndarray, depth: float) -> np.ndarray:
     return pts
 
 
+def speed_scale(speed: np.ndarray, decades: float = 3.0, wide: float = 30.0):
+    """The colour scale of a speed field: linear from 0 to the true maximum when
+    max/min <= ``wide``, else logarithmic from max(min, max 10^-decades) to the true maximum.
+
+    Returns ``(norm, extend, text)``: a matplotlib norm, the colour bar's ``extend`` ('min'
+    when values below the scale's bottom are drawn in its lowest colour) and a caption text
+    that states the range, the scale and any clipping.  The top is never clipped.
+    """
+    from matplotlib.colors import LogNorm, Normalize
+
+    v = np.asarray(speed, float)
+    v = v[np.isfinite(v)]
+    top = float(v.max()) if v.size else 1.0
+    low = float(v.min()) if v.size else 0.0
+    if low > 0 and top / low <= wide or top <= 0:
+        return Normalize(0.0, max(top, 1e-300)), "neither", (
+            f"linear scale from 0 to the maximum {top:.4g} m/s (unclipped)")
+    bottom = max(low, top * 10.0 ** -decades)
+    if bottom > low:
+        return LogNorm(bottom, top), "min", (
+            f"log scale from {bottom:.3g} m/s to the true maximum {top:.4g} m/s; the {low:.3g}-{bottom:.3g} m/s of "
+            "the far field are drawn in the lowest colour (arrow of the colour bar)")
+    return LogNorm(bottom, top), "neither", f"log scale from the minimum {low:.3g} to the maximum {top:.4g} m/s (unclipped)"
+
+
 def velocity_field_figure(
-    x: np.ndarray,
-    r: np.ndarray,
+    points: np.ndarray,
+    quads: np.ndarray,
     vx: np.ndarray,
     vr: np.ndarray,
     outline: np.ndarray,
+    window: tuple[float, float, float],
+    surface_radius: float,
     title: str,
     length_unit: float = 1e-3,
-    max_arrows: int = 30,
-) -> Figure:
-    """Meridian-plane picture of the velocity field (Part I Figs. 12-13): |v| in colour,
-    arrows for direction, the projectile outline and its mirror in r < 0.
+    streamline_density: float = 1.1,
+):
+    """Meridian-plane picture of the velocity field (Part I Figs. 12-13) on a body-fitted mesh:
+    |v| in colour (:func:`speed_scale`), streamlines of v, the projectile, its wetted surface
+    (x >= 0) and the free surface x = 0, mirrored to r < 0.
 
-    ``x, r``: 1D node coordinates (m); ``vx, vr``: arrays of shape (len(x), len(r)) with NaN
-    inside the projectile; ``outline``: (m, 2) meridian in the target frame.
+    ``points`` (n, 2) of (x, r) [m] and ``quads`` (m, 4): the fluid mesh (no cell inside the
+    body); ``vx, vr`` (n,) [m/s]; ``outline`` (k, 2): the closed meridian of the projectile in
+    the target frame; ``window`` = (0, x_max, r_max) [m]; ``surface_radius``: the body's radius
+    at x = 0 [m].  Returns ``(figure, colour-scale text for the caption)``.
     """
-    X, R = np.meshgrid(x, r, indexing="ij")
-    speed = np.hypot(vx, vr)
+    from matplotlib.lines import Line2D
+    from matplotlib.patches import Patch
+    from matplotlib.tri import LinearTriInterpolator, Triangulation
+
     s = 1.0 / length_unit
-    fig = Figure(figsize=(7.2, 4.6), layout=LAYOUT)
-    ax = fig.add_subplot()
-    finite = np.isfinite(speed)
-    vmax = float(np.nanpercentile(speed[finite], 98)) if finite.any() else 1.0
-    for sign in (1.0, -1.0):
-        pcm = ax.pcolormesh(X * s, sign * R * s, np.ma.masked_invalid(speed), shading="gouraud",
-                            cmap="viridis", vmin=0.0, vmax=vmax)
-    stride_x = max(1, len(x) // max_arrows)
-    stride_r = max(1, len(r) // max(4, max_arrows // 2))
-    sl = (slice(None, None, stride_x), slice(None, None, stride_r))
-    with np.errstate(invalid="ignore", divide="ignore"):
-        ux = np.where(finite, vx / np.where(speed > 0, speed, 1.0), np.nan)
-        ur = np.where(finite, vr / np.where(speed > 0, speed, 1.0), np.nan)
-    for sign in (1.0, -1.0):
-        ax.quiver(X[sl] * s, sign * R[sl] * s, ux[sl], sign * ur[sl], color="w", scale=35, width=0.003,
-                  alpha=0.85)
-    o = np.asarray(outline)
-    for sign in (1.0, -1.0):
-        ax.fill(o[:, 0] * s, sign * o[:, 1] * s, color="0.55", zorder=3)
-        ax.plot(o[:, 0] * s, sign * o[:, 1] * s, "k-", lw=1.0, zorder=4)
-    ax.axvline(0.0, color="k", lw=0.8, ls="--")
-    ax.set_aspect("equal")
-    ax.set_xlim(x.min() * s, x.max() * s)
-    ax.set_ylim(-r.max() * s, r.max() * s)
     unit = {1e-3: "mm", 1.0: "m", 1e-2: "cm"}.get(length_unit, f"{length_unit:g} m")
-    ax.set_xlabel(f"x (target frame, free surface at 0) [{unit}]")
-    ax.set_ylabel(f"r [{unit}]")
+    pts = np.asarray(points, float)
+    q = np.asarray(quads)
+    tris = np.vstack([q[:, [0, 1, 2]], q[:, [0, 2, 3]]])
+    n = len(pts)
+    # both halves: the mirror image r -> -r (its triangles reversed to stay counter-clockwise);
+    # nodes on the axis are shared, not duplicated (a valid triangulation for the interpolator)
+    xy = np.vstack([pts * s, pts * [s, -s]])
+    mirror = np.arange(n) + n
+    mirror[pts[:, 1] == 0.0] = np.flatnonzero(pts[:, 1] == 0.0)
+    tri_all = np.vstack([tris, mirror[tris[:, ::-1]]])
+    speed = np.hypot(vx, vr)
+    speed2 = np.concatenate([speed, speed])
+    norm, extend, scale_text = speed_scale(speed[np.unique(q)])  # the nodes drawn
+    tri = Triangulation(xy[:, 0], xy[:, 1], tri_all)
+
+    _, x1, r1 = window
+    fig = Figure(figsize=(8.6, 4.4), layout=LAYOUT)
+    ax = fig.add_subplot()
+    x_lo = -0.07 * x1 * s
+    ax.axvspan(x_lo, 0.0, color="0.93", zorder=0)  # above the target: air
+    pcm = ax.tripcolor(tri, speed2, shading="gouraud", cmap="viridis", norm=norm, zorder=1)
+
+    # streamlines on a regular lattice, interpolated linearly inside the mesh (masked outside)
+    gx = np.linspace(0.0, x1 * s, 120)
+    gy = np.linspace(-r1 * s, r1 * s, 66)
+    GX, GY = np.meshgrid(gx, gy)
+    vx2 = np.concatenate([vx, vx])
+    vy2 = np.concatenate([vr, -vr])
+    U = LinearTriInterpolator(tri, vx2)(GX, GY)
+    V = LinearTriInterpolator(tri, vy2)(GX, GY)
+    lines = ax.streamplot(gx, gy, U, V, density=streamline_density, color="white", linewidth=0.6, arrowsize=0.7,
+                          zorder=2)
+    lines.lines.set_in_layout(False)  # hundreds of small artists: keep them out of the layout's bboxes
+    lines.arrows.set_in_layout(False)
+
+    o = np.asarray(outline, float)
+    # the wetted surface: the outline clipped at the free surface x = 0
+    wet = np.vstack([o[o[:, 0] >= 0.0], [[0.0, surface_radius]]]) if np.any(o[:, 0] < 0.0) else o
+    for sign in (1.0, -1.0):
+        ax.fill(o[:, 0] * s, sign * o[:, 1] * s, color="0.6", zorder=3)
+        ax.plot(wet[:, 0] * s, sign * wet[:, 1] * s, color="tab:orange", lw=2.2, zorder=4)
+        ax.plot([0.0, 0.0], [sign * surface_radius * s, sign * r1 * s], color="tab:blue", lw=2.2, zorder=4)
+    ax.set_aspect("equal")
+    ax.set_xlim(x_lo, x1 * s)
+    ax.set_ylim(-r1 * s, r1 * s)
+    ax.set_xlabel(f"x, depth below the free surface [{unit}]")
+    ax.set_ylabel(f"r, distance from the axis [{unit}]")
     ax.set_title(title, fontsize=10)
-    fig.colorbar(pcm, ax=ax, label="|v| [m/s]", shrink=0.85)
-    return fig
+    cb = fig.colorbar(pcm, ax=ax, extend=extend, shrink=0.9)
+    cb.set_label("|v| [m/s]" + (" (log scale)" if type(norm).__name__ == "LogNorm" else ""))
+    fig.legend(
+        handles=[
+            Line2D([], [], color="tab:blue", lw=2.2, label="free surface x = 0"),
+            Line2D([], [], color="tab:orange", lw=2.2, label="wetted surface (x >= 0)"),
+            Patch(color="0.6", label="projectile"),
+            Line2D([], [], color="0.4", lw=0.8, label="streamlines of v"),
+        ],
+        fontsize=8, loc="outside lower center", ncols=4, frameon=False,
+    )
+    return fig, scale_text

@@ -1,13 +1,17 @@
 """Render a :class:`~semianalytic.report.document.Document` as one self-contained HTML page.
 
-Images are referenced by their relative paths (the PNGs sit beside the page); all text is
-escaped, so nothing from a case file (titles, notes) can inject markup.
+Images are embedded as ``data:`` URIs when their bytes are given (``images``), so the page
+can be moved or mailed alone; the PNG files stay beside it for reuse.  An image without bytes
+is linked by its relative path.  All text is escaped, so nothing from a case file (titles,
+notes) can inject markup.
 """
 
 from __future__ import annotations
 
+import base64
 import html
 import re
+from typing import Callable
 
 from semianalytic.report.document import Code, Document, Heading, Image, Note, Paragraph, Table
 
@@ -42,8 +46,21 @@ def _inline(text: str) -> str:
     return "".join(out)
 
 
-def to_html(doc: Document) -> str:
-    """The page as a string (UTF-8, no external resources but the figures)."""
+_MIME = {".png": "image/png", ".jpg": "image/jpeg", ".jpeg": "image/jpeg", ".svg": "image/svg+xml"}
+
+
+def _image_src(path: str, images: Callable[[str], bytes | None] | None) -> str:
+    """A ``data:`` URI of the image's bytes (from ``images(path)``), else the escaped relative path."""
+    data = images(path) if images is not None else None
+    if data is None:
+        return html.escape(path, quote=True)
+    mime = _MIME.get(path[path.rfind("."):].lower(), "application/octet-stream")
+    return f"data:{mime};base64,{base64.b64encode(data).decode('ascii')}"
+
+
+def to_html(doc: Document, images: Callable[[str], bytes | None] | None = None) -> str:
+    """The page as a string (UTF-8).  ``images(relative path) -> bytes | None`` gives the bytes
+    of each figure to embed; with it the page has no external resources at all."""
     body = [f"<h1>{_inline(doc.title)}</h1>"]
     for b in doc.blocks:
         if isinstance(b, Heading):
@@ -64,9 +81,10 @@ def to_html(doc: Document) -> str:
             rows.append("</table>")
             body.append("\n".join(rows))
         elif isinstance(b, Image):
-            src = html.escape(b.path, quote=True)
+            src = _image_src(b.path, images)
             body.append(
-                f'<figure><img src="{src}" alt="{html.escape(b.alt, quote=True)}">'
+                f'<figure><img src="{src}" data-file="{html.escape(b.path, quote=True)}" '
+                f'alt="{html.escape(b.alt, quote=True)}">'
                 f"<figcaption>{_inline(b.caption)}</figcaption></figure>"
             )
         elif isinstance(b, Code):

@@ -127,6 +127,15 @@ def json_safe(obj: Any) -> Any:
     return json.loads(json.dumps(obj, default=str))
 
 
+def stamp_version(markdown: str) -> str:
+    """``markdown`` with a line naming the version that made it (package version and
+    ``git describe``) after its title: a committed report says what made it."""
+    from semianalytic.report.provenance import version
+
+    title, _, rest = markdown.partition("\n")
+    return f"{title}\n\nVersion: {version()}.\n" + (rest if rest.startswith("\n") else "\n" + rest)
+
+
 def report_command(prog: str, description: str, filename: str, build, argv: list[str] | None = None) -> int:
     """``main`` shared by the report modules: ``--out DIR [--force]``.
 
@@ -146,6 +155,7 @@ def report_command(prog: str, description: str, filename: str, build, argv: list
     try:
         target = check_report_target(out / filename, args.force)
         text, figs = build(out)
+        text = stamp_version(text)
         for name, data in figs.items():
             atomic_write_bytes(out / name, data)
         atomic_write_text(target, text)

@@ -38,90 +38,115 @@ def _quad_cells(fluid: np.ndarray) -> np.ndarray:
     return np.argwhere(ok)
 
 
-def _field_data(field: FieldOnGrid) -> dict:
+def _field_data(field) -> dict:
     fd = {"speed_u_m_s": np.array([field.speed_u])}
     if field.depth is not None:
         fd["depth_m"] = np.array([field.depth])
     return fd
 
 
-def meridian_mesh(field: FieldOnGrid):
+def _as_quads(field):
+    """``(points (n, 2), quads (m, 4) counter-clockwise in (x, r), vx, vr, phi or None)`` of a
+    field on a tensor grid (:class:`~semianalytic.bem.field.FieldOnGrid`: the cells whose four
+    nodes are in the fluid) or on a body-fitted quad mesh (any object with ``points``,
+    ``quads``, ``vx``, ``vr``, ``phi``: e.g. the ``run`` pipeline's BodyFittedField)."""
+    if hasattr(field, "grid"):
+        g = field.grid
+        nx, nr = g.fluid.shape
+        X, R = np.meshgrid(g.x, g.r, indexing="ij")
+        cells = _quad_cells(g.fluid)
+        node = lambda i, j: i * nr + j  # noqa: E731
+        quads = np.column_stack(
+            [node(cells[:, 0], cells[:, 1]), node(cells[:, 0] + 1, cells[:, 1]),
+             node(cells[:, 0] + 1, cells[:, 1] + 1), node(cells[:, 0], cells[:, 1] + 1)]
+        )
+        phi = None if field.phi is None else field.phi.ravel()
+        return np.column_stack([X.ravel(), R.ravel()]), quads, field.vx.ravel(), field.vr.ravel(), phi
+    return (np.asarray(field.points, float), np.asarray(field.quads, np.int64), np.asarray(field.vx, float),
+            np.asarray(field.vr, float), None if field.phi is None else np.asarray(field.phi, float))
+
+
+def meridian_mesh(field):
     """The meridian plane as a meshio mesh: quads in z = 0, point data velocity (m/s),
     speed |v| (m/s), phi (m, unit speed) and Phi = u phi (m^2/s)."""
     import meshio
 
-    g = field.grid
-    nx, nr = g.fluid.shape
-    X, R = np.meshgrid(g.x, g.r, indexing="ij")
-    used = np.zeros(nx * nr, dtype=bool)
-    cells = _quad_cells(g.fluid)
-    node = lambda i, j: i * nr + j  # noqa: E731
-    quads = np.column_stack(
-        [node(cells[:, 0], cells[:, 1]), node(cells[:, 0] + 1, cells[:, 1]),
-         node(cells[:, 0] + 1, cells[:, 1] + 1), node(cells[:, 0], cells[:, 1] + 1)]
-    )
+    pts2, quads, vx, vr, phi = _as_quads(field)
+    n = len(pts2)
+    used = np.zeros(n, dtype=bool)
     used[quads.ravel()] = True
-    new = -np.ones(nx * nr, dtype=np.int64)
+    new = -np.ones(n, dtype=np.int64)
     new[used] = np.arange(used.sum())
-    pts = np.column_stack([X.ravel(), R.ravel(), np.zeros(nx * nr)])[used]
-    vel = np.column_stack([field.vx.ravel(), field.vr.ravel(), np.zeros(nx * nr)])[used]
+    pts = np.column_stack([pts2, np.zeros(n)])[used]
+    vel = np.column_stack([vx, vr, np.zeros(n)])[used]
     pdata = {"velocity": vel, "speed": np.hypot(vel[:, 0], vel[:, 1])}
-    if field.phi is not None:
-        pdata["phi"] = field.phi.ravel()[used]
+    if phi is not None:
+        pdata["phi"] = phi[used]
         pdata["Phi"] = field.speed_u * pdata["phi"]
     return meshio.Mesh(pts, [("quad", new[quads])], point_data=pdata, field_data=_field_data(field))
 
 
-def revolved_mesh(field: FieldOnGrid, segments: int = 24):
-    """The grid revolved about the x axis: hexahedra, and wedges for the cells on the axis.
+def revolved_mesh(field, segments: int = 24):
+    """The meridian quads revolved about the x axis: hexahedra, and wedges for the cells with
+    an edge on the axis.
 
     Node (x, r, theta_k) -> (x, r cos theta_k, r sin theta_k), theta_k = 2 pi k / segments;
-    nodes on the axis are shared.  Velocity (v_x, v_r cos theta, v_r sin theta).
+    nodes on the axis (r = 0) are shared.  Velocity (v_x, v_r cos theta, v_r sin theta).
     """
     import meshio
 
-    g = field.grid
-    nx, nr = g.fluid.shape
+    pts2, quads, vx, vr, phi = _as_quads(field)
     S = int(segments)
     th = 2 * math.pi * np.arange(S) / S
-    # node numbering: axis nodes (i, 0) once, ring nodes (i, j>=1, k)
-    axis_id = np.arange(nx)
-    ring0 = nx
+    n = len(pts2)
+    on_axis = pts2[:, 1] == 0.0
+    # numbering: each axis node once, every other node once per azimuthal segment
+    first = np.empty(n, dtype=np.int64)
+    first[on_axis] = np.arange(on_axis.sum())
+    n_axis = int(on_axis.sum())
+    first[~on_axis] = n_axis + np.arange((~on_axis).sum()) * S
 
-    def rid(i, j, k):
-        return ring0 + (i * (nr - 1) + (j - 1)) * S + (k % S)
+    def nid(a, k):
+        """Id of meridian node(s) ``a`` in segment(s) ``k``."""
+        return np.where(on_axis[a], first[a], first[a] + (k % S))
 
-    n_nodes = nx + nx * (nr - 1) * S
+    n_nodes = n_axis + int((~on_axis).sum()) * S
     pts = np.empty((n_nodes, 3))
     vel = np.empty((n_nodes, 3))
-    phi = np.empty(n_nodes)
-    pts[axis_id] = np.column_stack([g.x, np.zeros(nx), np.zeros(nx)])
-    vel[axis_id] = np.column_stack([field.vx[:, 0], np.zeros(nx), np.zeros(nx)])
-    phi[axis_id] = field.phi[:, 0] if field.phi is not None else np.nan
-    I, J, K = np.meshgrid(np.arange(nx), np.arange(1, nr), np.arange(S), indexing="ij")
-    ids = rid(I, J, K).ravel()
-    rr, tt = g.r[J].ravel(), th[K].ravel()
-    pts[ids] = np.column_stack([g.x[I].ravel(), rr * np.cos(tt), rr * np.sin(tt)])
-    vrr = field.vr[I, J].ravel()
-    vel[ids] = np.column_stack([field.vx[I, J].ravel(), vrr * np.cos(tt), vrr * np.sin(tt)])
-    phi[ids] = field.phi[I, J].ravel() if field.phi is not None else np.nan
+    ph = np.full(n_nodes, np.nan)
+    ax = np.flatnonzero(on_axis)
+    pts[first[ax]] = np.column_stack([pts2[ax, 0], np.zeros(len(ax)), np.zeros(len(ax))])
+    vel[first[ax]] = np.column_stack([vx[ax], np.zeros(len(ax)), np.zeros(len(ax))])
+    if phi is not None:
+        ph[first[ax]] = phi[ax]
+    ring = np.flatnonzero(~on_axis)
+    A, K = np.meshgrid(ring, np.arange(S), indexing="ij")
+    ids = (first[A] + K).ravel()
+    rr, tt = pts2[A, 1].ravel(), th[K].ravel()
+    pts[ids] = np.column_stack([pts2[A, 0].ravel(), rr * np.cos(tt), rr * np.sin(tt)])
+    vrr = vr[A].ravel()
+    vel[ids] = np.column_stack([vx[A].ravel(), vrr * np.cos(tt), vrr * np.sin(tt)])
+    if phi is not None:
+        ph[ids] = phi[A].ravel()
 
-    cells = _quad_cells(g.fluid)
-    hexes, wedges = [], []
     k = np.arange(S)
-    for i, j in cells:
-        if j == 0:
-            # triangle (axis, ring(1, k+1), ring(1, k)) at x_i and at x_{i+1}
-            # (VTK wedge: the first triangle's right-hand normal points away from the second)
-            wedges.append(np.column_stack([
-                np.full(S, axis_id[i]), rid(i, 1, k + 1), rid(i, 1, k),
-                np.full(S, axis_id[i + 1]), rid(i + 1, 1, k + 1), rid(i + 1, 1, k),
-            ]))
+    hexes, wedges = [], []
+    n_axis_nodes = on_axis[quads].sum(axis=1)
+    for q, m in zip(quads, n_axis_nodes):
+        if m == 0:
+            a, b, c, d = q
+            hexes.append(np.column_stack([nid(a, k), nid(b, k), nid(c, k), nid(d, k),
+                                          nid(a, k + 1), nid(b, k + 1), nid(c, k + 1), nid(d, k + 1)]))
+        elif m == 2:
+            # rotate so that the axis edge comes first: (a, b) on the axis (+x for a CCW quad),
+            # c, d off it; VTK wedge: triangle (a, d_{k+1}, d_k), then (b, c_{k+1}, c_k)
+            while not (on_axis[q[0]] and on_axis[q[1]]):
+                q = np.roll(q, 1)
+            a, b, c, d = q
+            wedges.append(np.column_stack([np.full(S, first[a]), nid(d, k + 1), nid(d, k),
+                                           np.full(S, first[b]), nid(c, k + 1), nid(c, k)]))
         else:
-            hexes.append(np.column_stack([
-                rid(i, j, k), rid(i + 1, j, k), rid(i + 1, j + 1, k), rid(i, j + 1, k),
-                rid(i, j, k + 1), rid(i + 1, j, k + 1), rid(i + 1, j + 1, k + 1), rid(i, j + 1, k + 1),
-            ]))
+            raise ValueError("a meridian cell touches the axis at one node only (or lies on it)")
     blocks = []
     if wedges:
         blocks.append(("wedge", np.vstack(wedges)))
@@ -136,9 +161,9 @@ def revolved_mesh(field: FieldOnGrid, segments: int = 24):
     blocks = [(t, new[c]) for t, c in blocks]
     vel = vel[used]
     pdata = {"velocity": vel, "speed": np.linalg.norm(vel, axis=1)}
-    if field.phi is not None:
-        pdata["phi"] = phi[used]
-        pdata["Phi"] = field.speed_u * phi[used]
+    if phi is not None:
+        pdata["phi"] = ph[used]
+        pdata["Phi"] = field.speed_u * ph[used]
     return meshio.Mesh(pts[used], blocks, point_data=pdata, field_data=_field_data(field))
 
 
@@ -216,10 +241,15 @@ def fem_meridian_mesh(field, u: float, phi_reference=None):
 
 
 def render_png(volume_path, meridian_path, surface_path, png_path, title: str = "", window=(1000, 620)) -> Path:
-    """Off-screen pyvista picture: the revolved field cut in half at the meridian plane z = 0,
-    coloured by |v|, arrows of the in-plane direction from the meridian grid (mirrored to
-    r < 0) and the projectile surface.  Written to ``png_path``."""
+    """Off-screen pyvista picture: the revolved body-fitted field cut in half at the meridian
+    plane z = 0 (the volume conforms to the projectile, so the field is clipped at the body),
+    coloured by |v| on the scale of :func:`semianalytic.report.figures.speed_scale` (log where
+    the range is wide, never clipped at the top), well-spaced arrows of the in-plane direction
+    (a regular lattice sampled in the meridian mesh, mirrored to r < 0) and the projectile
+    surface.  Written to ``png_path``."""
     import pyvista as pv
+
+    from semianalytic.report.figures import speed_scale
 
     pv.OFF_SCREEN = True
     vol = pv.read(str(volume_path))
@@ -227,30 +257,38 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
     p = pv.Plotter(off_screen=True, window_size=list(window))
     p.set_background("white")
     speed_all = np.asarray(vol.point_data["speed"])
-    top = float(np.nanpercentile(speed_all, 98)) if speed_all.size else 1.0
-    p.add_mesh(half, scalars="speed", cmap="viridis", show_scalar_bar=True, clim=[0.0, max(top, 1e-30)],
-               scalar_bar_args={"title": "speed |v| [m/s]", "color": "black", "vertical": True,
-                                "position_x": 0.86, "position_y": 0.15, "height": 0.7})
+    norm, extend, _ = speed_scale(speed_all)
+    log = type(norm).__name__ == "LogNorm"
+    # VTK's fonts lack '|': a plain title (the old "speed |v|" rendered as "speed ᵛ")
+    bar = {"title": "speed [m/s]" + (", log scale" if log else ""), "color": "black", "vertical": True,
+           "position_x": 0.86, "position_y": 0.15, "height": 0.7, "fmt": "%.3g"}
+    p.add_mesh(half, scalars="speed", cmap="viridis", show_scalar_bar=True, clim=[norm.vmin, norm.vmax],
+               log_scale=log, scalar_bar_args=bar)
     mer = pv.read(str(meridian_path))
     if mer.n_points:
-        step = max(1, mer.n_points // 300)
-        pts = np.asarray(mer.points)[::step]
-        vel = np.asarray(mer.point_data["velocity"])[::step]
+        b = mer.bounds
+        span = float(b[1] - b[0])
+        step = span / 28.0
+        gx, gy = np.meshgrid(np.arange(b[0] + 0.5 * step, b[1], step), np.arange(0.5 * step, b[3], step), indexing="ij")
+        lattice = pv.PolyData(np.column_stack([gx.ravel(), gy.ravel(), np.zeros(gx.size)]))
+        probed = lattice.sample(mer)
+        ok = np.asarray(probed["vtkValidPointMask"]) == 1
+        pts = np.asarray(probed.points)[ok]
+        vel = np.asarray(probed["velocity"])[ok]
         pts = np.vstack([pts, pts * [1.0, -1.0, 1.0]])
         vel = np.vstack([vel, vel * [1.0, -1.0, 1.0]])
-        span = float(np.ptp(vol.points[:, 0]))
         pts[:, 2] += 0.01 * span  # just above the cut face, towards the camera
         speed = np.linalg.norm(vel, axis=1)
         arrows_src = pv.PolyData(pts)
         arrows_src.point_data["direction"] = vel / np.where(speed > 0, speed, 1.0)[:, None]
-        p.add_mesh(arrows_src.glyph(orient="direction", scale=False, factor=0.035 * span), color="white")
+        p.add_mesh(arrows_src.glyph(orient="direction", scale=False, factor=0.6 * step), color="white")
     if surface_path is not None:
-        surf = pv.read(str(surface_path))
-        surf = surf.clip(normal=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0))
-        p.add_mesh(surf, color="lightgrey", smooth_shading=True)
+        # the whole projectile: in parallel projection it covers exactly its own cut section
+        p.add_mesh(pv.read(str(surface_path)), color="lightgrey", smooth_shading=True)
     if title:
         p.add_text(title, font_size=10, color="black")
     p.view_xy()
+    p.enable_parallel_projection()
     p.reset_camera(bounds=vol.bounds)
     p.camera.zoom(1.1)
     png_path = Path(png_path)

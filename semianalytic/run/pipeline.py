@@ -19,6 +19,7 @@ from pathlib import Path
 from semianalytic.case import Case
 from semianalytic.errors import InputError
 from semianalytic.report.document import fmt
+from semianalytic.report.provenance import generated_by, version
 from semianalytic.run import bodies, fields, part1, part2, parts34  # noqa: F401 (steps register on import)
 from semianalytic.run.context import Context
 from semianalytic.run.registry import Step, _mm, _projectile, select_steps
@@ -32,10 +33,12 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     from semianalytic.report.document import Document, to_markdown
     from semianalytic.report.html import to_html
     from semianalytic.report.output import StagedDir, check_output_dir
+    from semianalytic.report.provenance import case_identity
     from semianalytic.run.case import RunSection
 
     t0 = time.perf_counter()
     case = load_case(case_path)
+    identity = case_identity(case_path)
     run_section = case.section("run") or RunSection()
     steps, skipped = select_steps(case, run_section, only)
     check_output_dir(out, force)
@@ -44,7 +47,7 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     with StagedDir(out, force) as staged:
         title = case.title or Path(case_path).stem
         ctx = Context(case, staged, run_section, Document(f"Report: {title}"), render=render, cache_dir=cache_dir)
-        introduction(ctx, case_path, steps, skipped)
+        introduction(ctx, identity, steps, skipped, _command(identity, out, case_path))
         for step in steps:
             t = time.perf_counter()
             step.run(ctx)
@@ -57,7 +60,10 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
             caption="Wall-clock time of each analysis (this machine).",
         )
         results = {
-            "case": {"path": str(case_path), "title": case.title, "reproduces": case.reproduces},
+            # the case by file name and content hash: no output carries a machine path
+            "case": {"path": identity["file"], "file": identity["file"], "sha256": identity["sha256"],
+                     "title": case.title, "reproduces": case.reproduces},
+            "generated_by": {"command": _command(identity, out, case_path), "version": version()},
             "analyses": ctx.results,
             "skipped": skipped,
             "timings_s": ctx.timings,
@@ -65,19 +71,40 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
         }
         staged.write_json("results.json", results)
         staged.write_text("report.md", to_markdown(ctx.doc))
-        staged.write_text("report.html", to_html(ctx.doc))
+        # the figures embedded as data: URIs (the page can be mailed alone); the files stay beside it
+        staged.write_text("report.html", to_html(ctx.doc, images=lambda rel: _staged_bytes(staged, rel)))
         results["files"] = sorted(staged.files)
     return results
+
+
+def _staged_bytes(staged, rel: str) -> bytes | None:
+    p = staged.root / rel
+    return p.read_bytes() if p.is_file() else None
+
+
+def _shown(path, name: str) -> str:
+    """A path as a report may show it: relative as given (e.g. ``cases/x.toml``), else ``name``
+    only (an absolute path, or one climbing with '..', would name the machine's folders)."""
+    p = Path(path)
+    return p.as_posix() if not p.is_absolute() and ".." not in p.parts else name
+
+
+def _command(identity: dict, out, case_path) -> str:
+    """The command that made the report, without the machine's folders."""
+    return f"python -m semianalytic run {_shown(case_path, identity['file'])} --out {_shown(out, Path(out).name)}"
 
 
 # --------------------------------------------------------------------------------------
 # introduction
 
 
-def introduction(ctx: Context, case_path, steps: list[Step], skipped: dict[str, str]) -> None:
+def introduction(ctx: Context, identity: dict, steps: list[Step], skipped: dict[str, str],
+                 command: str | None = None) -> None:
     case = ctx.case
     d = ctx.doc
-    d.para(f"Case file: `{Path(case_path).as_posix()}`.")
+    if command is not None:
+        d.para(generated_by(command))
+    d.para(f"Case file: `{identity['file']}` (sha256 `{identity['sha256'][:12]}`).")
     if case.reproduces:
         d.para(f"Reproduces: {case.reproduces}.")
     d.para("Analyses run: " + ", ".join(f"`{s.name}`" for s in steps) + ".")
