@@ -7,8 +7,8 @@ Example (``cases/piekutowski1999_var4340.toml``)::
     parameters = ["target.resistance.yield_stress"]  # default: the resistance model's strength
     discrepancy = "halfnormal(0.15)"  # prior of sigma, the sd of ln(measured/predicted depth)
     walkers = 32                      # emcee ensemble
-    steps = 1500
-    burn = 300
+    steps = 1000
+    burn = 250
     seed = 1
     transfer = ["piekutowski1999_aermet100.toml"]   # cases predicted in --cross-validate
     [calibration.prior]
@@ -63,8 +63,8 @@ class CalibrationSection(Section):
     parameters: list[str] | None = None
     discrepancy: str = "halfnormal(0.15)"
     walkers: int = Field(default=32, ge=4, le=1000)
-    steps: int = Field(default=1500, ge=50, le=10**6)
-    burn: int = Field(default=300, ge=0)
+    steps: int = Field(default=1000, ge=50, le=10**6)
+    burn: int = Field(default=250, ge=0)
     seed: int = 1
     transfer: list[str] = Field(default_factory=list)
     prior: dict[str, str] = Field(default_factory=dict)

@@ -43,6 +43,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
     parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+    parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None,
+                        help="add predictive depth quantiles (depth_quantiles_m) from a posterior written by calibrate")
 
 
 def _load(paths):
@@ -102,6 +104,11 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
             f" {'YES (outside the model)' if r['yields'] else 'no'}"
         )
+    if "depth_quantiles_m" in result:
+        p(f"  predictive depth from {result['posterior_file']}: median [5 %, 95 %] mm")
+        for model, q in result["depth_quantiles_m"].items():
+            cells = "  ".join(f"{a * 1e3:.0f} [{b * 1e3:.0f}, {c * 1e3:.0f}]" for a, b, c in zip(q["0.5"], q["0.05"], q["0.95"]))
+            p(f"    {model:<18} {cells}")
     val = result.get("validation")
     if val:
         p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
@@ -126,6 +133,10 @@ def run(args) -> int:
             print("warning: the BEM coefficient table is not available in this version; using the paper's quoted "
                   "constant Abar, Bbar, Cbar instead", file=sys.stderr)
         results.append(evaluate_case(case, coefficients, w1=args.w1))
+        if args.posterior is not None:
+            from semianalytic.calibration.evaluate import predict_with_posterior
+
+            results[-1].update(predict_with_posterior(case, coefficients, args.posterior))
         descs.append(desc)
     if args.json:
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
