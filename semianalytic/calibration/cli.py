@@ -31,6 +31,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--report-name", default="report", help="stem of the report files in DIR (default: report)")
     parser.add_argument("--coefficients", choices=("bem", "paper"), default="bem", help="A, B, C source (default: BEM table)")
     parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
+    parser.add_argument("--diagnose", action="store_true",
+                        help="add the study of the over-prediction of the Part I models (B reading, W1, contact region, Y)")
+    parser.add_argument("--report", metavar="PATH.md", default=None,
+                        help="also write the report as PATH.md and PATH.html, figures beside it (e.g. reports/validation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--force", action="store_true", help="replace an existing DIR")
 
@@ -51,13 +55,19 @@ def run(args) -> int:
     if not args.report_name.replace("_", "").replace("-", "").isalnum():
         raise InputError("--report-name", "letters, digits, '_' and '-' only")
     check_output_dir(args.out, args.force)
+    if args.report is not None:
+        from semianalytic.io import check_report_target
+
+        if not str(args.report).endswith(".md"):
+            raise InputError("--report", f"expected a path ending in .md; got {args.report!r}")
+        check_report_target(args.report, args.force)
     case = load_case(args.case)
     for sec in ("projectile", "target", "data"):
         case.require(sec)
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []
-    if args.cross_validate:
+    if args.cross_validate or args.diagnose:
         sec = case.section("calibration")
         paths = [Path(case.path).parent / p for p in (sec.transfer if sec else [])] + [Path(p) for p in args.transfer]
         for p in paths:
@@ -68,9 +78,18 @@ def run(args) -> int:
     result = calibrate_case(case, coefficients, models=args.model, parameters=args.parameter, progress=progress,
                             steps=args.steps)
     cv = cross_validate(case, coefficients, result, transfer, progress=progress) if args.cross_validate else None
+    diag = None
+    if args.diagnose:
+        from semianalytic.calibration.diagnose import diagnose
+
+        pairs = [(case, coefficients), *transfer]
+        diag = diagnose(pairs, [coefficients_for_case(c, "paper")[0] for c, _ in pairs])
     command = "python -m semianalytic calibrate " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == [
         "calibrate"] else f"python -m semianalytic calibrate {args.case} --out {args.out}"
-    doc, figs = build_report(result, command, cv)
+    from semianalytic.calibration.report import diagnosis_blocks
+
+    extra = (lambda d, f: diagnosis_blocks(d, diag)) if diag is not None else None
+    doc, figs = build_report(result, command, cv, extra)
     with StagedDir(args.out, args.force) as out:
         out.write_json("posterior.json", result["posterior"])
         if cv is not None:
@@ -79,6 +98,18 @@ def run(args) -> int:
             out.write_bytes(name, data)
         out.write_text(f"{args.report_name}.md", to_markdown(doc))
         out.write_text(f"{args.report_name}.html", to_html(doc))
+        if diag is not None:
+            out.write_json("diagnosis.json", diag)
+    if args.report is not None:
+        from semianalytic.io import atomic_write_bytes, atomic_write_text
+
+        target = Path(args.report)
+        doc2, figs2 = build_report(result, command, cv, extra, prefix=target.stem + "_")
+        target.parent.mkdir(parents=True, exist_ok=True)
+        for name, data in figs2.items():
+            atomic_write_bytes(target.parent / name, data)
+        atomic_write_text(target.with_suffix(".html"), to_html(doc2))
+        atomic_write_text(target, to_markdown(doc2))
     print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
     for m in result["settings"]["models"]:
         s = result["posterior"]["models"][m]["summary"]

@@ -49,7 +49,7 @@ __all__ = ["calibrate_case", "cross_validate", "predict_with_posterior", "QUANTI
 QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 SURROGATE_NODES = 16  # Chebyshev nodes in ln R_t over the prior range (see the tests for its accuracy)
 PREDICTION_NODES = 6  # over the narrower posterior range
-STORED_DRAWS = 2000
+STORED_DRAWS = 1000
 LOO_STEPS = 500  # per refit, a quarter discarded: 32 walkers x 375 steps / tau ~ 20 -> ~600 effective draws
 
 

@@ -161,3 +161,29 @@ def cross_validation_blocks(doc: Document, cv: dict, models) -> None:
                   caption=f"Transfer predictions of {MODEL_LABELS[show]} for {entry['title']}")
 
 
+
+
+def diagnosis_blocks(doc: Document, diag: dict) -> None:
+    """Item 5 of issue 12: the over-prediction of the physically consistent model."""
+    doc.heading("Why the physically consistent model over-predicts (issue 12, item 5)")
+    doc.para(
+        "Relative error (predicted - measured)/measured of the quasi-rigid and the exact-rod elastic models on the "
+        f"rigid shots of {', '.join(diag['cases'])}, one change at a time, nothing fitted to the shots. "
+        "'slope' is the least-squares slope of the error against U_s over all shots (per km/s): a wrong static "
+        "resistance shifts the error by a nearly constant fraction at these velocities, a wrong velocity term "
+        "makes it grow with U_s."
+    )
+    rows = []
+    for v in diag["variants"]:
+        if "error" in v:
+            rows.append([v["label"], v["what"], "-", "-", "-", f"not evaluable: {v['error']}"])
+            continue
+        for m, st in v["models"].items():
+            per = ", ".join(_pct(x) for x in st["per_case_mean"])
+            rows.append([v["label"], v["what"] if m == "quasi_rigid" else "", m, per, _pct(st["mean"]),
+                         f"{_pct(st['mean_abs']).lstrip('+')}; slope {_pct(st['slope_per_km_s'])}/(km/s)"])
+    doc.table(["variant", "change", "model", "mean error per case", "mean error, all shots", "mean |error|; slope"],
+              rows, caption="Mean error of the Part I models on the rigid shots under single changes")
+    doc.table(["force model", "coefficient of rho U^2 in the deep nose pressure"],
+              [[k, f"{v:.3f}"] for k, v in diag["dynamic_coefficients"].items()],
+              caption="The velocity term of each force model (deep penetration, per unit shank area)")

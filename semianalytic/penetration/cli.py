@@ -132,11 +132,12 @@ def run(args) -> int:
         if fallback:
             print("warning: the BEM coefficient table is not available in this version; using the paper's quoted "
                   "constant Abar, Bbar, Cbar instead", file=sys.stderr)
-        results.append(evaluate_case(case, coefficients, w1=args.w1))
-        if args.posterior is not None:
+        quantiles = {}
+        if args.posterior is not None:  # first: a bad posterior stops before anything is computed
             from semianalytic.calibration.evaluate import predict_with_posterior
 
-            results[-1].update(predict_with_posterior(case, coefficients, args.posterior))
+            quantiles = predict_with_posterior(case, coefficients, args.posterior)
+        results.append(dict(evaluate_case(case, coefficients, w1=args.w1), **quantiles))
         descs.append(desc)
     if args.json:
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
