@@ -84,6 +84,10 @@ def run(args) -> int:
 
         pairs = [(case, coefficients), *transfer]
         diag = diagnose(pairs, [coefficients_for_case(c, "paper")[0] for c, _ in pairs])
+        if args.cross_validate and args.coefficients == "bem":
+            from semianalytic.calibration.diagnose import reading_cross_validation
+
+            diag["literal_cross_validation"] = reading_cross_validation(case, coefficients, transfer, progress=progress)
     command = "python -m semianalytic calibrate " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == [
         "calibrate"] else f"python -m semianalytic calibrate {args.case} --out {args.out}"
     from semianalytic.calibration.report import diagnosis_blocks

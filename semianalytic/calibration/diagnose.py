@@ -113,3 +113,16 @@ def diagnose(cases_with_coefficients, paper_coefficients) -> dict:
         dyn["Forrestal, the data authors' constants: C N_2"] = data.cavity_C * N2
     return {"cases": [c.title for c, _ in cases_with_coefficients], "variants": variants,
             "dynamic_coefficients": dyn, "nose_factor_N2": N2}
+
+
+def reading_cross_validation(case, table, transfer, models=MODELS, reading: str = "literal", progress: bool = False) -> dict:
+    """Calibration, leave-one-out and transfer split of ``models`` with the B reading
+    ``reading`` (the other inputs unchanged): whether the reading chosen on the case's shots
+    also predicts the transfer cases' shots, which it was not chosen on."""
+    from semianalytic.calibration.evaluate import calibrate_case, cross_validate
+
+    res = calibrate_case(case, table.with_reading(reading), models=list(models))
+    cv = cross_validate(case, table.with_reading(reading), res, [(c, t.with_reading(reading)) for c, t in transfer],
+                        progress=progress)
+    return {"reading": reading, "models": list(models), "cross_validation": cv,
+            "posterior_summary": {m: res["posterior"]["models"][m]["summary"] for m in models}}
