@@ -260,6 +260,7 @@ def test_penetrate_posterior_refuses_other_target_and_bad_files(tmp_path, capsys
     assert code == 2 and "does not exist" in err
 
 
+PRIOR = '"target.resistance.yield_stress" = "lognormal(300 MPa, 0.5)"'
 CSV_HEAD = "table,shot,material,Vs_m_s,P_mm,mass_g,regime\n"
 
 
@@ -276,18 +277,23 @@ CSV_HEAD = "table,shot,material,Vs_m_s,P_mm,mass_g,regime\n"
         (None, CSV_HEAD + "1,a,VAR4340,600,60,0,rigid\n1,b,VAR4340,700,70,20.4,rigid\n1,c,VAR4340,800,90,20.4,rigid\n",
          [], "data.file"),
         (None, CSV_HEAD + "1,a,VAR4340,600,60,20.4,rigid\n1,b,VAR4340,700,70,20.4,rigid\n", [], "data.file"),
-        (lambda t: t + '\n[calibration.prior]\n"target.resistance.yield_stress" = "lognormal(300 MPa 0.5)"\n', None, [],
+        (lambda t: t.replace(PRIOR, PRIOR.replace("MPa,", "MPa")), None, [],
          "calibration.prior.target.resistance.yield_stress"),
-        (lambda t: t + '\n[calibration.prior]\n"target.resistance.yield_stress" = "lognormal(300 m/s, 0.5)"\n', None, [],
+        (lambda t: t.replace(PRIOR, PRIOR.replace("MPa", "m/s")), None, [],
          "calibration.prior.target.resistance.yield_stress"),
-        (lambda t: t + '\n[calibration.prior]\n"target.resistance.yield_stress" = "gamma(2, 3)"\n', None, [],
+        (lambda t: t.replace(PRIOR, PRIOR.replace("lognormal(300 MPa, 0.5)", "gamma(2, 3)")), None, [],
          "calibration.prior.target.resistance.yield_stress"),
-        (lambda t: t + '\n[calibration]\ndiscrepancy = "halfnormal(-1)"\n', None, [], "calibration.discrepancy"),
+        (lambda t: t.replace('discrepancy = "halfnormal(0.15)"', 'discrepancy = "halfnormal(-1)"'), None, [],
+         "calibration.discrepancy"),
+        (lambda t: t.replace(PRIOR, PRIOR.replace("yield_stress", "yield_strength")), None, [],
+         "calibration.prior.target.resistance.yield_strength"),
         (None, None, ["--parameter", "target.density"], "--parameter"),
         (None, None, ["--parameter", "target.resistance.shear"], "--parameter"),
     ],
 )
 def test_calibrate_bad_input(tmp_path, capsys, edit, csv_text, argv, field):
+    if edit is not None:
+        assert edit((CASES / "piekutowski1999_var4340.toml").read_text()) != (CASES / "piekutowski1999_var4340.toml").read_text()
     if csv_text is not None and csv_text:
         csv_text = "# comment\n" + csv_text
     case = _copy_case(tmp_path, edit=edit, csv_text=csv_text)

@@ -95,9 +95,13 @@ def _settings(case, models, parameters):
     resistance = resistance_from_case(case)
     models = check_models(models or sec.models or MODELS)
     keys = list(dict.fromkeys(parameters or sec.parameters or [default_parameter(resistance)]))
-    for key in sec.prior:
-        if key not in keys:
-            raise InputError(f"calibration.prior.{key}", f"not a calibrated parameter (calibrated: {', '.join(keys)})")
+    for key in keys:
+        parameter_kind(key, resistance)
+    for key in sec.prior:  # a prior of a parameter not calibrated now is unused, but must name a parameter
+        try:
+            parameter_kind(key, resistance)
+        except InputError as exc:
+            raise InputError(f"calibration.prior.{key}", exc.message) from None
     priors, units = [], []
     for key in keys:
         kind, unit, scale = parameter_kind(key, resistance)
@@ -213,6 +217,9 @@ def calibrate_case(case, coefficients, *, models=None, parameters=None, progress
                    steps: int | None = None) -> dict:
     """Calibrate (see the module docstring).  Returns {"posterior": JSON dict, "shots": ShotSet,
     "fits": {model: quantiles}, "curves": {...}, "histograms": {...}, "settings": {...}}."""
+    import time
+
+    t0, c0 = time.perf_counter(), time.process_time()
     sec, models, keys, priors, sigma_prior, units = _settings(case, models, parameters)
     target = _target(case, coefficients, keys)
     shots = load_shot_set(case, target.inputs.setup.mass)
@@ -250,6 +257,7 @@ def calibrate_case(case, coefficients, *, models=None, parameters=None, progress
         "shots": shots,
         "curves": curves,
         "histograms": histograms,
+        "timing_s": {"wall": time.perf_counter() - t0, "cpu": time.process_time() - c0},
         "settings": {"models": list(models), "parameters": list(keys), "units": units, "R_range_Pa": (lo, hi),
                      "surrogate_nodes": SURROGATE_NODES, "discrepancy_prior": sec.discrepancy},
         "_internal": {"target": target, "surrogates": surrogates, "posts": posts, "priors": priors,
@@ -286,8 +294,11 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
                    loo_steps: int | None = None) -> dict:
     """Leave-one-out (exact refits) and transfer splits for every model of ``result``
     (from :func:`calibrate_case`).  ``transfer``: [(case, coefficients)] with the same target."""
+    import time
+
     from tqdm import tqdm
 
+    t0, c0 = time.perf_counter(), time.process_time()
     it = result["_internal"]
     target, surrogates, posts = it["target"], it["surrogates"], it["posts"]
     sec = it["section"]
@@ -316,7 +327,9 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
                          "shots": {"id": list(shots.ids), "measured_m": shots.depth.tolist(),
                                    **{f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}}}
     bar.close()
+    out["timing_s"] = {"loo_wall": time.perf_counter() - t0, "loo_cpu": time.process_time() - c0}
     for tcase, tcoef in transfer:
+        t1, c1 = time.perf_counter(), time.process_time()
         check_target(tcase, result["posterior"]["target"], keys)
         ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape)
         tshots = load_shot_set(tcase, ttarget.inputs.setup.mass, minimum=1)
@@ -329,6 +342,7 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
                                   "shots": {"id": list(tshots.ids), "velocity_m_s": tshots.velocity.tolist(),
                                             "measured_m": tshots.depth.tolist(),
                                             **{f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}}}
+        entry["timing_s"] = {"wall": time.perf_counter() - t1, "cpu": time.process_time() - c1}
         out["transfer"][entry["case"]] = entry
     return out
 

@@ -46,6 +46,10 @@ def build_report(result: dict, command: str, cv: dict | None = None, extra=None,
         "model to about 0.4 %, the size of that model's own steps in R_t (its stop time jumps between oscillation "
         "periods of the rod), far below sigma."
     )
+    tm = result.get("timing_s")
+    if tm:
+        doc.para(f"Time of this calibration ({len(models)} models, surrogates included): {tm['cpu']:.1f} s CPU, "
+                 f"{tm['wall']:.1f} s wall on the machine that ran the command (shared; CPU time is the fair figure).")
     doc.heading("Data and priors")
     data = post["data"]
     doc.para(f"Data: `{data['file']}` ({data.get('source') or ''}), rows selected by {data['select']}; "
@@ -142,6 +146,13 @@ def cross_validation_blocks(doc: Document, cv: dict, models) -> None:
     )
     doc.table(_STATS_HEADER, [_stats_row(MODEL_LABELS[m], cv["loo"][m]["statistics"]) for m in models],
               caption="Leave-one-out, per model")
+    if "timing_s" in cv:
+        t = cv["timing_s"]
+        doc.para(f"Leave-one-out time: {t['loo_cpu']:.1f} s CPU ({t['loo_wall']:.1f} s wall) for "
+                 f"{len(models) * cv['loo'][models[0]]['statistics']['n']} refits. " + " ".join(
+                     f"Predicting the {e['models'][models[0]]['statistics']['n']} shots of `{k}` from the posterior "
+                     f"(what `penetrate --posterior` does, all models): {e['timing_s']['cpu']:.2f} s CPU."
+                     for k, e in cv["transfer"].items() if "timing_s" in e))
     for name, entry in cv["transfer"].items():
         doc.table(_STATS_HEADER, [_stats_row(MODEL_LABELS[m], entry["models"][m]["statistics"]) for m in models],
                   caption=f"Transfer: calibrated on this case's shots, predicting the shots of {entry['title']} (`{name}`)")
