@@ -64,14 +64,18 @@ class Target:
     fixed: dict
 
 
-def _target(case, coefficients, keys, cavity_shape=None) -> Target:
+def _target(case, coefficients, keys, cavity_shape=None, models=MODELS) -> Target:
     from semianalytic.geometry import nose_from_section
     from semianalytic.penetration import peers
     from semianalytic.penetration.curve import PenetrationSetup
     from semianalytic.penetration.resistance import resistance_from_case
 
-    setup = PenetrationSetup.from_case(case, coefficients)
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
     psec = case.require("projectile")
+    needs_rod = [m for m in models if m in ("quasi_rigid", "elastic", "elastic_exact_rod")]
+    if needs_rod and setup.rod is None:
+        raise InputError("projectile.youngs_modulus", f"missing: the {needs_rod[0]} model needs the projectile's "
+                                                      "Young's modulus (e.g. '210 GPa')")
     resistance = resistance_from_case(case)
     fields = tuple(k.rsplit(".", 1)[-1] for k in keys)
     if cavity_shape is None:
@@ -221,7 +225,7 @@ def calibrate_case(case, coefficients, *, models=None, parameters=None, progress
 
     t0, c0 = time.perf_counter(), time.process_time()
     sec, models, keys, priors, sigma_prior, units = _settings(case, models, parameters)
-    target = _target(case, coefficients, keys)
+    target = _target(case, coefficients, keys, models=models)
     shots = load_shot_set(case, target.inputs.setup.mass)
     lo, hi = _range(target.resistance, priors)
     surrogates = build_surrogate(target.inputs, models, shots, lo, hi, SURROGATE_NODES)
@@ -331,7 +335,7 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
     for tcase, tcoef in transfer:
         t1, c1 = time.perf_counter(), time.process_time()
         check_target(tcase, result["posterior"]["target"], keys)
-        ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape)
+        ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape, models=models)
         tshots = load_shot_set(tcase, ttarget.inputs.setup.mass, minimum=1)
         pred = _predict(ttarget, models, tshots, {m: (posts[m].theta, posts[m].sigma) for m in models})
         entry = {"case": str(tcase.path) if tcase.path else tcase.title, "title": tcase.title, "models": {}}
@@ -354,7 +358,7 @@ def predict_with_posterior(case, coefficients, path, velocities=None) -> dict:
     post = read_posterior(path)
     keys = post["parameters"]
     check_target(case, post["target"], keys)
-    target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"])
+    target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"], models=tuple(post["models"]))
     U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
     shots = ShotSet(U, np.full(U.shape, target.inputs.setup.mass), np.full(U.shape, np.nan),
                     tuple(str(k) for k in range(len(U))))

@@ -88,9 +88,9 @@ def build_report(result: dict, command: str, cv: dict | None = None, extra=None,
     # figures
     hist_panels = []
     for j, (k, u) in enumerate(zip(keys, units)):
-        series = [Series(np.asarray(result["histograms"][m][k]["centres"]) / u[1], result["histograms"][m][k]["density"],
-                         m, "-") for m in models]
-        hist_panels.append((f"{k} [{u[0]}]", "posterior density", series))
+        series = [Series(np.asarray(result["histograms"][m][k]["centres"]) / u[1],
+                         np.asarray(result["histograms"][m][k]["density"]) * u[1], m, "-") for m in models]
+        hist_panels.append((f"{k} [{u[0]}]", f"posterior density [1/{u[0]}]" if u[0] else "posterior density", series))
     hist_panels.append(("sigma (ln depth)", "posterior density",
                         [Series(result["histograms"][m]["sigma"]["centres"], result["histograms"][m]["sigma"]["density"], m)
                          for m in models]))
