@@ -66,6 +66,12 @@ SHOTS = ShotSet(np.array([569.0, 821.0, 1147.0, 1237.0]), np.array([20.38e-3, 20
                 np.array([58e-3, 102e-3, 190e-3, 224e-3]), ("a", "b", "c", "d"))
 
 
+def test_models_are_the_validation_models():
+    from semianalytic.penetration.validation import MODEL_LABELS
+
+    assert MODELS == tuple(MODEL_LABELS)
+
+
 def test_rigid_depth_is_exact_for_every_resistance():
     """Rigid model vectorised in R_t (the G/R_t scaling of eq. (11)) against the closed form."""
     inp = _paper_inputs()

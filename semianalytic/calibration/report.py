@@ -5,7 +5,8 @@ from __future__ import annotations
 
 import numpy as np
 
-from semianalytic.calibration.models import MODEL_LABELS, PHYSICALLY_CONSISTENT
+from semianalytic.calibration.models import PHYSICALLY_CONSISTENT
+from semianalytic.penetration.validation import MODEL_LABELS
 from semianalytic.report.document import Document
 from semianalytic.report.figures import Points, Series, line_figure, png_bytes, side_by_side_figure
 
