@@ -210,6 +210,7 @@ SECTIONS: dict[str, str] = {
     "nanostrength": "semianalytic.nanostrength.case:NanostrengthSection",
     "data": "semianalytic.penetration.case:DataSection",
     "run": "semianalytic.run.case:RunSection",
+    "calibration": "semianalytic.calibration.case:CalibrationSection",
 }
 
 _CORE = {

@@ -24,6 +24,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "fit-constants": ("semianalytic.ballistic_limit.fit_cli", "refit the empirical constants C1, C2, C3 (Part IV, eqs. 7-9)"),
     "nanostrength": ("semianalytic.nanostrength.cli", "theoretical strength of diamond-like nanoparticles (Part III)"),
     "run": ("semianalytic.run.cli", "run everything a case asks for and write a report"),
+    "calibrate": ("semianalytic.calibration.cli", "Bayesian calibration of target parameters on measured depths, predictive intervals, cross-validation"),
     "sweep": ("semianalytic.sweep.cli", "parallel parameter sweeps and Monte-Carlo studies"),
     "demo": ("semianalytic.demo", "run the main job on a bundled case and say where its report is"),
 }

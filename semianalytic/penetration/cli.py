@@ -57,6 +57,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
                         "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
+    parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None,
+                        help="add predictive depth quantiles (depth_quantiles_m) from a posterior written by calibrate")
 
 
 def _load(paths):
@@ -121,6 +123,11 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             f" {_fmt(result['depth_eroding_m'][i], 1e3):>8} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} |"
             f" {'YES (outside the model)' if r['yields'] else 'no'}"
         )
+    if "depth_quantiles_m" in result:
+        p(f"  predictive depth from {result['posterior_file']}: median [5 %, 95 %] mm")
+        for model, q in result["depth_quantiles_m"].items():
+            cells = "  ".join(f"{a * 1e3:.0f} [{b * 1e3:.0f}, {c * 1e3:.0f}]" for a, b, c in zip(q["0.5"], q["0.05"], q["0.95"]))
+            p(f"    {model:<18} {cells}")
     val = result.get("validation")
     if val:
         p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
@@ -144,7 +151,12 @@ def run(args) -> int:
         if fallback:
             print("warning: the BEM coefficient table is not available in this version; using the paper's quoted "
                   "constant Abar, Bbar, Cbar instead", file=sys.stderr)
-        results.append(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model))
+        quantiles = {}
+        if args.posterior is not None:  # first: a bad posterior stops before anything is computed
+            from semianalytic.calibration.evaluate import predict_with_posterior
+
+            quantiles = predict_with_posterior(case, coefficients, args.posterior)
+        results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model), **quantiles))
         descs.append(desc)
         for line in results[-1]["warnings"]:
             print(f"{line} [{case.path or case.title}]", file=sys.stderr)

@@ -1,0 +1,235 @@
+"""The ``[calibration]`` case section, prior strings with units, the shots and the posterior file.
+
+Example (``cases/piekutowski1999_var4340.toml``)::
+
+    [calibration]
+    models = ["elastic_exact_rod", "quasi_rigid", "forrestal"]   # default: every depth model
+    parameters = ["target.resistance.yield_stress"]  # default: the resistance model's strength
+    discrepancy = "halfnormal(0.15)"  # prior of sigma, the sd of ln(measured/predicted depth)
+    walkers = 32                      # emcee ensemble
+    steps = 1000
+    burn = 250
+    seed = 1
+    transfer = ["piekutowski1999_aermet100.toml"]   # cases predicted in --cross-validate
+    [calibration.prior]
+    "target.resistance.yield_stress" = "lognormal(300 MPa, 0.5)"
+
+Priors: ``lognormal(MEDIAN, SIGMA_LN)``, ``normal(MEAN, SD)``, ``uniform(LOW, HIGH)``,
+``halfnormal(SCALE)``, quantities with the parameter's unit (dimensionless parameters and
+SIGMA_LN plain numbers).  Default prior of a parameter: lognormal(the case's value, 0.5).
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import json
+import math
+import re
+from pathlib import Path
+
+import numpy as np
+from pydantic import Field
+
+from semianalytic.calibration.models import MODELS, ShotSet
+from semianalytic.calibration.priors import HalfNormal, LogNormal, Normal, Uniform
+from semianalytic.errors import InputError
+from semianalytic.schema import Section
+
+__all__ = ["CalibrationSection", "parse_prior", "parameter_kind", "default_parameter", "load_shot_set",
+           "read_posterior", "POSTERIOR_FORMAT"]
+
+POSTERIOR_FORMAT = "semianalytic-posterior"
+MIN_SHOTS = 3
+
+# resistance field -> unit kind (pint) and display unit
+_KINDS = {
+    "yield_stress": ("pressure", "MPa", 1e6), "youngs_modulus": ("pressure", "GPa", 1e9),
+    "compressive_strength": ("pressure", "MPa", 1e6), "tensile_strength": ("pressure", "MPa", 1e6),
+    "psi": ("pressure", "MPa", 1e6), "phi": ("pressure", "MPa", 1e6), "value": ("pressure", "MPa", 1e6),
+    "reference_diameter": ("length", "mm", 1e-3),
+    "poisson_ratio": ("dimensionless", "", 1.0), "alpha": ("dimensionless", "", 1.0),
+    "hardening_exponent": ("dimensionless", "", 1.0),
+}
+_DEFAULT_PARAMETER = {
+    "elastic-plastic": "yield_stress", "hardening": "yield_stress", "part4": "yield_stress",
+    "brittle": "compressive_strength", "limestone": "psi", "constant": "value",
+}
+
+
+class CalibrationSection(Section):
+    """``[calibration]`` (see the module docstring)."""
+
+    models: list[str] | None = None
+    parameters: list[str] | None = None
+    discrepancy: str = "halfnormal(0.15)"
+    walkers: int = Field(default=32, ge=4, le=1000)
+    steps: int = Field(default=1000, ge=50, le=10**6)
+    burn: int = Field(default=250, ge=0)
+    seed: int = 1
+    transfer: list[str] = Field(default_factory=list)
+    prior: dict[str, str] = Field(default_factory=dict)
+
+
+def parameter_kind(key: str, resistance) -> tuple[str, str, float]:
+    """(unit kind, display unit, its SI scale) of a calibrated case key, or InputError."""
+    prefix = "target.resistance."
+    if not key.startswith(prefix):
+        raise InputError("--parameter", f"only target.resistance.* keys can be calibrated (the target's "
+                                        f"resistance, Part I eqs. (16)-(19)); got {key!r}")
+    name = key[len(prefix):]
+    fields = {f.name for f in dataclasses.fields(resistance)}
+    if name not in fields or name not in _KINDS:
+        ok = ", ".join(prefix + f for f in sorted(fields) if f in _KINDS)
+        raise InputError("--parameter", f"{key!r} is not a number of the '{resistance.name}' resistance model; "
+                                        f"one of: {ok or 'none'}")
+    return _KINDS[name]
+
+
+def default_parameter(resistance) -> str:
+    name = _DEFAULT_PARAMETER.get(resistance.name)
+    if name is None:
+        raise InputError("target.resistance.model", f"the '{resistance.name}' resistance cannot be calibrated; "
+                                                    "use elastic-plastic, hardening, part4, brittle, limestone or constant")
+    return "target.resistance." + name
+
+
+_PRIOR = re.compile(r"^\s*(lognormal|normal|uniform|halfnormal)\s*\((.*)\)\s*$", re.IGNORECASE)
+
+
+def _value(text: str, kind: str, field: str) -> float:
+    from semianalytic.units import parse_quantity
+
+    text = text.strip()
+    if kind == "dimensionless":
+        try:
+            return float(text)
+        except ValueError:
+            raise InputError(field, f"expected a plain number; got {text!r}") from None
+    return parse_quantity(text, kind, field)
+
+
+def parse_prior(text, kind: str, field: str):
+    """A prior from its string, e.g. ``"lognormal(300 MPa, 0.5)"`` with a ``kind`` quantity."""
+    m = _PRIOR.match(text) if isinstance(text, str) else None
+    if m is None:
+        raise InputError(field, f"expected lognormal(MEDIAN, SIGMA_LN), normal(MEAN, SD), uniform(LOW, HIGH) or "
+                                f"halfnormal(SCALE); got {text!r}")
+    name, args = m.group(1).lower(), [a for a in m.group(2).split(",")]
+    need = 1 if name == "halfnormal" else 2
+    if len(args) != need or any(not a.strip() for a in args):
+        raise InputError(field, f"{name} takes {need} argument(s); got {text!r}")
+    if name == "lognormal":
+        median, sigma = _value(args[0], kind, field), _value(args[1], "dimensionless", field)
+        if not (median > 0 and sigma > 0):
+            raise InputError(field, f"lognormal needs a positive median and sigma; got {text!r}")
+        return LogNormal(median, sigma)
+    if name == "normal":
+        mean, sd = _value(args[0], kind, field), _value(args[1], kind, field)
+        if not sd > 0:
+            raise InputError(field, f"normal needs a positive sd; got {text!r}")
+        return Normal(mean, sd)
+    if name == "uniform":
+        lo, hi = _value(args[0], kind, field), _value(args[1], kind, field)
+        if not hi > lo:
+            raise InputError(field, f"uniform needs LOW < HIGH; got {text!r}")
+        return Uniform(lo, hi)
+    scale = _value(args[0], kind, field)
+    if not scale > 0:
+        raise InputError(field, f"halfnormal needs a positive scale; got {text!r}")
+    return HalfNormal(scale)
+
+
+def check_models(models) -> tuple[str, ...]:
+    for m in models:
+        if m not in MODELS:
+            raise InputError("--model", f"unknown model {m!r}; one of {', '.join(MODELS)}")
+    return tuple(dict.fromkeys(models))
+
+
+def load_shot_set(case, projectile_mass: float, *, minimum: int = MIN_SHOTS) -> ShotSet:
+    """The case's ``[data]`` shots as a :class:`ShotSet` (SI), each with its own mass where the
+    data give one, else the projectile's.  Bad input (file missing or empty, a column absent,
+    a non-positive value, fewer than ``minimum`` shots): InputError naming the field."""
+    from semianalytic.penetration.validation import load_shots
+
+    data = case.section("data")
+    if data is None or data.file is None:
+        raise InputError("data.file", "calibration needs a [data] section with a CSV 'file' of shots")
+    shots = load_shots(case)
+    if len(shots) < minimum:
+        raise InputError("data.file", f"at least {minimum} shots with a depth are needed (after 'select'); "
+                                      f"got {len(shots)}")
+    mass = np.array([s.mass if s.mass is not None else projectile_mass for s in shots], float)
+    if not np.all(mass > 0):
+        raise InputError("projectile.mass", "the projectile mass must be positive")
+    return ShotSet(np.array([s.velocity for s in shots]), mass, np.array([s.depth for s in shots]),
+                   tuple(s.id for s in shots))
+
+
+def _need(obj, key, typ, field):
+    if not isinstance(obj, dict) or key not in obj:
+        raise InputError(field, f"missing '{key}'")
+    val = obj[key]
+    if typ is float:
+        if isinstance(val, bool) or not isinstance(val, (int, float)) or not math.isfinite(val):
+            raise InputError(f"{field}.{key}", f"expected a finite number; got {val!r}")
+        return float(val)
+    if not isinstance(val, typ):
+        raise InputError(f"{field}.{key}", f"expected {typ.__name__}; got {type(val).__name__}")
+    return val
+
+
+def _samples(obj, key, field, n=None) -> np.ndarray:
+    arr = _need(obj, key, list, field)
+    try:
+        out = np.asarray(arr, float)
+    except (TypeError, ValueError):
+        raise InputError(f"{field}.{key}", "expected a list of numbers") from None
+    if out.ndim != 1 or out.size == 0 or not np.all(np.isfinite(out)) or (n is not None and out.size != n):
+        raise InputError(f"{field}.{key}", "expected a non-empty list of finite numbers, one per draw")
+    return out
+
+
+def read_posterior(path) -> dict:
+    """Read and validate a posterior.json written by ``calibrate``; returns
+    {"target": ..., "parameters": [keys], "models": {name: {"theta": (n, p), "sigma": (n,)}}, "raw": obj}."""
+    field = "--posterior"
+    path = Path(path)
+    if not path.is_file():
+        raise InputError(field, f"file {str(path)!r} does not exist")
+    try:
+        obj = json.loads(path.read_text())
+    except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:
+        raise InputError(field, f"{path.name} is not a JSON file: {exc}") from None
+    if not isinstance(obj, dict) or obj.get("format") != POSTERIOR_FORMAT:
+        raise InputError(f"{field}.format", f"expected '{POSTERIOR_FORMAT}' (a posterior.json written by calibrate)")
+    target = _need(obj, "target", dict, field)
+    _need(target, "density_kg_m3", float, "target")
+    _need(target, "resistance_model", str, "target")
+    fixed = _need(target, "resistance_fixed", dict, "target")
+    for k, v in fixed.items():
+        _need(fixed, k, float, "target.resistance_fixed")
+    params = _need(obj, "parameters", list, field)
+    keys = []
+    for i, p in enumerate(params):
+        keys.append(_need(p, "key", str, f"parameters[{i}]"))
+    if not keys:
+        raise InputError("parameters", "empty: the posterior holds no calibrated parameter")
+    models_obj = _need(obj, "models", dict, field)
+    if not models_obj:
+        raise InputError("models", "empty: the posterior holds no model")
+    models = {}
+    for name, mobj in models_obj.items():
+        if name not in MODELS:
+            raise InputError(f"models.{name}", f"unknown model; one of {', '.join(MODELS)}")
+        samples = _need(mobj, "samples", dict, f"models.{name}")
+        sigma = _samples(samples, "sigma", f"models.{name}.samples")
+        if np.any(sigma <= 0):
+            raise InputError(f"models.{name}.samples.sigma", "must be positive")
+        theta = np.column_stack([_samples(samples, k, f"models.{name}.samples", len(sigma)) for k in keys])
+        models[name] = {"theta": theta, "sigma": sigma}
+    cav = obj.get("cavity_shape")
+    if not (isinstance(cav, list) and len(cav) == 3 and all(isinstance(c, (int, float)) and c >= 0 for c in cav)
+            and cav[0] > 0):
+        raise InputError("cavity_shape", "expected [A, B, C] of the cavity law (A > 0)")
+    return {"target": target, "parameters": keys, "models": models, "cavity_shape": tuple(map(float, cav)), "raw": obj}

@@ -1,0 +1,370 @@
+"""What ``calibrate`` and ``penetrate --posterior`` compute, from validated cases.
+
+* :func:`calibrate_case`: the posterior of the calibrated target parameters and the
+  discrepancy scale for every chosen model (:mod:`.sampler`), the posterior predictive at the
+  calibration shots and on a velocity grid, and the JSON posterior.
+* :func:`cross_validate`: leave-one-out by exact refits (each shot predicted by the posterior
+  of the others) and the transfer split (predict the shots of other cases with the same
+  target), per model: mean and RMS error of the predictive median, mean |error|, coverage of
+  the central 50% and 90% predictive intervals, mean log predictive density of ln P.
+* :func:`predict_with_posterior`: predictive depth quantiles of any case (nose, mass, length
+  may differ) from a posterior file whose target matches the case's.
+"""
+
+from __future__ import annotations
+
+import dataclasses
+import math
+from dataclasses import dataclass
+
+import numpy as np
+
+from semianalytic.calibration.case import (
+    POSTERIOR_FORMAT,
+    CalibrationSection,
+    check_models,
+    default_parameter,
+    load_shot_set,
+    parameter_kind,
+    parse_prior,
+    read_posterior,
+)
+from semianalytic.calibration.models import (
+    MODELS,
+    DepthModelInputs,
+    ShotSet,
+    build_surrogate,
+)
+from semianalytic.calibration.sampler import (
+    Problem,
+    ResistanceMap,
+    log_predictive_density,
+    mixture_quantiles,
+    sample_posterior,
+)
+from semianalytic.errors import InputError
+
+__all__ = ["calibrate_case", "cross_validate", "predict_with_posterior", "QUANTILES"]
+
+QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
+SURROGATE_NODES = 16  # Chebyshev nodes in ln R_t over the prior range (see the tests for its accuracy)
+PREDICTION_NODES = 6  # over the narrower posterior range
+STORED_DRAWS = 1000
+LOO_STEPS = 500  # per refit, a quarter discarded: 32 walkers x 375 steps / tau ~ 20 -> ~600 effective draws
+
+
+@dataclass(frozen=True)
+class Target:
+    """The case-side description of what a posterior is about."""
+
+    inputs: DepthModelInputs
+    resistance: ResistanceMap
+    density: float
+    resistance_model: str
+    fixed: dict
+
+
+def _target(case, coefficients, keys, cavity_shape=None, models=MODELS) -> Target:
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.penetration import peers
+    from semianalytic.penetration.curve import PenetrationSetup
+    from semianalytic.penetration.resistance import resistance_from_case
+
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+    psec = case.require("projectile")
+    needs_rod = [m for m in models if m in ("quasi_rigid", "elastic", "elastic_exact_rod")]
+    if needs_rod and setup.rod is None:
+        raise InputError("projectile.youngs_modulus", f"missing: the {needs_rod[0]} model needs the projectile's "
+                                                      "Young's modulus (e.g. '210 GPa')")
+    resistance = resistance_from_case(case)
+    fields = tuple(k.rsplit(".", 1)[-1] for k in keys)
+    if cavity_shape is None:
+        data = case.section("data")
+        if data is not None and data.cavity_A is not None:
+            cavity_shape = (data.cavity_A, 0.0, data.cavity_B) if data.cavity_C is None else (
+                data.cavity_A, data.cavity_B, data.cavity_C)
+        else:
+            cavity_shape = (1.0, 0.0, 1.5)  # A Y = R_t, incompressible two-term law (penetration.validation)
+    inputs = DepthModelInputs(setup, peers.nose_factors(nose_from_section(psec)), tuple(map(float, cavity_shape)))
+    fixed = {f.name: float(getattr(resistance, f.name)) for f in dataclasses.fields(resistance)
+             if f.name not in fields and isinstance(getattr(resistance, f.name), (int, float))}
+    return Target(inputs, ResistanceMap(resistance, fields, float(psec.diameter)), float(setup.target_density),
+                  resistance.name, fixed)
+
+
+def _settings(case, models, parameters):
+    sec = case.section("calibration") or CalibrationSection()
+    from semianalytic.penetration.resistance import resistance_from_case
+
+    resistance = resistance_from_case(case)
+    models = check_models(models or sec.models or MODELS)
+    keys = list(dict.fromkeys(parameters or sec.parameters or [default_parameter(resistance)]))
+    for key in keys:
+        parameter_kind(key, resistance)
+    for key in sec.prior:  # a prior of a parameter not calibrated now is unused, but must name a parameter
+        try:
+            parameter_kind(key, resistance)
+        except InputError as exc:
+            raise InputError(f"calibration.prior.{key}", exc.message) from None
+    priors, units = [], []
+    for key in keys:
+        kind, unit, scale = parameter_kind(key, resistance)
+        text = sec.prior.get(key)
+        if text is None:
+            value = float(getattr(resistance, key.rsplit(".", 1)[-1]))
+            text = f"lognormal({value / scale:.6g} {unit}, 0.5)" if kind != "dimensionless" else f"lognormal({value:.6g}, 0.5)"
+        priors.append(parse_prior(text, kind, f"calibration.prior.{key}"))
+        units.append((unit, scale, text))
+    sigma_prior = parse_prior(sec.discrepancy, "dimensionless", "calibration.discrepancy")
+    return sec, models, tuple(keys), tuple(priors), sigma_prior, units
+
+
+def _range(resistance: ResistanceMap, priors, q=1e-3) -> tuple[float, float]:
+    """R_t range covering the priors' central 1 - 2q (the posterior is truncated outside)."""
+    levels = np.linspace(q, 1 - q, 9)
+    grids = np.meshgrid(*[np.asarray(p.ppf(levels), float) for p in priors], indexing="ij")
+    theta = np.column_stack([g.ravel() for g in grids])
+    if len(theta) > 4096:
+        theta = theta[np.random.default_rng(0).choice(len(theta), 4096, replace=False)]
+    R = resistance(theta)
+    R = R[np.isfinite(R)]
+    if R.size < 2 or not R.max() > R.min():
+        raise InputError("calibration.prior", "the priors give no range of the resistance R_t to calibrate on")
+    return float(R.min()), float(R.max())
+
+
+def _stats(q: np.ndarray, lpd: np.ndarray, measured: np.ndarray) -> dict:
+    """Per-split statistics from predictive quantiles q (len(QUANTILES), n)."""
+    e = (q[2] - measured) / measured
+    return {
+        "n": int(len(measured)),
+        "mean_error": float(np.mean(e)),
+        "rms_error": float(math.sqrt(np.mean(e * e))),
+        "mean_abs_error": float(np.mean(np.abs(e))),
+        "coverage_50": float(np.mean((q[1] <= measured) & (measured <= q[3]))),
+        "coverage_90": float(np.mean((q[0] <= measured) & (measured <= q[4]))),
+        "mean_log_predictive_density": float(np.mean(lpd)),
+    }
+
+
+def _predict(target: Target, models, shots: ShotSet, draws: dict, n_nodes: int = PREDICTION_NODES) -> dict:
+    """{model: (quantiles (len(QUANTILES), n_shots), mu (n_s, n_shots))} from posterior draws
+    {model: (theta, sigma)} for a shot set of ``target``'s projectile."""
+    R_by = {m: target.resistance(draws[m][0]) for m in models}
+    allR = np.concatenate([r[np.isfinite(r)] for r in R_by.values()])
+    if allR.size == 0:
+        raise InputError("target.resistance", "the posterior's parameters give no valid resistance R_t for this case")
+    lo, hi = float(allR.min()) * (1 - 1e-6), float(allR.max()) * (1 + 1e-6)
+    sur = build_surrogate(target.inputs, models, shots, lo, hi, n_nodes)
+    out = {}
+    for m in models:
+        ok = np.isfinite(R_by[m])
+        mu = sur[m].log_depth(R_by[m][ok])
+        sigma = draws[m][1][ok]
+        out[m] = (mixture_quantiles(mu, sigma, QUANTILES), mu, sigma)
+    return out
+
+
+def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, posts: dict, fits: dict) -> dict:
+    data = case.require("data")
+    models = {}
+    for m, post in posts.items():
+        n = len(post.sigma)
+        idx = np.unique(np.linspace(0, n - 1, min(n, STORED_DRAWS)).astype(int))
+        samples = {k: post.theta[idx, j].tolist() for j, k in enumerate(keys)}
+        samples["resistance_Pa"] = post.resistance[idx].tolist()
+        samples["sigma"] = post.sigma[idx].tolist()
+        summary = {}
+        for name, arr in [*((k, post.theta[:, j]) for j, k in enumerate(keys)), ("resistance_Pa", post.resistance),
+                          ("sigma", post.sigma)]:
+            qs = np.percentile(arr, [5, 50, 95])
+            summary[name] = {"mean": float(np.mean(arr)), "sd": float(np.std(arr)), "q05": qs[0], "q50": qs[1],
+                             "q95": qs[2]}
+        q = fits[m]
+        models[m] = {
+            "samples": samples,
+            "summary": summary,
+            "mode": dict(zip([*keys, "sigma"], post.mode)),
+            "diagnostics": {
+                "acceptance_fraction": post.acceptance_fraction,
+                "autocorrelation_time": dict(zip([*keys, "sigma"], post.autocorrelation_time)),
+                "effective_sample_size": post.effective_sample_size,
+                "walkers": post.n_walkers, "steps": post.n_steps, "burn": post.n_burn,
+                "draws_stored": int(len(idx)),
+            },
+            "fit": {f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)},
+        }
+    return {
+        "format": POSTERIOR_FORMAT,
+        "version": 1,
+        "case": str(case.path) if case.path else case.title,
+        "title": case.title,
+        "target": {"density_kg_m3": target.density, "resistance_model": target.resistance_model,
+                   "resistance_fixed": target.fixed},
+        "parameters": [{"key": k, "unit": "SI", "display_unit": u[0], "prior": u[2]} for k, u in zip(keys, units)],
+        "discrepancy": {"model": "ln P_measured = ln P_model + eps, eps ~ N(0, sigma^2)", "prior": sigma_prior_text},
+        "cavity_shape": list(target.inputs.cavity_shape),
+        "data": {
+            "file": data.file, "source": data.source, "select": data.select,
+            "shots": [{"id": i, "velocity_m_s": float(v), "depth_m": float(d), "mass_kg": float(mm)}
+                      for i, v, d, mm in zip(shots.ids, shots.velocity, shots.depth, shots.mass)],
+        },
+        "models": models,
+    }
+
+
+def _problem(keys, priors, sigma_prior, resistance, surrogate, depth):
+    return Problem(keys, priors, sigma_prior, resistance, surrogate, depth)
+
+
+def calibrate_case(case, coefficients, *, models=None, parameters=None, progress: bool = False,
+                   steps: int | None = None) -> dict:
+    """Calibrate (see the module docstring).  Returns {"posterior": JSON dict, "shots": ShotSet,
+    "fits": {model: quantiles}, "curves": {...}, "histograms": {...}, "settings": {...}}."""
+    import time
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    sec, models, keys, priors, sigma_prior, units = _settings(case, models, parameters)
+    target = _target(case, coefficients, keys, models=models)
+    shots = load_shot_set(case, target.inputs.setup.mass)
+    lo, hi = _range(target.resistance, priors)
+    surrogates = build_surrogate(target.inputs, models, shots, lo, hi, SURROGATE_NODES)
+    fast = target.resistance
+    if len(priors) == 1 and priors[0].positive:
+        fast = fast.tabulated(float(priors[0].ppf(1e-4)), float(priors[0].ppf(1 - 1e-4)))
+    posts, fits = {}, {}
+    for m in models:
+        problem = _problem(keys, priors, sigma_prior, fast, surrogates[m], shots.depth)
+        posts[m] = sample_posterior(problem, walkers=sec.walkers, steps=steps or sec.steps, burn=min(sec.burn, (steps or sec.steps) // 2),
+                                    seed=sec.seed, progress=progress)
+        mu = surrogates[m].log_depth(posts[m].resistance)
+        fits[m] = mixture_quantiles(mu, posts[m].sigma, QUANTILES)
+    # predictive curves on a velocity grid at the mean shot mass
+    grid = np.linspace(0.85 * shots.velocity.min(), 1.1 * shots.velocity.max(), 21)
+    grid_shots = ShotSet(grid, np.full(grid.shape, float(np.mean(shots.mass))), np.full(grid.shape, np.nan),
+                         tuple(f"U{k}" for k in range(len(grid))))
+    pred = _predict(target, models, grid_shots, {m: (posts[m].theta, posts[m].sigma) for m in models})
+    curves = {"velocity_m_s": grid.tolist(), "mass_kg": float(np.mean(shots.mass)),
+              "models": {m: {f"{p:g}": pred[m][0][k].tolist() for k, p in enumerate(QUANTILES)} for m in models}}
+    histograms = {}
+    for m in models:
+        h = {}
+        for j, k in enumerate(keys):
+            dens, edges = np.histogram(posts[m].theta[:, j], bins=30, density=True)
+            h[k] = {"centres": (0.5 * (edges[1:] + edges[:-1])).tolist(), "density": dens.tolist()}
+        dens, edges = np.histogram(posts[m].sigma, bins=30, density=True)
+        h["sigma"] = {"centres": (0.5 * (edges[1:] + edges[:-1])).tolist(), "density": dens.tolist()}
+        histograms[m] = h
+    posterior = _posterior_json(case, target, keys, units, sec.discrepancy, shots, posts, fits)
+    return {
+        "posterior": posterior,
+        "shots": shots,
+        "curves": curves,
+        "histograms": histograms,
+        "timing_s": {"wall": time.perf_counter() - t0, "cpu": time.process_time() - c0},
+        "settings": {"models": list(models), "parameters": list(keys), "units": units, "R_range_Pa": (lo, hi),
+                     "surrogate_nodes": SURROGATE_NODES, "discrepancy_prior": sec.discrepancy},
+        "_internal": {"target": target, "surrogates": surrogates, "posts": posts, "priors": priors,
+                      "sigma_prior": sigma_prior, "section": sec,
+                      "resistance": fast},
+    }
+
+
+def check_target(case, target_obj: dict, keys) -> None:
+    """Refuse (InputError, exit 2) a case whose target differs from the posterior's."""
+    from semianalytic.penetration.resistance import resistance_from_case
+
+    rho = float(case.require("target").density)
+    rho_post = float(target_obj["density_kg_m3"])
+    if not math.isclose(rho, rho_post, rel_tol=1e-9):
+        raise InputError("target.density", f"the posterior was calibrated on a target of {rho_post:g} kg/m^3; "
+                                           f"the case has {rho:g} kg/m^3")
+    res = resistance_from_case(case)
+    if res.name != target_obj["resistance_model"]:
+        raise InputError("target.resistance.model", f"the posterior was calibrated with the "
+                                                    f"'{target_obj['resistance_model']}' resistance; the case has '{res.name}'")
+    names = {f.name for f in dataclasses.fields(res)}
+    for key in keys:
+        if key.rsplit(".", 1)[-1] not in names:
+            raise InputError(key, "the case's resistance model has no such parameter")
+    for k, v in target_obj["resistance_fixed"].items():
+        here = getattr(res, k, None)
+        if here is None or not math.isclose(float(here), float(v), rel_tol=1e-9):
+            raise InputError(f"target.resistance.{k}", f"the posterior was calibrated with {k} = {v:g} (SI); "
+                                                       f"the case has {here!r}")
+
+
+def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: bool = False,
+                   loo_steps: int | None = None) -> dict:
+    """Leave-one-out (exact refits) and transfer splits for every model of ``result``
+    (from :func:`calibrate_case`).  ``transfer``: [(case, coefficients)] with the same target."""
+    import time
+
+    from tqdm import tqdm
+
+    t0, c0 = time.perf_counter(), time.process_time()
+    it = result["_internal"]
+    target, surrogates, posts = it["target"], it["surrogates"], it["posts"]
+    sec = it["section"]
+    keys = tuple(result["settings"]["parameters"])
+    shots: ShotSet = result["shots"]
+    models = result["settings"]["models"]
+    steps = loo_steps or LOO_STEPS
+    out = {"loo": {}, "transfer": {}, "loo_steps": steps}
+    n = len(shots)
+    bar = tqdm(total=len(models) * n, desc="leave-one-out refits", disable=not progress, file=None, leave=False)
+    for m in models:
+        sur = surrogates[m]
+        q = np.empty((len(QUANTILES), n))
+        lpd = np.empty(n)
+        for i in range(n):
+            keep = np.array([k for k in range(n) if k != i])
+            sub = dataclasses.replace(sur, coef=sur.coef[:, keep])
+            problem = _problem(keys, it["priors"], it["sigma_prior"], it["resistance"], sub, shots.depth[keep])
+            post = sample_posterior(problem, walkers=sec.walkers, steps=steps, burn=steps // 4, seed=sec.seed + i + 1,
+                                    start=posts[m].mode_u)
+            mu = sur.log_depth(post.resistance)[:, i : i + 1]
+            q[:, i] = mixture_quantiles(mu, post.sigma, QUANTILES)[:, 0]
+            lpd[i] = log_predictive_density(mu, post.sigma, shots.depth[i : i + 1])[0]
+            bar.update()
+        out["loo"][m] = {"statistics": _stats(q, lpd, shots.depth),
+                         "shots": {"id": list(shots.ids), "measured_m": shots.depth.tolist(),
+                                   **{f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}}}
+    bar.close()
+    out["timing_s"] = {"loo_wall": time.perf_counter() - t0, "loo_cpu": time.process_time() - c0}
+    for tcase, tcoef in transfer:
+        t1, c1 = time.perf_counter(), time.process_time()
+        check_target(tcase, result["posterior"]["target"], keys)
+        ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape, models=models)
+        tshots = load_shot_set(tcase, ttarget.inputs.setup.mass, minimum=1)
+        pred = _predict(ttarget, models, tshots, {m: (posts[m].theta, posts[m].sigma) for m in models})
+        entry = {"case": str(tcase.path) if tcase.path else tcase.title, "title": tcase.title, "models": {}}
+        for m in models:
+            q, mu, sigma = pred[m]
+            lpd = log_predictive_density(mu, sigma, tshots.depth)
+            entry["models"][m] = {"statistics": _stats(q, lpd, tshots.depth),
+                                  "shots": {"id": list(tshots.ids), "velocity_m_s": tshots.velocity.tolist(),
+                                            "measured_m": tshots.depth.tolist(),
+                                            **{f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}}}
+        entry["timing_s"] = {"wall": time.perf_counter() - t1, "cpu": time.process_time() - c1}
+        out["transfer"][entry["case"]] = entry
+    return out
+
+
+def predict_with_posterior(case, coefficients, path, velocities=None) -> dict:
+    """{"depth_quantiles_m": {model: {"0.05": [...], "0.5": [...], "0.95": [...], ...}}} at the
+    case's striking velocities (or ``velocities``), with the case's projectile (mass from its
+    geometry and density) and the posterior's target parameters."""
+    post = read_posterior(path)
+    keys = post["parameters"]
+    check_target(case, post["target"], keys)
+    target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"], models=tuple(post["models"]))
+    U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
+    shots = ShotSet(U, np.full(U.shape, target.inputs.setup.mass), np.full(U.shape, np.nan),
+                    tuple(str(k) for k in range(len(U))))
+    models = tuple(post["models"])
+    pred = _predict(target, models, shots, {m: (post["models"][m]["theta"], post["models"][m]["sigma"]) for m in models})
+    return {
+        "depth_quantiles_m": {m: {f"{p:g}": pred[m][0][k].tolist() for k, p in enumerate(QUANTILES)} for m in models},
+        "posterior_file": str(path),
+    }
