@@ -67,6 +67,7 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--samples", "must not be negative")
     spec = build_spec(args.vary, args.sample, args.samples, args.seed)
     case = load_case(args.case)
+    check_axes(case, spec)
     kernel = select_kernel(case, args.analysis, cache_dir=args.cache_dir, full=args.full)
     summary = run_sweep(
         args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
@@ -89,3 +90,25 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
                       f"(n = {st['n']})")
     return 0 if summary.n_error == 0 else 1
+
+
+def check_axes(case, spec) -> None:
+    """Refuse (exit status 2) an axis whose every value the case rejects for that key, e.g.
+    ``impact.striking_velocity=400:500:10 kg`` (a mass where a velocity belongs): checked at
+    the first and the last value of each axis, before any worker starts."""
+    from semianalytic.case import parse_case
+    from semianalytic.sweep.spec import VELOCITY_KEY, apply_overrides, raw_value
+
+    for axis in spec.axes:
+        target = "impact.striking_velocities" if axis.key == VELOCITY_KEY else axis.key
+        errors = []
+        for value in {axis.values[0], axis.values[-1]}:
+            try:
+                parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}), case.path)
+            except InputError as exc:
+                if exc.field == target or exc.field.startswith(target + "."):
+                    errors.append(exc)
+                    continue
+            break
+        else:
+            raise InputError(f"--vary {axis.key}", errors[0].message)
