@@ -11,6 +11,7 @@ import argparse
 import importlib
 import sys
 import traceback
+import warnings
 
 from semianalytic.errors import InputError
 
@@ -43,6 +44,25 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2
     module_name, help_ = commands[name]
+    notes: list[str] = []
+
+    def collect(message, category, filename, lineno, file=None, line=None) -> None:
+        text = " ".join(str(message).split())
+        if text not in notes:
+            notes.append(text)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = collect
+        for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning, ResourceWarning):
+            warnings.simplefilter("ignore", category)  # the libraries' business, not the user's
+        rc = _run_command(prog, name, module_name, help_, rest)
+    if rc != 2:  # bad input: the one line naming the field is all that is printed
+        for text in notes:
+            print(f"warning: {text}", file=sys.stderr)
+    return rc
+
+
+def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:
     try:
         module = importlib.import_module(module_name)
         parser = argparse.ArgumentParser(prog=f"{prog} {name}", description=help_)

@@ -201,9 +201,12 @@ def check_tree(data: Any, where: str = "case") -> None:
 
 
 # Measured elastic constants of one isotropic material agree to a few per cent (the bundled
-# ceramics: AD995, SiC, B4C to 0.2 %); a bulk modulus 10 % away from E / (3 (1 - 2 nu)) means
-# one of the three is mistyped.
-BULK_MODULUS_TOLERANCE = 0.10
+# ceramics: AD995, SiC, B4C to 0.2 %).  A bulk modulus more than 10 % away from
+# E / (3 (1 - 2 nu)) is warned about; a factor of 10 or more away (a wrong unit prefix) is
+# refused.  Between the two the model still runs (K enters only the compressed zone), which
+# keeps sensitivity studies of nu at a fixed measured K possible.
+BULK_MODULUS_WARN = 0.10
+BULK_MODULUS_FACTOR = 10.0
 
 
 def check_brittle_constants(section: str, youngs_modulus: float, poisson_ratio: float, tensile_strength: float,
@@ -220,10 +223,20 @@ def check_brittle_constants(section: str, youngs_modulus: float, poisson_ratio: 
         )
     if bulk_modulus is not None and poisson_ratio < 0.5:
         implied = youngs_modulus / (3 * (1 - 2 * poisson_ratio))
-        if abs(bulk_modulus / implied - 1) > BULK_MODULUS_TOLERANCE:
+        apart = abs(bulk_modulus / implied - 1)
+        ratio = bulk_modulus / implied
+        if not 1 / BULK_MODULUS_FACTOR < ratio < BULK_MODULUS_FACTOR:
             raise InputError(
                 f"{section}.bulk_modulus",
                 f"{bulk_modulus / 1e9:.4g} GPa is inconsistent with youngs_modulus and poisson_ratio, which give "
-                f"K = E / (3 (1 - 2 nu)) = {implied / 1e9:.4g} GPa (more than {BULK_MODULUS_TOLERANCE:.0%} apart); "
+                f"K = E / (3 (1 - 2 nu)) = {implied / 1e9:.4g} GPa (a factor {max(ratio, 1 / ratio):.3g} apart); "
                 "leave bulk_modulus out to use that value",
             )
+        if apart > BULK_MODULUS_WARN:
+            import warnings
+
+            from semianalytic.errors import ModelValidityWarning
+
+            warnings.warn(
+                f"{section}.bulk_modulus: {bulk_modulus / 1e9:.4g} GPa is {apart:.0%} away from E / (3 (1 - 2 nu)) = "
+                f"{implied / 1e9:.4g} GPa; check the elastic constants", ModelValidityWarning, stacklevel=2)

@@ -111,4 +111,4 @@ def check_axes(case, spec) -> None:
                     continue
             break
         else:
-            raise InputError(f"--vary {axis.key}", errors[0].message)
+            raise InputError(errors[0].field, f"{errors[0].message} (every value from --vary {axis.key})")
