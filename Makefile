@@ -25,10 +25,14 @@ test: $(VENV)/.installed
 
 # Long convergence studies and benchmarks; they write into reports/.
 bench: $(VENV)/.installed
-	$(PY) -m semianalytic bench-bem --force
+	$(PY) -m semianalytic bench-bem --out reports --force
 
 reports: bench
 	$(PY) -m pytest -q -m slow
+	for c in fig5_ogive fig5_sphere body_sphere body_spheroid_7to1; do $(PY) -m fem_check verify cases/$$c.toml --out reports --force || exit 1; done
+	$(PY) -m fem_check rod cases/fig9_ogive_7075T651.toml --out reports --force
+	$(PY) -m fem_check cavity --out reports --force
+	$(PY) -m fem_check bench --out reports --force
 
 clean:
 	rm -rf $(VENV) meshes/cache .pytest_cache

@@ -197,9 +197,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from fem_check.report import add_output_arguments
 
     parser.add_argument("case", help="case TOML with a [body] or a [projectile]")
-    parser.add_argument("--depths", default=None,
+    from semianalytic.cli_types import number, number_list
+
+    parser.add_argument("--depths", default=None, type=number_list(0.0, 1e4, exclude={1.0: "P = L_h is the nose-shank junction, where the BEM layout changes topology; use a nearby depth such as 0.99 or 1.01"}),
                         help="comma-separated depths in nose lengths L_h (default: " + ",".join(map(str, DEFAULT_DEPTHS)) + ")")
-    parser.add_argument("--h", type=float, default=0.04, help="FEM element size on the body over d (default 0.04)")
+    parser.add_argument("--h", type=number(0.005, 0.5), default=0.04, help="FEM element size on the body over d (default 0.04)")
     parser.add_argument("--quick", action="store_true", help="skip the convergence and far-field studies")
     add_output_arguments(parser, "")
 
@@ -207,6 +209,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _parse_depths(text: str | None) -> tuple[float, ...]:
     if text is None:
         return DEFAULT_DEPTHS
+    if isinstance(text, tuple):  # already parsed by the option's type
+        return text
     try:
         vals = tuple(float(v) for v in text.split(",") if v.strip())
     except ValueError:

@@ -13,6 +13,7 @@ import sys
 import traceback
 import warnings
 
+from semianalytic.cli_types import OneLineParser
 from semianalytic.errors import InputError
 
 # name -> (module, one-line help)
@@ -65,7 +66,7 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
 def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:
     try:
         module = importlib.import_module(module_name)
-        parser = argparse.ArgumentParser(prog=f"{prog} {name}", description=help_)
+        parser = OneLineParser(prog=f"{prog} {name}", description=help_)
         module.add_arguments(parser)
         args = parser.parse_args(rest)
         return int(module.run(args) or 0)

@@ -29,6 +29,7 @@ JSON_KEYS = (
 
 
 def add_arguments(parser) -> None:
+    from semianalytic.cli_types import file_stem, output_dir
     from semianalytic.penetration.options import W1_MODELS
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target], [impact]")
@@ -39,9 +40,9 @@ def add_arguments(parser) -> None:
     )
     parser.add_argument("--w1", choices=W1_MODELS, default="neglect",
                         help="lateral-compression energy W1 of eq. (28) (default: neglect, as the paper)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
-    parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
-    parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--report", metavar="DIR", default=None, type=output_dir, help="write a markdown report with plots into DIR")
+    parser.add_argument("--report-name", default=None, type=file_stem, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
 
 
