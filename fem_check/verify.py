@@ -231,6 +231,10 @@ def run(args) -> int:
     depths = _parse_depths(args.depths)
     if case.body is None and case.projectile is None:
         raise InputError("case", "needs a [body] or a [projectile] section")
+    from semianalytic.guards import check_case, check_fem
+
+    check_case(case)  # the BEM side, then the FEM mesh: refused before gmsh if they would not fit
+    check_fem(case, args.h, depths)
     name = args.name or f"fem_verify_{Path(args.case).stem}"
     report = None if args.no_report else Report(Path(args.out), name, args.force)
     if report:

@@ -13,8 +13,9 @@ import sys
 import traceback
 import warnings
 
-from semianalytic.cli_types import OneLineParser
+from semianalytic.cli_types import OneLineParser, memory_size
 from semianalytic.errors import InputError
+from semianalytic.guards import set_memory_limit
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -56,7 +57,10 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         warnings.showwarning = collect
         for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning, ResourceWarning):
             warnings.simplefilter("ignore", category)  # the libraries' business, not the user's
-        rc = _run_command(prog, name, module_name, help_, rest)
+        try:
+            rc = _run_command(prog, name, module_name, help_, rest)
+        finally:
+            set_memory_limit(None)  # the flag holds for one command (tests call main() repeatedly)
     if rc != 2:  # bad input: the one line naming the field is all that is printed
         for text in notes:
             print(f"warning: {text}", file=sys.stderr)
@@ -68,15 +72,26 @@ def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[
         module = importlib.import_module(module_name)
         parser = OneLineParser(prog=f"{prog} {name}", description=help_)
         module.add_arguments(parser)
+        parser.add_argument("--memory-limit", type=memory_size, default=None, metavar="SIZE",
+                            help="memory budget, e.g. 8GB (default: $SEMIANALYTIC_MEMORY_LIMIT, else 4GB); "
+                                 "larger problems are refused before they start")
         args = parser.parse_args(rest)
+        set_memory_limit(args.memory_limit)
         return int(module.run(args) or 0)
     except SystemExit as exc:  # argparse: --help (0) or bad arguments (2)
         return int(exc.code or 0)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except RecursionError:
+        print(f"error: input: nested too deeply for {prog} {name}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print(f"error: memory: {prog} {name} ran out of memory; lower the resolution or raise --memory-limit "
+              "only if the machine has the memory", file=sys.stderr)
         return 1
     except Exception:
         traceback.print_exc()

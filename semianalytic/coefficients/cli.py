@@ -41,6 +41,9 @@ def _run_body(case, args) -> int:
     from semianalytic.exact import spheroid_added_mass_coefficient
     from semianalytic.geometry import body_from_section
 
+    from semianalytic.guards import check_body
+
+    check_body(case, args.order, args.refinement)  # refuse before assembly what would not fit in memory
     body = case.body
     meridian = body_from_section(body)
     order = args.order or case.bem.order
@@ -73,6 +76,9 @@ def _run_projectile(case, args) -> int:
     from semianalytic.coefficients.table import coefficient_table
     from semianalytic.geometry import nose_from_section
 
+    from semianalytic.guards import check_coefficients
+
+    check_coefficients(case, args.order, args.refinement, args.max_depth)  # refuse what would not fit in memory
     nose = nose_from_section(case.projectile)
     reading = args.reading or case.coefficients.reading
     n_depths = args.depths or case.coefficients.depths

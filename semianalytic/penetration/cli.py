@@ -116,6 +116,11 @@ def run(args) -> int:
     from semianalytic.penetration.evaluate import evaluate_case
 
     cases = _load(args.cases)
+    if args.coefficients == "bem":  # refuse before solving what would not fit in memory
+        from semianalytic.guards import check_coefficients
+
+        for case in cases:
+            check_coefficients(case)
     if args.report is not None:
         from semianalytic.penetration.report import report_path
 

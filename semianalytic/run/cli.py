@@ -26,8 +26,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
+    from semianalytic.case import load_case
+    from semianalytic.guards import check_case
     from semianalytic.run.pipeline import run_case
 
+    check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
     out = Path(args.out)
     results = run_case(
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir

@@ -70,6 +70,9 @@ def run(args: argparse.Namespace) -> int:
     spec = build_spec(args.vary, args.sample, args.samples, args.seed)
     case = load_case(args.case)
     check_axes(case, spec)
+    from semianalytic.guards import check_case
+
+    check_case(case)  # refuse before any worker starts what would not fit in memory
     kernel = select_kernel(case, args.analysis, cache_dir=args.cache_dir, full=args.full)
     summary = run_sweep(
         args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
