@@ -39,7 +39,7 @@ class Section(BaseModel):
     @classmethod
     def _strict_numbers(cls, value: Any, info: ValidationInfo) -> Any:
         field = cls.model_fields.get(info.field_name) if info.field_name else None
-        if field is not None and not field.metadata:
+        if field is not None and not any(type(m).__name__.endswith("Validator") for m in field.metadata):
             problem = number_problem(field.annotation, value)
             if problem:
                 raise ValueError(problem)
@@ -66,6 +66,10 @@ def number_problem(annotation: Any, value: Any) -> str | None:
             return None
         if len(args) == 1:
             return number_problem(args[0], value)
+        return None
+    if annotation is bool:
+        if not isinstance(value, bool):
+            return f"expected true or false (a TOML boolean); got {value!r}"
         return None
     if _is_plain_number_type(annotation):
         if isinstance(value, bool) or not isinstance(value, (int, float)):

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from typing import Annotated, Any
 
 from pydantic import BeforeValidator
@@ -101,6 +102,8 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
         raise InputError(
             field, f"expected a {kind} with a unit, e.g. '{example}'; got the bare number {value!r}"
         )
+    if not _NUMBER_FIRST.match(value):  # pint reads a bare "mm" as 1 mm
+        raise InputError(field, f"expected a {kind} as a number and a unit, e.g. '{example}'; got {value!r}")
     ureg = registry()
     try:
         q = ureg.Quantity(value.strip())
@@ -126,6 +129,9 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
     if out != 0 and not low <= abs(out) <= high:
         raise InputError(field, f"{value!r} lies outside the physical range of a {kind} ({text})")
     return out
+
+
+_NUMBER_FIRST = re.compile(r"\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
 
 
 def format_quantity(value: float, unit: str, digits: int = 4) -> str:
