@@ -101,6 +101,7 @@ def bench(quick: bool = False, repeat: int = 3) -> dict:
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     from fem_check.report import add_output_arguments
+    from semianalytic.cli_types import integer
 
     parser.add_argument("--quick", action="store_true", help="fewer resolutions (a smoke run)")
     parser.add_argument("--repeat", type=integer(1, 20), default=3, help="best of N timings (default 3)")
