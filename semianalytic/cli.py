@@ -32,6 +32,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+MAX_WARNINGS_PER_KIND = 3
+
+
 def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | None) -> int:
     """Shared by both packages' CLIs: pick the command, import it, run it, map errors."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -62,8 +65,15 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         finally:
             set_memory_limit(None)  # the flag holds for one command (tests call main() repeatedly)
     if rc != 2:  # bad input: the one line naming the field is all that is printed
-        for text in notes:
-            print(f"warning: {text}", file=sys.stderr)
+        shown: dict[str, int] = {}
+        for text in notes:  # a sweep may warn once per value: the first few of each kind
+            kind = text.split(":", 1)[0]
+            shown[kind] = shown.get(kind, 0) + 1
+            if shown[kind] <= MAX_WARNINGS_PER_KIND:
+                print(f"warning: {text}", file=sys.stderr)
+        for kind, n in shown.items():
+            if n > MAX_WARNINGS_PER_KIND:
+                print(f"warning: {kind}: {n - MAX_WARNINGS_PER_KIND} more warnings like the above", file=sys.stderr)
     return rc
 
 
