@@ -127,3 +127,19 @@ def test_out_through_a_file_or_proc_is_exit_2(tmp_path, capsys):
         assert main(["run", str(OGIVE), "--out", str(out)]) == 2
         err = capsys.readouterr().err
         assert err.startswith("error: --out:") and len(err.strip().splitlines()) == 1
+
+
+def test_run_and_penetrate_write_no_cache_into_the_cwd(tmp_path):
+    """Without $SEMIANALYTIC_CACHE_DIR the tables go to the per-user cache (platformdirs,
+    here $XDG_CACHE_HOME), never to ./.cache of the folder the command runs in."""
+    work = tmp_path / "work"
+    work.mkdir()
+    env = {k: v for k, v in os.environ.items() if k != "SEMIANALYTIC_CACHE_DIR"}
+    env["XDG_CACHE_HOME"] = str(tmp_path / "xdg")
+    for argv in (["run", str(OGIVE), "--out", "out", "--only", "coefficients", "--no-render"],
+                 ["penetrate", str(ROOT / "cases" / "fig15a_ogive_6061T651.toml"), "--json"]):
+        proc = subprocess.run([sys.executable, "-m", "semianalytic", *argv], cwd=work, env=env,
+                              capture_output=True, text=True, timeout=600)
+        assert proc.returncode == 0, proc.stderr[-1500:]
+    assert sorted(p.name for p in work.iterdir()) == ["out"]
+    assert any((tmp_path / "xdg" / "semianalytic").rglob("*.npz"))
