@@ -34,10 +34,15 @@ $(CHROMIUM):
 
 # Long convergence studies and benchmarks; they write into reports/.
 bench: $(VENV)/.installed
-	$(PY) -m semianalytic bench-bem --force
+	$(PY) -m semianalytic bench-bem --out reports --force
 
 reports: bench
 	$(PY) -m pytest -q -m slow
+	for c in fig5_ogive fig5_sphere body_sphere body_spheroid_7to1; do $(PY) -m fem_check verify cases/$$c.toml --out reports --force || exit 1; done
+	$(PY) -m fem_check rod cases/fig9_ogive_7075T651.toml --out reports --force
+	$(PY) -m fem_check cavity --out reports --force
+	$(PY) -m fem_check bench --out reports --force
+	$(PY) tests/hardening_tally.py --out reports
 
 clean:
 	rm -rf $(VENV) meshes/cache .pytest_cache
@@ -58,10 +63,5 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic.cavity.report --out reports --force
 	$(PY) -m semianalytic penetrate $(VALIDATION_CASES) --report reports --force
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force
-	for c in body_sphere body_spheroid_7to1 fig5_ogive fig5_sphere; do \
-		$(PY) -m fem_check verify cases/$$c.toml --force || exit 1; done
-	$(PY) -m fem_check rod cases/fig9_ogive_7075T651.toml --force
-	$(PY) -m fem_check cavity --force
-	$(PY) -m fem_check bench --force
 	$(PY) -m semianalytic.run.benchmark --force
 	$(PY) -m semianalytic.sweep.benchmark --force

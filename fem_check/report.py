@@ -15,11 +15,33 @@ from semianalytic.io import atomic_write_bytes, atomic_write_text, check_report_
 
 
 def add_output_arguments(parser: argparse.ArgumentParser, default_name: str) -> None:
+    from semianalytic.cli_types import file_stem, output_dir
+
     parser.add_argument("--json", action="store_true", help="print the results as JSON on stdout")
-    parser.add_argument("--out", default="reports", help="folder of the report (default: reports/)")
-    parser.add_argument("--name", default=default_name, help=f"report file stem (default: {default_name})")
+    # files only where asked: without --out nothing is written (``make reports`` passes --out reports)
+    parser.set_defaults(no_report=True)
+    parser.add_argument("--out", default="reports", type=output_dir, action=_WriteReportInto,
+                        help="write the report (markdown and PNGs) into this folder, e.g. reports; default: write nothing")
+    parser.add_argument("--name", default=default_name or None, type=file_stem, help=f"report file stem (default: {default_name})")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
-    parser.add_argument("--no-report", action="store_true", help="compute and print only; write no files")
+    parser.add_argument("--no-report", action=_NoReport, nargs=0, help="compute and print only; write no files (the default without --out)")
+
+
+class _WriteReportInto(argparse.Action):
+    """``--out DIR``: store DIR and ask for the report (``no_report`` is True until then)."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        setattr(namespace, self.dest, values)
+        if not getattr(namespace, "_no_report_given", False):
+            namespace.no_report = False
+
+
+class _NoReport(argparse.Action):
+    """``--no-report``: write nothing, wherever it stands among the options."""
+
+    def __call__(self, parser, namespace, values, option_string=None):
+        namespace.no_report = True
+        namespace._no_report_given = True
 
 
 def fmt(value, digits: int = 4) -> str:

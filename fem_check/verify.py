@@ -197,9 +197,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from fem_check.report import add_output_arguments
 
     parser.add_argument("case", help="case TOML with a [body] or a [projectile]")
-    parser.add_argument("--depths", default=None,
+    from semianalytic.cli_types import number, number_list
+
+    parser.add_argument("--depths", default=None, type=number_list(0.0, 1e4, exclude={1.0: "P = L_h is the nose-shank junction, where the BEM layout changes topology; use a nearby depth such as 0.99 or 1.01"}),
                         help="comma-separated depths in nose lengths L_h (default: " + ",".join(map(str, DEFAULT_DEPTHS)) + ")")
-    parser.add_argument("--h", type=float, default=0.04, help="FEM element size on the body over d (default 0.04)")
+    parser.add_argument("--h", type=number(0.005, 0.5), default=0.04, help="FEM element size on the body over d (default 0.04)")
     parser.add_argument("--quick", action="store_true", help="skip the convergence and far-field studies")
     add_output_arguments(parser, "")
 
@@ -207,6 +209,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def _parse_depths(text: str | None) -> tuple[float, ...]:
     if text is None:
         return DEFAULT_DEPTHS
+    if isinstance(text, tuple):  # already parsed by the option's type
+        return text
     try:
         vals = tuple(float(v) for v in text.split(",") if v.strip())
     except ValueError:
@@ -227,6 +231,10 @@ def run(args) -> int:
     depths = _parse_depths(args.depths)
     if case.body is None and case.projectile is None:
         raise InputError("case", "needs a [body] or a [projectile] section")
+    from semianalytic.guards import check_case, check_fem
+
+    check_case(case)  # the BEM side, then the FEM mesh: refused before gmsh if they would not fit
+    check_fem(case, args.h, depths)
     name = args.name or f"fem_verify_{Path(args.case).stem}"
     report = None if args.no_report else Report(Path(args.out), name, args.force)
     if report:

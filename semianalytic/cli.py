@@ -11,8 +11,11 @@ import argparse
 import importlib
 import sys
 import traceback
+import warnings
 
+from semianalytic.cli_types import OneLineParser, memory_size
 from semianalytic.errors import InputError
+from semianalytic.guards import set_memory_limit
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
@@ -30,6 +33,9 @@ COMMANDS: dict[str, tuple[str, str]] = {
 }
 
 
+MAX_WARNINGS_PER_KIND = 3
+
+
 def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | None) -> int:
     """Shared by both packages' CLIs: pick the command, import it, run it, map errors."""
     argv = list(sys.argv[1:] if argv is None else argv)
@@ -44,19 +50,59 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2
     module_name, help_ = commands[name]
+    notes: list[str] = []
+
+    def collect(message, category, filename, lineno, file=None, line=None) -> None:
+        text = " ".join(str(message).split())
+        if text not in notes:
+            notes.append(text)
+
+    with warnings.catch_warnings():
+        warnings.showwarning = collect
+        for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning, ResourceWarning):
+            warnings.simplefilter("ignore", category)  # the libraries' business, not the user's
+        try:
+            rc = _run_command(prog, name, module_name, help_, rest)
+        finally:
+            set_memory_limit(None)  # the flag holds for one command (tests call main() repeatedly)
+    if rc != 2:  # bad input: the one line naming the field is all that is printed
+        shown: dict[str, int] = {}
+        for text in notes:  # a sweep may warn once per value: the first few of each kind
+            kind = text.split(":", 1)[0]
+            shown[kind] = shown.get(kind, 0) + 1
+            if shown[kind] <= MAX_WARNINGS_PER_KIND:
+                print(f"warning: {text}", file=sys.stderr)
+        for kind, n in shown.items():
+            if n > MAX_WARNINGS_PER_KIND:
+                print(f"warning: {kind}: {n - MAX_WARNINGS_PER_KIND} more warnings like the above", file=sys.stderr)
+    return rc
+
+
+def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:
     try:
         module = importlib.import_module(module_name)
-        parser = argparse.ArgumentParser(prog=f"{prog} {name}", description=help_)
+        parser = OneLineParser(prog=f"{prog} {name}", description=help_)
         module.add_arguments(parser)
+        parser.add_argument("--memory-limit", type=memory_size, default=None, metavar="SIZE",
+                            help="memory budget, e.g. 8GB (default: $SEMIANALYTIC_MEMORY_LIMIT, else 4GB); "
+                                 "larger problems are refused before they start")
         args = parser.parse_args(rest)
+        set_memory_limit(args.memory_limit)
         return int(module.run(args) or 0)
     except SystemExit as exc:  # argparse: --help (0) or bad arguments (2)
         return int(exc.code or 0)
     except InputError as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2
+    except RecursionError:
+        print(f"error: input: nested too deeply for {prog} {name}", file=sys.stderr)
+        return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
+        return 1
+    except MemoryError:
+        print(f"error: memory: {prog} {name} ran out of memory; lower the resolution or raise --memory-limit "
+              "only if the machine has the memory", file=sys.stderr)
         return 1
     except Exception:
         traceback.print_exc()

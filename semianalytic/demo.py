@@ -14,7 +14,9 @@ OUT = ROOT / "reports" / "demo"
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
-    parser.add_argument("--out", default=str(OUT), help=f"output folder (default {OUT})")
+    from semianalytic.cli_types import output_dir
+
+    parser.add_argument("--out", default=str(OUT), type=output_dir, help=f"output folder (default {OUT})")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render")
 
 

@@ -6,10 +6,19 @@ an internal failure (exit status 1).
 """
 
 
+def one_line(text: str) -> str:
+    """``text`` with every unprintable character (newline, tab, NUL, ...) escaped, so that an
+    error message stays one line whatever the user typed."""
+    if text.isprintable():
+        return text
+    return "".join(c if c.isprintable() or c == " " else repr(c)[1:-1] for c in text)
+
+
 class InputError(ValueError):
     """Bad input in a case file or on the command line (exit status 2)."""
 
     def __init__(self, field: str, message: str):
+        field, message = one_line(str(field)), one_line(str(message))  # a key may hold a newline
         self.field = field
         self.message = message
         super().__init__(f"{field}: {message}" if field else message)

@@ -12,6 +12,7 @@ from __future__ import annotations
 
 import functools
 import math
+import re
 from typing import Annotated, Any
 
 from pydantic import BeforeValidator
@@ -30,6 +31,30 @@ KINDS: dict[str, tuple[str, str, str]] = {
     "energy": ("[mass]*[length]**2/[time]**2", "J", "2.6 kJ"),
     "surface_energy": ("[mass]/[time]**2", "J/m^2", "12 J/m^2"),
     "angle": ("", "rad", "30 deg"),
+}
+
+
+# kind -> (smallest, largest) magnitude in SI that a case may give (zero is left to each field).
+# Not the validity of any model (each model warns about its own range): the physical range
+# of the quantity in anything this product computes, so that an absurd value ("1e300 m",
+# "1e-300 m") is refused at the door instead of overflowing inside a solver.
+PHYSICAL_BOUNDS: dict[str, tuple[float, float, str]] = {
+    "length": (1e-12, 1e4, "1 pm (below an atom) to 10 km"),
+    "area": (1e-24, 1e8, "1 pm^2 to 100 km^2"),
+    "volume": (1e-36, 1e12, "1 pm^3 to 1000 km^3"),
+    "mass": (1e-30, 1e7, "1e-30 kg (an electron) to 10 000 t"),
+    "time": (1e-18, 1e7, "1 as to 4 months"),
+    # above 100 km/s nothing in the solar system moves relative to a target (meteoroids reach
+    # 72 km/s); the striking velocities have their own, lower bound (semianalytic.case)
+    "velocity": (1e-9, 1e5, "1 nm/s to 100 km/s"),
+    # the theoretical strength and moduli of diamond are ~1 TPa; 10 TPa is beyond any solid
+    "pressure": (1e-3, 1e13, "1 mPa to 10 TPa"),
+    # air is 1.2 kg/m^3, osmium 22 590 kg/m^3
+    "density": (1e-2, 1e5, "0.01 to 100 000 kg/m^3"),
+    "areal_density": (1e-6, 1e7, "1 mg/m^2 to 10 000 t/m^2"),
+    "energy": (1e-30, 1e15, "1e-30 J to 1 PJ"),
+    "surface_energy": (1e-6, 1e6, "1 uJ/m^2 to 1 MJ/m^2"),
+    "angle": (1e-12, 2 * math.pi, "1e-12 rad to 360 deg"),
 }
 
 
@@ -77,6 +102,8 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
         raise InputError(
             field, f"expected a {kind} with a unit, e.g. '{example}'; got the bare number {value!r}"
         )
+    if not _NUMBER_FIRST.match(value):  # pint reads a bare "mm" as 1 mm
+        raise InputError(field, f"expected a {kind} as a number and a unit, e.g. '{example}'; got {value!r}")
     ureg = registry()
     try:
         q = ureg.Quantity(value.strip())
@@ -98,7 +125,13 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
         out = float(q.to(si.replace("^", "**")).magnitude)
     if not math.isfinite(out):
         raise InputError(field, f"{value!r} is not a finite {kind}")
+    low, high, text = PHYSICAL_BOUNDS[kind]
+    if out != 0 and not low <= abs(out) <= high:
+        raise InputError(field, f"{value!r} lies outside the physical range of a {kind} ({text})")
     return out
+
+
+_NUMBER_FIRST = re.compile(r"\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)
 
 
 def format_quantity(value: float, unit: str, digits: int = 4) -> str:

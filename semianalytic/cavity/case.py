@@ -16,9 +16,9 @@ from __future__ import annotations
 
 from typing import Literal
 
-from pydantic import Field, field_validator
+from pydantic import Field, field_validator, model_validator
 
-from semianalytic.schema import Section
+from semianalytic.schema import Section, check_brittle_constants
 from semianalytic.units import Pressure
 
 __all__ = ["MaterialSection"]
@@ -41,3 +41,9 @@ class MaterialSection(Section):
         if not -1.0 < v < 0.5:
             raise ValueError(f"must lie in (-1, 0.5); got {v!r}")
         return v
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        check_brittle_constants("material", self.youngs_modulus, self.poisson_ratio, self.tensile_strength,
+                                self.compressive_strength, self.bulk_modulus)
+        return self

@@ -17,13 +17,15 @@ from semianalytic.coefficients import READINGS
 
 
 def add_arguments(parser) -> None:
+    from semianalytic.cli_types import integer, number
+
     parser.add_argument("case", help="TOML case file with [projectile]+[target] or [body]")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
-    parser.add_argument("--depths", type=int, default=None, help="number of depths (default: [coefficients].depths, 60)")
-    parser.add_argument("--max-depth", type=float, default=None, help="deepest depth in nose lengths (default 300)")
+    parser.add_argument("--depths", type=integer(8, 2000), default=None, help="number of depths (default: [coefficients].depths, 60)")
+    parser.add_argument("--max-depth", type=number(1.0, 1e6, low_open=True), default=None, help="deepest depth in nose lengths (default 300)")
     parser.add_argument("--reading", choices=READINGS, default=None, help="reading of B for B_m2 (errata item 2a)")
-    parser.add_argument("--refinement", type=float, default=None, help="BEM panel-count multiplier")
-    parser.add_argument("--order", type=int, default=None, help="Gauss points per panel")
+    parser.add_argument("--refinement", type=number(0.0, 8.0, low_open=True), default=None, help="BEM panel-count multiplier")
+    parser.add_argument("--order", type=integer(2, 16), default=None, help="Gauss points per panel")
 
 
 def run(args) -> int:
@@ -39,6 +41,9 @@ def _run_body(case, args) -> int:
     from semianalytic.exact import spheroid_added_mass_coefficient
     from semianalytic.geometry import body_from_section
 
+    from semianalytic.guards import check_body
+
+    check_body(case, args.order, args.refinement)  # refuse before assembly what would not fit in memory
     body = case.body
     meridian = body_from_section(body)
     order = args.order or case.bem.order
@@ -71,6 +76,9 @@ def _run_projectile(case, args) -> int:
     from semianalytic.coefficients.table import coefficient_table
     from semianalytic.geometry import nose_from_section
 
+    from semianalytic.guards import check_coefficients
+
+    check_coefficients(case, args.order, args.refinement, args.max_depth)  # refuse what would not fit in memory
     nose = nose_from_section(case.projectile)
     reading = args.reading or case.coefficients.reading
     n_depths = args.depths or case.coefficients.depths

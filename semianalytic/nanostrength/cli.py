@@ -22,9 +22,11 @@ from semianalytic.nanostrength.analysis import Analysis, analyse_section
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from semianalytic.cli_types import output_dir
+
     parser.add_argument("case", help="TOML case file with a [nanostrength] section")
     parser.add_argument("--json", action="store_true", help="print the results as JSON (units in the keys)")
-    parser.add_argument("--report", metavar="DIR", help="write DIR/<case stem>.md and its PNG figures")
+    parser.add_argument("--report", metavar="DIR", type=output_dir, help="write DIR/<case stem>.md and its PNG figures")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
 
 

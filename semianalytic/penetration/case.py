@@ -98,6 +98,9 @@ class _Input(BaseModel):
     model_config = ConfigDict(extra="forbid", frozen=True)
     # R_t of the eroding rod (Alekseevskii-Tate, penetration.regime); default: the model's R_t at the projectile's diameter
     eroding_resistance: Pressure | None = None
+    # strict numbers as in every Section (a "*" validator would touch the discriminator 'model')
+    _strict = field_validator("poisson_ratio", "alpha", "hardening_exponent", "initial_porosity",
+                              mode="before", check_fields=False)(Section._strict_numbers.__func__)
 
 
 def _nu(v):
@@ -179,6 +182,14 @@ class CavityInput(_Input):
     bulk_modulus: Pressure | None = None
     initial_porosity: float = Field(default=0.0, ge=0.0, lt=1.0)
     _check_nu = field_validator("poisson_ratio")(_nu)
+
+    @model_validator(mode="after")
+    def _consistent(self):
+        from semianalytic.schema import check_brittle_constants
+
+        check_brittle_constants("target.resistance", self.youngs_modulus, self.poisson_ratio, self.tensile_strength,
+                                self.compressive_strength, self.bulk_modulus)
+        return self
 
     def build(self) -> Cavity:
         from semianalytic.cavity.material import BrittleMaterial

@@ -40,6 +40,7 @@ JSON_KEYS = (
 
 
 def add_arguments(parser) -> None:
+    from semianalytic.cli_types import file_stem, output_dir
     from semianalytic.penetration.options import W1_MODELS
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target], [impact]")
@@ -50,9 +51,9 @@ def add_arguments(parser) -> None:
     )
     parser.add_argument("--w1", choices=W1_MODELS, default="neglect",
                         help="lateral-compression energy W1 of eq. (28) (default: neglect, as the paper)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
-    parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
-    parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--report", metavar="DIR", default=None, type=output_dir, help="write a markdown report with plots into DIR")
+    parser.add_argument("--report-name", default=None, type=file_stem, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
@@ -141,6 +142,11 @@ def run(args) -> int:
     from semianalytic.penetration.evaluate import evaluate_case
 
     cases = _load(args.cases)
+    if args.coefficients == "bem":  # refuse before solving what would not fit in memory
+        from semianalytic.guards import check_coefficients
+
+        for case in cases:
+            check_coefficients(case)
     if args.report is not None:
         from semianalytic.penetration.report import report_path
 

@@ -22,11 +22,68 @@ from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_
 def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out") -> Path:
     """Refuse an existing ``out`` without ``force``, and a path that is a file."""
     out = Path(out)
-    if out.exists() and not out.is_dir():
-        raise InputError(field, f"{str(out)!r} exists and is not a folder")
-    if out.exists() and not force and any(out.iterdir()):
-        raise InputError(field, f"{str(out)!r} exists; pass --force to overwrite it")
+    try:
+        if out.exists() and not out.is_dir():
+            raise InputError(field, f"{str(out)!r} exists and is not a folder")
+        if out.exists() and not force and any(out.iterdir()):
+            raise InputError(field, f"{str(out)!r} exists; pass --force to overwrite it")
+    except OSError as exc:
+        raise InputError(field, f"cannot use {str(out)!r}: {exc.strerror or exc}") from None
     return out
+
+
+STALE_AGE = 24 * 3600.0  # a staging folder this old [s] is stale whoever made it
+
+
+def _owner() -> str:
+    """``HOST.PID`` of this process, written into the name of its staging folders."""
+    import socket
+
+    host = "".join(c for c in socket.gethostname() if c.isalnum() or c == "-")[:40] or "host"
+    return f"{host}.{os.getpid()}"
+
+
+def _process_alive(pid: int) -> bool:
+    try:
+        os.kill(pid, 0)
+    except ProcessLookupError:
+        return False
+    except PermissionError:  # someone else's live process
+        return True
+    return True
+
+
+def remove_stale_staging(final: Path, now: float | None = None) -> list[Path]:
+    """Remove the hidden ``.NAME.partial-*`` and ``.NAME.old-*`` siblings of ``final`` left by
+    killed runs: those whose owning process (same host) is gone, and any older than
+    :data:`STALE_AGE`.  A live run's folder (same host, process alive, recent) is kept, and so
+    is anything that is not a folder or not named after ``final``.  Returns what was removed."""
+    import re
+    import socket
+    import time
+
+    now = time.time() if now is None else now
+    host = "".join(c for c in socket.gethostname() if c.isalnum() or c == "-")[:40] or "host"
+    pattern = re.compile(re.escape(f".{final.name}.") + r"(partial|old)-(?:(?P<host>[A-Za-z0-9-]+)\.(?P<pid>\d+)-)?[^/]*")
+    removed = []
+    try:
+        siblings = list(final.parent.iterdir())
+    except OSError:
+        return removed
+    for path in siblings:
+        match = pattern.fullmatch(path.name)
+        if not match or path.is_symlink() or not path.is_dir():
+            continue
+        try:
+            age = now - path.lstat().st_mtime
+        except OSError:
+            continue
+        ours = match.group("host") == host and match.group("pid") is not None
+        gone = ours and not _process_alive(int(match.group("pid")))
+        if gone or age > STALE_AGE:
+            shutil.rmtree(path, ignore_errors=True)
+            removed.append(path)
+    return removed
 
 
 class StagedDir:
@@ -40,13 +97,18 @@ class StagedDir:
     def __init__(self, out: str | os.PathLike, force: bool = False, field: str = "--out"):
         self.final = check_output_dir(out, force, field).absolute()
         self.force = force
+        self.field = field
         self.root: Path | None = None
         self.files: list[str] = []
 
     # -- context -------------------------------------------------------------------------
     def __enter__(self) -> "StagedDir":
-        self.final.parent.mkdir(parents=True, exist_ok=True)
-        self.root = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.partial-", dir=self.final.parent))
+        try:
+            self.final.parent.mkdir(parents=True, exist_ok=True)
+            remove_stale_staging(self.final)
+            self.root = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.partial-{_owner()}-", dir=self.final.parent))
+        except OSError as exc:
+            raise InputError(self.field, f"cannot create {str(self.final)!r}: {exc.strerror or exc}") from None
         from semianalytic.io import _umask
 
         os.chmod(self.root, 0o777 & ~_umask())  # mkdtemp makes 0700; the report folder is for reading
@@ -63,7 +125,7 @@ class StagedDir:
         old = None
         if self.final.exists():
             check_output_dir(self.final, self.force)  # it may have appeared meanwhile
-            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.old-", dir=self.final.parent))
+            old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.old-{_owner()}-", dir=self.final.parent))
             os.replace(self.final, old / "previous")
         try:
             os.replace(self.root, self.final)
@@ -147,8 +209,10 @@ def report_command(prog: str, description: str, filename: str, build, argv: list
 
     from semianalytic.io import check_report_target
 
-    parser = argparse.ArgumentParser(prog=prog, description=description)
-    parser.add_argument("--out", default="reports", help="output folder (default reports/)")
+    from semianalytic.cli_types import OneLineParser, output_dir
+
+    parser = OneLineParser(prog=prog, description=description)
+    parser.add_argument("--out", default="reports", type=output_dir, help="output folder (default reports/)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
     args = parser.parse_args(argv)
     out = Path(args.out)

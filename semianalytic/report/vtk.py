@@ -240,6 +240,17 @@ def fem_meridian_mesh(field, u: float, phi_reference=None):
 # rendering
 
 
+def quiet_vtk_display_messages() -> None:
+    """Silence VTK's own log on stderr (on a headless machine every off-screen render window
+    logs "vtkXOpenGLRenderWindow ... bad X server connection" before falling back to
+    off-screen rendering, which works): the picture is written either way, and real
+    failures still raise."""
+    from vtkmodules.vtkCommonCore import vtkLogger, vtkObject
+
+    vtkLogger.SetStderrVerbosity(vtkLogger.VERBOSITY_OFF)
+    vtkObject.GlobalWarningDisplayOff()
+
+
 def render_png(volume_path, meridian_path, surface_path, png_path, title: str = "", window=(1000, 620)) -> Path:
     """Off-screen pyvista picture: the revolved body-fitted field cut in half at the meridian
     plane z = 0 (the volume conforms to the projectile, so the field is clipped at the body),
@@ -252,6 +263,7 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
     from semianalytic.report.figures import speed_scale
 
     pv.OFF_SCREEN = True
+    quiet_vtk_display_messages()
     vol = pv.read(str(volume_path))
     half = vol.clip(normal=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0))
     p = pv.Plotter(off_screen=True, window_size=list(window))

@@ -13,19 +13,24 @@ from semianalytic.run.case import ANALYSES
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from semianalytic.cli_types import output_dir
+
     parser.add_argument("case", help="case file (TOML)")
-    parser.add_argument("--out", required=True, help="output folder (created; replaced only with --force)")
+    parser.add_argument("--out", required=True, type=output_dir, help="output folder (created; replaced only with --force)")
     parser.add_argument("--force", action="store_true", help="replace an existing output folder")
     parser.add_argument("--only", action="append", choices=ANALYSES, default=None, metavar="ANALYSIS",
                         help=f"run only these analyses (repeatable; one of: {', '.join(ANALYSES)})")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render (VTK files are still written)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--json", action="store_true", help="print results.json to stdout as well")
 
 
 def run(args: argparse.Namespace) -> int:
+    from semianalytic.case import load_case
+    from semianalytic.guards import check_case
     from semianalytic.run.pipeline import run_case
 
+    check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
     out = Path(args.out)
     results = run_case(
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir

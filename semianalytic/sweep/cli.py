@@ -25,15 +25,17 @@ from semianalytic.errors import InputError
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
+    from semianalytic.cli_types import integer, output_dir
+
     parser.add_argument("case", help="case file (TOML)")
-    parser.add_argument("--out", required=True, help="output folder (results file + sweep.json)")
+    parser.add_argument("--out", required=True, type=output_dir, help="output folder (results file + sweep.json)")
     parser.add_argument("--vary", action="append", default=[], metavar="KEY=START:STOP:STEP",
                         help="grid axis (STOP included) or KEY=V1,V2,...; repeat for a Cartesian product")
     parser.add_argument("--sample", action="append", default=[], metavar="KEY=DIST(...)",
                         help="random input: normal(MEAN,SD), uniform(LOW,HIGH), lognormal(MEDIAN,SIGMA), "
                              "triangular(LOW,MODE,HIGH)")
-    parser.add_argument("--samples", type=int, default=0, help="number of Monte-Carlo samples (with --sample)")
-    parser.add_argument("--seed", type=int, default=0, help="seed of the Monte-Carlo draws (default 0)")
+    parser.add_argument("--samples", type=integer(0, 10_000_000), default=0, help="number of Monte-Carlo samples (with --sample)")
+    parser.add_argument("--seed", type=integer(0, 2**63 - 1), default=0, help="seed of the Monte-Carlo draws (default 0)")
     parser.add_argument("--analysis", choices=["penetration", "cavity"], default=None,
                         help="what to compute per case (default: from the case's sections)")
     parser.add_argument("--full", action="store_true",
@@ -42,9 +44,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--scheduler", default=None,
                         help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process; "
                              "default: a local cluster")
-    parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
-    parser.add_argument("--batch-size", type=int, default=None, help="cases per task (default: automatic)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--workers", type=integer(1, 256), default=2, help="workers of the local cluster (default 2)")
+    parser.add_argument("--batch-size", type=integer(1, 10_000_000), default=None, help="cases per task (default: automatic)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--resume", action="store_true", help="continue an interrupted sweep in --out")
     parser.add_argument("--force", action="store_true", help="discard existing results in --out")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")
@@ -67,6 +69,10 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--samples", "must not be negative")
     spec = build_spec(args.vary, args.sample, args.samples, args.seed)
     case = load_case(args.case)
+    check_axes(case, spec)
+    from semianalytic.guards import check_case
+
+    check_case(case)  # refuse before any worker starts what would not fit in memory
     kernel = select_kernel(case, args.analysis, cache_dir=args.cache_dir, full=args.full)
     summary = run_sweep(
         args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
@@ -89,3 +95,25 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
                       f"(n = {st['n']})")
     return 0 if summary.n_error == 0 else 1
+
+
+def check_axes(case, spec) -> None:
+    """Refuse (exit status 2) an axis whose every value the case rejects for that key, e.g.
+    ``impact.striking_velocity=400:500:10 kg`` (a mass where a velocity belongs): checked at
+    the first and the last value of each axis, before any worker starts."""
+    from semianalytic.case import parse_case
+    from semianalytic.sweep.spec import VELOCITY_KEY, apply_overrides, raw_value
+
+    for axis in spec.axes:
+        target = "impact.striking_velocities" if axis.key == VELOCITY_KEY else axis.key
+        errors = []
+        for value in {axis.values[0], axis.values[-1]}:
+            try:
+                parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}), case.path)
+            except InputError as exc:
+                if exc.field == target or exc.field.startswith(target + "."):
+                    errors.append(exc)
+                    continue
+            break
+        else:
+            raise InputError(errors[0].field, f"{errors[0].message} (every value from --vary {axis.key})")

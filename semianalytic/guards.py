@@ -1,0 +1,332 @@
+"""Resource guards: refuse, before anything is allocated, what would not fit in memory.
+
+Every command that solves estimates the size of its largest arrays from the geometry and the
+options (cheap: arithmetic on the panel plan, no assembly, no gmsh) and stops with exit status
+2 when the estimate exceeds the memory budget, naming the field that drives the size and the
+largest (or smallest) value of it that fits.
+
+The budget is, in order: the command's ``--memory-limit`` (set by the dispatcher with
+:func:`set_memory_limit`), ``$SEMIANALYTIC_MEMORY_LIMIT`` (e.g. ``8GB``), or 4 GB.
+
+Memory models (measured; see ``tests/test_guards.py`` and ``reports/hardening.md``):
+
+- BEM: the assembly holds the single and double layer of N primary unknowns against 2N
+  (with the mirror image) nodes and the kernel temporaries: 150-162 bytes per N^2 measured
+  for coefficient tables of the Fig. 5 ogive at refinements 1-4 (tracemalloc peak); 170 is
+  used.  N = order x panels of the deepest layout.
+- Velocity field of ``run``: the revolved 3D grid of nx x nr x segments nodes (points, hexahedra,
+  point data and the VTK copy): 400 bytes per node.
+- FEM (fem_check): triangles ~ 2.3 [L_b / (h^2 g d) + (pi/2) ln(R_far/d) / (h^2 g^2)] for
+  the size field h (d + g s) of :mod:`fem_check.meshing` (L_b the wetted length, g = 3),
+  two P2 unknowns per triangle, 3 kB per unknown (mesh, sparse matrix and its LU factors).
+"""
+
+from __future__ import annotations
+
+import math
+import os
+from typing import Callable
+
+from semianalytic.errors import InputError
+
+__all__ = [
+    "DEFAULT_MEMORY_LIMIT",
+    "MEMORY_ENV",
+    "memory_limit",
+    "set_memory_limit",
+    "bem_halfspace_unknowns",
+    "bem_body_unknowns",
+    "check_case",
+    "check_coefficients",
+    "check_body",
+    "check_field_grid",
+    "check_fem",
+    "format_bytes",
+]
+
+DEFAULT_MEMORY_LIMIT = 4e9
+MEMORY_ENV = "SEMIANALYTIC_MEMORY_LIMIT"
+BASE_BYTES = 0.0  # the budget is for the arrays of the problem (the interpreter itself takes ~300 MB more)
+BEM_BYTES_PER_UNKNOWN2 = 170.0
+FIELD_BYTES_PER_NODE = 400.0
+FEM_BYTES_PER_DOF = 3000.0
+EXACT_PLAN_PANELS = 20_000  # below this many (estimated) panels the real panel plan is counted
+
+_limit: float | None = None
+
+
+def set_memory_limit(limit: float | None) -> None:
+    """The budget of this process (the ``--memory-limit`` flag); ``None``: environment/default."""
+    global _limit
+    _limit = limit
+
+
+def memory_limit() -> float:
+    """The memory budget in bytes: ``--memory-limit``, else ``$SEMIANALYTIC_MEMORY_LIMIT``, else 4 GB."""
+    if _limit is not None:
+        return float(_limit)
+    env = os.environ.get(MEMORY_ENV)
+    if env:
+        import argparse
+
+        from semianalytic.cli_types import memory_size
+
+        try:
+            return memory_size(env)
+        except argparse.ArgumentTypeError as exc:
+            raise InputError(MEMORY_ENV, str(exc)) from None
+    return DEFAULT_MEMORY_LIMIT
+
+
+def format_bytes(n: float) -> str:
+    for unit, scale in (("TB", 1e12), ("GB", 1e9), ("MB", 1e6)):
+        if n >= scale:
+            return f"{n / scale:.3g} {unit}"
+    return f"{n / 1e3:.3g} kB"
+
+
+def _budget_text(limit: float) -> str:
+    return f"the memory budget of {format_bytes(limit)} (--memory-limit or ${MEMORY_ENV})"
+
+
+# ------------------------------------------------------------------------------------
+# BEM unknowns from the panel plan
+
+
+def _estimated_nose_panels(nose, refinement: float, levels: int) -> float:
+    """Panels of the whole nose as :func:`semianalytic.bem.panels.halfspace_layout` would lay
+    them at full submersion, by arithmetic only (a float: may be astronomically large)."""
+    from semianalytic.bem.panels import _segment_arc_length
+    from semianalytic.geometry import SplineCurve
+
+    R = nose.radius
+    total = 0.0
+    for seg in nose.segments:
+        arc = _segment_arc_length(seg, seg.t0, seg.t1)
+        n = max(2.0, math.ceil(refinement * 1.6 * arc / R)) if math.isfinite(arc) else math.inf
+        if isinstance(seg, SplineCurve):
+            n = max(n, len(seg.knots))
+        total += n + 2 * levels
+    return total
+
+
+def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_depth_nose_lengths: float = 300.0,
+                           levels: int = 12) -> float:
+    """Primary unknowns N of the deepest half-space layout of ``nose`` (order x panels)."""
+    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+
+    estimate = _estimated_nose_panels(nose, refinement, levels)
+    if estimate > EXACT_PLAN_PANELS:
+        length = (max_depth_nose_lengths - 1) * nose.length
+        shank = levels + max(0.0, math.log2(max(length / nose.radius, 1.0)) * refinement) + 2
+        return order * (estimate + shank)
+    layout = halfspace_layout(nose, max_depth_nose_lengths * nose.length, LayoutOptions(order, refinement, levels))
+    return float(order * sum(len(p.panels) for p in layout.pieces))
+
+
+def bem_body_unknowns(meridian, order: int = 8, refinement: float = 1.0, levels: int = 12) -> float:
+    """Unknowns N of a closed body in unbounded fluid (order x panels of the body layout)."""
+    from semianalytic.bem.panels import LayoutOptions, _segment_arc_length, body_panels
+    from semianalytic.geometry import EllipseArc
+
+    segs = meridian.segments
+    scale = _max_radius(meridian)
+    estimate = 0.0
+    for seg in segs:
+        arc = _segment_arc_length(seg, seg.t0, seg.t1)
+        n = refinement * 1.6 * arc / scale
+        if isinstance(seg, EllipseArc):
+            n = max(n, refinement * 1.2 * max(seg.a, seg.b) / max(min(seg.a, seg.b), 1e-300))
+        estimate += n + 2 * levels + 2
+    if estimate > EXACT_PLAN_PANELS:
+        return order * estimate
+    return float(order * body_panels(meridian, LayoutOptions(order, refinement, levels)).n_panels)
+
+
+def _max_radius(meridian) -> float:
+    import numpy as np
+
+    return max(float(np.max(np.abs(s.point(np.linspace(s.t0, s.t1, 33))[1]))) for s in meridian.segments)
+
+
+def bem_bytes(unknowns: float, mirror: bool = True) -> float:
+    """Peak bytes of one BEM solve with ``unknowns`` primary unknowns."""
+    return BASE_BYTES + BEM_BYTES_PER_UNKNOWN2 * unknowns**2 * (1.0 if mirror else 0.5)
+
+
+# ------------------------------------------------------------------------------------
+# the checks
+
+
+def _largest(fits: Callable[[float], bool], good: float, bad: float, steps: int = 40) -> float:
+    """Bisection (geometric when both ends are positive) between a value that fits and one
+    that does not; returns the last value that fits."""
+    for _ in range(steps):
+        mid = math.sqrt(good * bad) if good > 0 and bad > 0 else 0.5 * (good + bad)
+        if fits(mid):
+            good = mid
+        else:
+            bad = mid
+        if abs(bad - good) <= 1e-3 * abs(good):
+            break
+    return good
+
+
+def _refuse(field: str, what: str, need: float, limit: float, hint: str) -> None:
+    raise InputError(field, f"{what} needs about {format_bytes(need)}, above {_budget_text(limit)}; {hint}")
+
+
+def check_coefficients(case, order: int | None = None, refinement: float | None = None,
+                       max_depth: float | None = None, *, default_refinement: float = 0.3,
+                       option_prefix: str = "bem") -> float:
+    """Refuse a coefficient table (or a half-space solve) of the case's ``[projectile]`` that
+    does not fit; returns the estimated bytes.  The field named is the one that drives the size:
+    the refinement or order when they were raised, else the nose shape (``crh`` of an ogive,
+    ``half_angle`` of a cone, the table ``points``)."""
+    from semianalytic.geometry import nose_from_section
+
+    psec = case.projectile
+    order = order or case.bem.order
+    ref_given = refinement or case.bem.refinement
+    ref = ref_given or default_refinement
+    depth = max_depth or case.coefficients.max_depth_nose_lengths
+    limit = memory_limit()
+    nose = nose_from_section(psec)
+
+    def need_for(n, o=order, r=ref) -> float:
+        return bem_bytes(bem_halfspace_unknowns(n, o, r, depth))
+
+    need = need_for(nose)
+    if need <= limit:
+        return need
+    what = f"the BEM solve of the {nose.kind} nose (~{bem_halfspace_unknowns(nose, order, ref, depth):.3g} unknowns)"
+    if ref > default_refinement and need_for(nose, r=default_refinement) <= limit:
+        best = _largest(lambda r: need_for(nose, r=r) <= limit, default_refinement, ref)
+        _refuse("--refinement" if refinement else f"{option_prefix}.refinement", what, need, limit,
+                f"the largest refinement that fits is {best:.3g}")
+    if order > 8 and need_for(nose, o=8) <= limit:
+        best = max(o for o in range(2, order) if need_for(nose, o=o) <= limit)
+        _refuse("--order" if order != case.bem.order else f"{option_prefix}.order", what, need, limit,
+                f"the largest order that fits is {best}")
+    if psec.nose == "ogive" and need_for(nose_from_section(psec.model_copy(update={"crh": 0.5}))) <= limit:
+        best = _largest(lambda c: need_for(nose_from_section(psec.model_copy(update={"crh": c}))) <= limit, 0.5, psec.crh)
+        _refuse("projectile.crh", what, need, limit, f"the largest crh that fits is {best:.4g}")
+    if psec.nose == "cone" and need_for(nose_from_section(psec.model_copy(update={"half_angle": math.radians(60)}))) <= limit:
+        worst = psec.half_angle
+        best = _largest(lambda a: need_for(nose_from_section(psec.model_copy(update={"half_angle": a}))) <= limit,
+                        math.radians(60), worst)
+        _refuse("projectile.half_angle", what, need, limit, f"the smallest half_angle that fits is {math.degrees(best):.4g} deg")
+    field = "projectile.points" if psec.nose == "table" else "projectile"
+    _refuse(field, what, need, limit, "make the nose less slender or lower the refinement")
+    return need
+
+
+def check_body(case, order: int | None = None, refinement: float | None = None) -> float:
+    """Refuse a ``[body]`` BEM solve that does not fit; returns the estimated bytes."""
+    from semianalytic.geometry import body_from_section
+
+    order = order or case.bem.order
+    ref = refinement or case.bem.refinement or 1.0
+    limit = memory_limit()
+    meridian = body_from_section(case.body)
+    unknowns = bem_body_unknowns(meridian, order, ref)
+    need = bem_bytes(unknowns, mirror=False)
+    if need > limit:
+        what = f"the BEM solve of the {case.body.shape} body (~{unknowns:.3g} unknowns)"
+        if ref > 1.0 and bem_bytes(bem_body_unknowns(meridian, order, 1.0), mirror=False) <= limit:
+            best = _largest(lambda r: bem_bytes(bem_body_unknowns(meridian, order, r), mirror=False) <= limit, 1.0, ref)
+            _refuse("--refinement" if refinement else "bem.refinement", what, need, limit,
+                    f"the largest refinement that fits is {best:.3g}")
+        field = {"spheroid": "body.length", "table": "body.points"}.get(case.body.shape, "body")
+        _refuse(field, what, need, limit, "make the body less slender or lower the refinement")
+    return need
+
+
+def check_field_grid(case) -> float:
+    """Refuse a ``[run]`` velocity field whose revolved grid does not fit."""
+    run = case.section("run")
+    if run is None:
+        return 0.0
+    nx, nr = run.field_grid
+    limit = memory_limit()
+
+    def need_for(segments: int, nodes: float = nx * nr) -> float:
+        return BASE_BYTES + FIELD_BYTES_PER_NODE * nodes * (segments + 1)
+
+    need = need_for(run.field_segments)
+    if need <= limit:
+        return need
+    what = f"the revolved field grid of {nx} x {nr} nodes x {run.field_segments} segments"
+    if need_for(3) <= limit:
+        best = max(s for s in range(3, run.field_segments) if need_for(s) <= limit)
+        _refuse("run.field_segments", what, need, limit, f"the largest field_segments that fits is {best}")
+    _refuse("run.field_grid", what, need, limit, "use fewer nodes (the default is [49, 25])")
+    return need
+
+
+def fem_unknowns(diameter: float, wetted_length: float, far_radius: float, h: float, growth: float = 3.0) -> float:
+    """P2 unknowns of a fem_check mesh (see the module docstring)."""
+    d = diameter
+    tri = 2.3 * (wetted_length / (h * h * growth * d) + 0.5 * math.pi * math.log(max(far_radius / d, 2.0)) / (h * h * growth**2))
+    return 2.0 * tri
+
+
+def check_fem(case, h: float, depths_nose_lengths=(), far: float = 20.0) -> float:
+    """Refuse a fem_check mesh (element size ``h`` d) that does not fit."""
+    limit = memory_limit()
+    if case.body is not None:
+        from semianalytic.geometry import body_from_section
+
+        meridian = body_from_section(case.body)
+        d = 2 * _max_radius(meridian)
+        length = sum(_arc(seg) for seg in meridian.segments)
+        dofs = fem_unknowns(d, length, far * max(d, length), h)
+        field = "body"
+    elif case.projectile is not None:
+        from semianalytic.geometry import nose_from_section
+
+        nose = nose_from_section(case.projectile)
+        d = nose.diameter
+        deepest = max(depths_nose_lengths or (1.0,)) * nose.length
+        wetted = sum(_arc(seg) for seg in nose.segments) + max(deepest - nose.length, 0.0)
+        dofs = fem_unknowns(d, wetted, far * (d + deepest), h)
+        field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
+            case.projectile.nose, "projectile")
+    else:
+        return 0.0
+    need = BASE_BYTES + FEM_BYTES_PER_DOF * dofs
+    if need > limit:
+        what = f"the FEM mesh (~{dofs:.3g} P2 unknowns at h = {h:g} d)"
+        # unknowns scale like 1/h^2: the smallest h that fits
+        best = h * math.sqrt(FEM_BYTES_PER_DOF * dofs / max(limit - BASE_BYTES, 1.0))
+        if best <= 0.5:
+            _refuse("--h", what, need, limit, f"the smallest h that fits is {best:.3g}")
+        _refuse(field, what, need, limit, "the body is too slender for the FEM mesh")
+    return need
+
+
+def _arc(seg) -> float:
+    from semianalytic.bem.panels import _segment_arc_length
+
+    return _segment_arc_length(seg, seg.t0, seg.t1)
+
+
+def check_case(case, *, order: int | None = None, refinement: float | None = None, max_depth: float | None = None,
+               field: bool = False) -> None:
+    """Every BEM guard that applies to ``case`` (and the ``[run]`` field grid with ``field``)."""
+    if case.projectile is not None:
+        check_coefficients(case, order, refinement, max_depth)
+        if field and case.section("run") is not None:
+            check_coefficients(case, order, refinement, 1.0 + 1e-9 + max(
+                [d / max(_nose_length(case), 1e-300) for d in (case.section("run").field_depths or [])] or [1.0]),
+                default_refinement=1.0)
+    if case.body is not None:
+        check_body(case, order, refinement)
+    if field:
+        check_field_grid(case)
+
+
+def _nose_length(case) -> float:
+    from semianalytic.geometry import nose_from_section
+
+    return nose_from_section(case.projectile).length

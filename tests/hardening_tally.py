@@ -1,0 +1,191 @@
+"""Tally of the hardening corpus (issue 13) -> ``reports/hardening.md``.
+
+    .venv/bin/python tests/hardening_tally.py --out reports
+
+Runs every file of ``tests/corpus/`` and ``tests/bad_cases/`` through all eight commands that
+read a case (in-process, each from an empty working folder), then the bad command-line options
+of issue 13, and counts: tried, rejected cleanly (exit 2, one line), warned (exit 0 with a
+warning), accepted (exit 0), tracebacks, anything else.  It also records the memory guard's
+answer on the three cases of the issue and the peak memory of the whole run.
+"""
+
+from __future__ import annotations
+
+import argparse
+import collections
+import os
+import resource
+import sys
+import tempfile
+import time
+from pathlib import Path
+
+sys.path.insert(0, str(Path(__file__).resolve().parent))
+
+from corpus_runner import ALL_COMMANDS, Outcome, corpus_files, headers, run_command, working_directory  # noqa: E402
+
+ROOT = Path(__file__).resolve().parents[1]
+OGIVE = str(ROOT / "cases" / "fig5_ogive.toml")
+
+# The bad options of issue 13 (and their neighbours): (package, argv)
+OPTIONS = [
+    ("semianalytic", ["coefficients", OGIVE, "--max-depth", "-5"]),
+    ("semianalytic", ["coefficients", OGIVE, "--refinement", "-1"]),
+    ("semianalytic", ["coefficients", OGIVE, "--refinement", "0"]),
+    ("semianalytic", ["coefficients", OGIVE, "--order", "1"]),
+    ("semianalytic", ["coefficients", OGIVE, "--order", "100"]),
+    ("semianalytic", ["coefficients", OGIVE, "--depths", "0"]),
+    ("semianalytic", ["coefficients", OGIVE, "--depths", "1e9"]),
+    ("semianalytic", ["coefficients", OGIVE, "--max-depth", "nan"]),
+    ("semianalytic", ["coefficients", OGIVE, "--refinement", "inf"]),
+    ("semianalytic", ["coefficients", OGIVE, "--memory-limit", "lots"]),
+    ("semianalytic", ["coefficients", OGIVE, "--refinement", "8", "--memory-limit", "100MB"]),
+    ("fem_check", ["verify", OGIVE, "--depths", "1.0"]),
+    ("fem_check", ["verify", OGIVE, "--depths", "0"]),
+    ("fem_check", ["verify", OGIVE, "--depths", "1,,x"]),
+    ("fem_check", ["verify", OGIVE, "--h", "0"]),
+    ("fem_check", ["verify", OGIVE, "--out", "{tmp}/d", "--name", "../../x"]),
+    ("fem_check", ["rod", "--name", "/tmp/x", "--out", "{tmp}/d"]),
+    ("fem_check", ["rod", "--elements", "1e9"]),
+    ("fem_check", ["bench", "--repeat", "-1"]),
+    ("semianalytic", ["run", OGIVE, "--out", "{tmp}/afile/sub"]),
+    ("semianalytic", ["run", OGIVE, "--out", "/proc/x"]),
+    ("semianalytic", ["run", OGIVE, "--out", ""]),
+    ("semianalytic", ["penetrate", OGIVE, "--report-name", "../x"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s",
+                      "--vary", "impact.striking_velocity=400:500:10 kg", "--scheduler", "inline"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s", "--workers", "0",
+                      "--vary", "impact.striking_velocity=400:500:10 m/s"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s", "--samples", "-3",
+                      "--vary", "impact.striking_velocity=400:500:10 m/s"]),
+    ("semianalytic", ["bench-bem"]),
+    ("semianalytic", ["nosuchcommand"]),
+]
+
+
+def run_option(package: str, argv: list[str], tmp: Path) -> Outcome:
+    import contextlib
+    import io
+
+    if package == "fem_check":
+        from fem_check.cli import main
+    else:
+        from semianalytic.cli import main
+    (tmp / "afile").write_text("a file, not a folder\n")
+    argv = [a.replace("{tmp}", str(tmp)) for a in argv]
+    err, out = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
+        rc = main(argv)
+    return Outcome(rc, err.getvalue(), out.getvalue())
+
+
+def classify(res: Outcome) -> str:
+    if res.rc == 2 and len(res.err.strip().splitlines()) != 1:
+        return "rejected, not one line"
+    return res.kind
+
+
+def main(argv=None) -> int:
+    parser = argparse.ArgumentParser(description=__doc__.splitlines()[0])
+    parser.add_argument("--out", default=None, help="folder of hardening.md (default: print only)")
+    args = parser.parse_args(argv)
+    os.environ.setdefault("MPLBACKEND", "Agg")
+    started = time.time()
+    tally: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
+    by_command: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
+    bad_rows, guard_rows, stray = [], [], []
+    files = corpus_files()
+    with tempfile.TemporaryDirectory() as tmp_root:
+        tmp_root = Path(tmp_root)
+        os.environ.setdefault("SEMIANALYTIC_CACHE_DIR", str(tmp_root / "cache"))
+        for k, path in enumerate(files):
+            group = path.parent.name
+            for command in ALL_COMMANDS:
+                work = tmp_root / f"w{k}_{command.replace(' ', '_')}"
+                work.mkdir()
+                with working_directory(work):
+                    res = run_command(command, str(path), work / "out")
+                kind = classify(res)
+                tally[group][kind] += 1
+                by_command[command][kind] += 1
+                if kind not in ("rejected", "warned", "accepted"):
+                    bad_rows.append((f"{group}/{path.name}", command, kind, res.err.strip().splitlines()[-1:] or [""]))
+                if {p.name for p in work.iterdir()} - {"out"}:
+                    stray.append((f"{group}/{path.name}", command, sorted(p.name for p in work.iterdir())))
+                if path.stem in ("crh_1e12_memory", "cone_0p001deg_memory", "field_grid_801_180_memory"):
+                    guard_rows.append((path.stem, command, res.rc, res.err.strip()))
+            print(f"\r{k + 1}/{len(files)} files", end="", file=sys.stderr, flush=True)
+        print(file=sys.stderr)
+        options = collections.Counter()
+        option_rows = []
+        for package, argv_ in OPTIONS:
+            tmp = tmp_root / f"opt{len(option_rows)}"
+            tmp.mkdir()
+            with working_directory(tmp):
+                res = run_option(package, argv_, tmp)
+            kind = classify(res)
+            options[kind] += 1
+            option_rows.append((f"{'python -m ' + package} {' '.join(a if a else repr(a) for a in argv_)}".replace(str(ROOT) + "/", ""),
+                                res.rc, (res.err.strip().splitlines() or [""])[-1]))
+    peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
+    seconds = time.time() - started
+
+    kinds = ["rejected", "warned", "accepted", "traceback", "rejected, not one line"]
+    lines = [
+        "# Hardening: bad inputs, tallied (issue 13)",
+        "",
+        "Generated by `.venv/bin/python tests/hardening_tally.py --out reports` "
+        f"({seconds:.0f} s, peak memory of the whole run {peak_mb:.0f} MB).",
+        "",
+        f"Every case file of `tests/corpus/` ({sum(1 for f in files if f.parent.name == 'corpus')} files, written for issue 13) and "
+        f"`tests/bad_cases/` ({sum(1 for f in files if f.parent.name == 'bad_cases')} files) through the eight commands that read a case "
+        f"({', '.join(ALL_COMMANDS)}), in-process, each from an empty working folder; then {len(OPTIONS)} bad command lines.",
+        "`rejected`: exit status 2 with one line naming the field; `warned`: exit 0 with a `warning:` line; "
+        "`accepted`: exit 0 (a command that does not use the bad section, e.g. `cavity` ignores `[run]`).",
+        "The same inputs are asserted file by file in `tests/test_corpus.py` (part of `make test`).",
+        "",
+        "## Case files",
+        "",
+        "| corpus | tried | " + " | ".join(kinds) + " |",
+        "|---|---|" + "---|" * len(kinds),
+    ]
+    for group, counter in sorted(tally.items()):
+        lines.append(f"| {group} | {sum(counter.values())} | " + " | ".join(str(counter[k]) for k in kinds) + " |")
+    total = collections.Counter()
+    for counter in tally.values():
+        total.update(counter)
+    lines.append("| **all** | " + f"**{sum(total.values())}** | " + " | ".join(f"**{total[k]}**" for k in kinds) + " |")
+    lines += ["", "| command | tried | " + " | ".join(kinds) + " |", "|---|---|" + "---|" * len(kinds)]
+    for command in ALL_COMMANDS:
+        counter = by_command[command]
+        lines.append(f"| `{command}` | {sum(counter.values())} | " + " | ".join(str(counter[k]) for k in kinds) + " |")
+    lines += ["", f"Runs that wrote outside their `--out`: {len(stray)}.", ""]
+    if bad_rows:
+        lines += ["Runs that were neither rejected cleanly, warned nor accepted:", ""]
+        lines += [f"- `{f}` `{c}`: {k}: {e[0][:200]}" for f, c, k, e in bad_rows]
+        lines.append("")
+    lines += ["## The memory guard on the three cases of the issue", "",
+              "Budget 4 GB (the default; `--memory-limit SIZE` or `$SEMIANALYTIC_MEMORY_LIMIT`). Refused before any "
+              "allocation, by the commands that would solve them (the others stop earlier, at a missing section):", ""]
+    for stem, command, rc, err in guard_rows:
+        if "memory budget" in err:
+            lines.append(f"- `{stem}` / `{command}` (exit {rc}): {err}")
+    lines += ["", "## Command-line options", "",
+              "| command | exit | stderr (last line) |", "|---|---|---|"]
+    for cmd, rc, err in option_rows:
+        lines.append(f"| `{cmd}` | {rc} | {err.replace('|', '/')[:220]} |")
+    lines += ["", "Options: " + ", ".join(f"{k} {v}" for k, v in sorted(options.items())) + ".", ""]
+    text = "\n".join(lines) + "\n"
+    if args.out:
+        sys.path.insert(0, str(ROOT))
+        from semianalytic.io import atomic_write_text
+
+        path = atomic_write_text(Path(args.out) / "hardening.md", text)
+        print(f"wrote {path}")
+    else:
+        print(text)
+    return 0 if not bad_rows and not stray and not options.get("traceback") else 1
+
+
+if __name__ == "__main__":
+    raise SystemExit(main())
