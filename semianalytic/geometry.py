@@ -119,6 +119,14 @@ class SplineCurve:
 
     xs: tuple[float, ...]
     rs: tuple[float, ...]
+    lo: float | None = None  # a sub-range [lo, hi] of the parameter (one interval between knots)
+    hi: float | None = None
+
+    def between_knots(self) -> tuple["SplineCurve", ...]:
+        """The curve cut at its knots: one segment per interval, so that panels never
+        straddle a knot (where the third derivative jumps)."""
+        k = self.knots
+        return tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
 
     @cached_property
     def _splines(self):
@@ -130,11 +138,11 @@ class SplineCurve:
 
     @property
     def t0(self) -> float:
-        return 0.0
+        return 0.0 if self.lo is None else self.lo
 
     @property
     def t1(self) -> float:
-        return float(self._splines[0][-1])
+        return float(self._splines[0][-1]) if self.hi is None else self.hi
 
     @property
     def knots(self) -> np.ndarray:
@@ -170,11 +178,12 @@ def _leggauss(n: int):
 def _gauss_integrate(segment: Segment, f, n: int = 48) -> float:
     """Integrate ``f(x, r, dx, dr)`` dt over a segment with composite Gauss-Legendre."""
     u, w = _leggauss(n)
-    edges = (
-        np.asarray(segment.knots)
-        if isinstance(segment, SplineCurve)
-        else np.linspace(segment.t0, segment.t1, 5)
-    )
+    if isinstance(segment, SplineCurve):
+        k = np.asarray(segment.knots)
+        inner = k[(k > segment.t0) & (k < segment.t1)]
+        edges = np.concatenate([[segment.t0], inner, [segment.t1]])
+    else:
+        edges = np.linspace(segment.t0, segment.t1, 5)
     total = 0.0
     for a, b in zip(edges[:-1], edges[1:]):
         t = 0.5 * (a + b) + 0.5 * (b - a) * u
@@ -457,7 +466,7 @@ def table_nose(points: list[tuple[float, float]], diameter: float, field_name: s
         if np.any(np.diff(x) > 1e-9 * diameter) or np.any(r[1:] <= 0) or np.any(r > 0.5 * diameter * (1 + 1e-6)):
             raise bad(i + 1, "the spline through the points folds back or crosses itself before this point "
                              "(self-intersecting meridian); add points or smooth the table")
-    return Nose("table", diameter, float(pts[-1, 0]), (spline,), {"points": pts.tolist()})
+    return Nose("table", diameter, float(pts[-1, 0]), spline.between_knots(), {"points": pts.tolist()})
 
 
 # ------------------------------------------------------------------------------------

@@ -521,6 +521,12 @@ def param_at_x(seg: Segment, x: float) -> float:
         c = np.clip((x - seg.center[0]) / seg.radius, -1.0, 1.0)
         return float(np.arccos(c))
     f = lambda t: float(seg.point(t)[0]) - x  # noqa: E731
+    if isinstance(seg, SplineCurve):
+        # a table nose is cut at its knots into segments; the free surface of a nearby
+        # depth (a difference in P) may lie just past the segment's end, on the next
+        # interval of the same (C^2) spline: search the whole spline
+        knots = seg.knots
+        return brentq(f, float(knots[0]), float(knots[-1]), xtol=1e-15 * float(knots[-1]), rtol=4.5 * np.finfo(float).eps)
     # scipy requires rtol >= 4 eps; xtol is absolute in the parameter (arc length of a spline)
     span = abs(seg.t1 - seg.t0)
     return brentq(f, seg.t0, seg.t1, xtol=1e-15 * max(span, 1e-300), rtol=4.5 * np.finfo(float).eps)
@@ -580,6 +586,13 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
     tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
     turning = Meridian(segs, closed=False).corners() if len(segs) > 1 else []
     joints = _joints(segs)
+
+    def junction(k: int) -> int:
+        # a knot of a table's spline (C^2: only the third derivative jumps) needs no grading
+        a, b = segs[k], segs[k + 1]
+        same_spline = isinstance(a, SplineCurve) and isinstance(b, SplineCurve) and a.xs == b.xs and a.rs == b.rs
+        return 0 if same_spline else options.junction_levels
+
     pieces = []
     for k, seg in enumerate(segs):
         x_end = float(seg.point(seg.t1)[0])
@@ -588,17 +601,17 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         arc = _segment_arc_length(seg, seg.t0, t1)
         if arc <= 0:
             continue
-        n = _count(arc, scale, ref, 1.6)
+        n = _count(arc, scale, ref, 1.6, minimum=1 if isinstance(seg, SplineCurve) else 2)
         if isinstance(seg, SplineCurve):
             n = max(n, int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) + 1)
         if k == 0:
             g0 = lev if tip_conical else 0
         else:
-            g0 = options.corner_grading(turning[k - 1]) if turning[k - 1] else options.junction_levels  # curvature jump between tangent segments
+            g0 = options.corner_grading(turning[k - 1]) if turning[k - 1] else junction(k - 1)  # curvature jump between tangent segments
         if cut_here:
             g1 = lev
         elif k < len(segs) - 1:
-            g1 = options.corner_grading(turning[k]) if turning[k] else options.junction_levels
+            g1 = options.corner_grading(turning[k]) if turning[k] else junction(k)
         else:
             g1 = options.corner_grading(_shoulder_turning(nose)) if _shoulder_is_corner(nose) else options.junction_levels
         p0 = (0.0, 0.0) if k == 0 else joints[k]
@@ -615,6 +628,8 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
             q1 = corner_power(turning[k])
         else:
             q1 = corner_power(_shoulder_turning(nose))
+        if n == 1 and g0 and g1:
+            n = 2
         pieces.append(Piece(seg, seg.t0, t1, p0, p1, graded_panels(n, g0, g1), (q0, q1)))
         if cut_here:
             break
