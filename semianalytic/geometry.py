@@ -531,6 +531,22 @@ def spheroid_body(length: float, diameter: float) -> Meridian:
     return Meridian((EllipseArc(0.0, 0.5 * length, 0.5 * diameter),))
 
 
+def cylinder_body(length: float, diameter: float) -> Meridian:
+    """Flat-ended circular cylinder (two 90 deg edges), centred on the origin."""
+    if not (length > 0 and diameter > 0):
+        raise InputError("body.length", "length and diameter must be positive")
+    h, R = 0.5 * length, 0.5 * diameter
+    return Meridian((Line((h, 0.0), (h, R)), Line((h, R), (-h, R)), Line((-h, R), (-h, 0.0))))
+
+
+def double_cone_body(length: float, diameter: float) -> Meridian:
+    """Two equal cones base to base (conical tips at x = +-length/2, an edge at x = 0)."""
+    if not (length > 0 and diameter > 0):
+        raise InputError("body.length", "length and diameter must be positive")
+    h, R = 0.5 * length, 0.5 * diameter
+    return Meridian((Line((h, 0.0), (0.0, R)), Line((0.0, R), (-h, 0.0))))
+
+
 def table_body(points: list[tuple[float, float]], field_name: str = "body.points") -> Meridian:
     """Closed meridian through user points from one axis point to the other."""
     pts = np.asarray(points, dtype=float)
@@ -574,4 +590,8 @@ def body_from_section(sec) -> Meridian:
         return sphere_body(sec.diameter)
     if sec.shape == "spheroid":
         return spheroid_body(sec.length, sec.diameter)
+    if sec.shape == "cylinder":
+        return cylinder_body(sec.length, sec.diameter)
+    if sec.shape == "double_cone":
+        return double_cone_body(sec.length, sec.diameter)
     return table_body(sec.points_si())

@@ -61,6 +61,7 @@ class PanelSet:
     # (corner at u = -1), +1 (corner at u = +1) or 0 (no substitution)
     power: np.ndarray | None = None
     cluster: np.ndarray | None = None
+    label: str = "body"  # what the panels cover, for error messages ("cone nose", "body")
 
     @property
     def n_panels(self) -> int:
@@ -332,7 +333,8 @@ def graded_panels(n: int, grade0: int, grade1: int, ratio: float = GRADING_RATIO
     return np.array(rows, dtype=float)
 
 
-def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float = 0.0, mirror: bool = False) -> PanelSet:
+def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float = 0.0, mirror: bool = False,
+              label: str = "body") -> PanelSet:
     """Assemble pieces (and optionally their mirror images) into a :class:`PanelSet`."""
     segs, idx, base, ax, ar, da, db = [], [], [], [], [], [], []
     power, cluster = [], []
@@ -383,7 +385,7 @@ def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float
     power_arr, cluster_arr = np.array(power, dtype=float), np.array(cluster, dtype=float)
     if not np.any(cluster_arr):
         power_arr = cluster_arr = None
-    return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n, power_arr, cluster_arr)
+    return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n, power_arr, cluster_arr, label)
 
 
 TIP_POWER = 2.0  # substitution at a conical tip (axisymmetric point exponent nu in (1/2, 1))
@@ -564,7 +566,7 @@ class HalfspaceLayout:
 
     def panels(self) -> PanelSet:
         """Primary panels (tip at x = P in the target frame) followed by their mirror images."""
-        return panel_set(self.pieces, self.options.order, offset=self.depth, mirror=True)
+        return panel_set(self.pieces, self.options.order, offset=self.depth, mirror=True, label=f"{self.nose.kind} nose")
 
 
 def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOptions()) -> HalfspaceLayout:
