@@ -466,7 +466,7 @@ def table_nose(points: list[tuple[float, float]], diameter: float, field_name: s
         if np.any(np.diff(x) > 1e-9 * diameter) or np.any(r[1:] <= 0) or np.any(r > 0.5 * diameter * (1 + 1e-6)):
             raise bad(i + 1, "the spline through the points folds back or crosses itself before this point "
                              "(self-intersecting meridian); add points or smooth the table")
-    return Nose("table", diameter, float(pts[-1, 0]), spline.between_knots(), {"points": pts.tolist()})
+    return Nose("table", diameter, float(pts[-1, 0]), (spline,), {"points": pts.tolist()})
 
 
 # ------------------------------------------------------------------------------------

@@ -582,7 +582,8 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         raise ValueError("depth must be positive")
     R, Lh = nose.radius, nose.length
     lev, ref = options.levels, options.refinement
-    segs = nose.segments
+    # a table's spline is cut at its knots, so that panels never straddle one
+    segs = tuple(p for seg in nose.segments for p in (seg.between_knots() if isinstance(seg, SplineCurve) else (seg,)))
     cut_on_nose = depth < Lh
     scale = R if not cut_on_nose else max(min(R, depth), 1e-300)
     tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
