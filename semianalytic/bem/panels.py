@@ -594,7 +594,9 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         # a knot of a table's spline (C^2: only the third derivative jumps) needs no grading
         a, b = segs[k], segs[k + 1]
         same_spline = isinstance(a, SplineCurve) and isinstance(b, SplineCurve) and a.xs == b.xs and a.rs == b.rs
-        return 0 if same_spline else options.junction_levels
+        # between two analytic segments of a nose (a sphere cap on a cone): two levels more
+        # than at the nose-shank junction (measured on the blunted cone: B from 5e-6 to 5e-7)
+        return 0 if same_spline else options.junction_levels + (2 if options.levels else 0)
 
     pieces = []
     for k, seg in enumerate(segs):
@@ -617,6 +619,11 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
             g1 = options.corner_grading(turning[k]) if turning[k] else junction(k)
         else:
             g1 = options.corner_grading(_shoulder_turning(nose)) if _shoulder_is_corner(nose) else options.junction_levels
+            if _shoulder_is_corner(nose) and depth > Lh and options.levels:
+                # the shoulder's mirror image lies 2 (P - L_h) away: grade down to that scale
+                gap = 0.5 * (depth - Lh)
+                need = math.ceil(math.log(gap / (arc / n)) / math.log(GRADING_RATIO)) if gap < arc / n else 0
+                g1 = max(g1, min(need, 22))
         p0 = (0.0, 0.0) if k == 0 else joints[k]
         if cut_here:
             p1 = (-depth, float(seg.point(t1)[1]))
