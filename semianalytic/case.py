@@ -88,6 +88,8 @@ class ProjectileSection(Section):
     ``nose``: ogive (needs ``crh``, psi = s/d), sphere (hemispherical), cone (needs
     ``half_angle``), flat (optional ``corner_radius``) or table (``points = [[x, r], ...]``
     in ``points_unit``, x measured back from the tip, from (0, 0) to the shoulder at r = d/2).
+    Ogive and cone take an optional ``meplat_diameter`` (flat tip: truncated nose) or
+    ``tip_radius`` (spherically blunted tip); a key a nose kind has no use for is an error.
     ``shank_length`` is the cylindrical part: total length = shank + nose.
     """
 
