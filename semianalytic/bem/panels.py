@@ -83,23 +83,24 @@ class PanelSet:
         their relative precision."""
         da, db = self.da[pk], self.db[pk]
         span = db - da
-        if self.cluster is None or not np.any(self.cluster[pk] != 0):
-            half = 0.5 * span
-            dt = da + half * (u + 1.0)
-            return dt, half, (np.zeros_like(dt) if second else None)
-        c, q = self.cluster[pk], self.power[pk]
-        plain = c == 0
-        lo = np.where(c < 0, 0.5 * (1.0 + u), 0.5 * (1.0 - u))  # distance from the corner end
-        lo = np.where(plain, 0.5 * (1.0 + u), lo)
-        qq = np.where(plain, 1.0, q)
-        w = lo**qq
-        dw = 0.5 * qq * lo ** (qq - 1.0)
-        dt = np.where(c > 0, db - span * w, da + span * w)
-        dtdu = span * dw  # both ends: d/du of the offset has the sign of span
-        d2 = None
+        half = 0.5 * span
+        dt = da + half * (u + 1.0)
+        d2 = np.zeros_like(dt) if second else None
+        if self.cluster is None:
+            return dt, half, d2
+        on = np.nonzero(self.cluster[pk])  # the few nodes on corner panels
+        if on[0].size == 0:
+            return dt, half, d2
+        dtdu = np.array(np.broadcast_to(half, dt.shape), dtype=float)
+        pko, uo, so = pk[on], u[on], span[on]
+        c, q = self.cluster[pko], self.power[pko]
+        lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
+        w = lo**q
+        dt[on] = np.where(c > 0, db[on] - so * w, da[on] + so * w)
+        dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
         if second:
-            d2w = 0.25 * qq * (qq - 1.0) * lo ** np.maximum(qq - 2.0, 0.0)
-            d2 = np.where(c > 0, -span * d2w, span * d2w)
+            d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)
+            d2[on] = np.where(c > 0, -so * d2w, so * d2w)
         return dt, dtdu, d2
 
     def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False):
@@ -155,6 +156,13 @@ class PanelSet:
             er[mask] = e_r
         sg = self.sign[panel]
         return sg * self.anchor_x[panel] + (sg - 1.0) * self.offset, self.anchor_r[panel], ex, er
+
+    @cached_property
+    def tiny_panels(self) -> np.ndarray:
+        """Panels shorter than 1e-4 of their distance from the computational origin (deep
+        grading at a corner): there coordinate differences lose digits."""
+        size = np.abs(self.anchor_x) + np.abs(self.anchor_r) + abs(self.offset) * (self.sign < 0)
+        return self.lengths < 1e-4 * size
 
     @cached_property
     def node_split(self):
