@@ -137,6 +137,14 @@ class PanelSet:
             out += [sg * (ddx * half * half + dx * d2t), ddr * half * half + dr * d2t]
         return tuple(out)
 
+    def _by_segment(self, panel: np.ndarray):
+        """(segment, mask into ``panel``, the panels of that segment) for each segment used."""
+        seg_of = self.segment_index[panel]
+        for s, seg in enumerate(self.segments):
+            mask = seg_of == s
+            if mask.any():
+                yield seg, mask, panel[mask]
+
     def split(self, panel: np.ndarray, u: np.ndarray):
         """Points as (anchor + offset) in the computational frame: returns (ax, ar, ex, er)
         with x = ax + ex, r = ar + er.  Differences between points near one anchor (a
@@ -144,12 +152,7 @@ class PanelSet:
         panel, u = np.broadcast_arrays(np.asarray(panel), np.asarray(u, dtype=float))
         ex = np.empty(u.shape)
         er = np.empty(u.shape)
-        seg_of = self.segment_index[panel]
-        for s, seg in enumerate(self.segments):
-            mask = seg_of == s
-            if not mask.any():
-                continue
-            pk = panel[mask]
+        for seg, mask, pk in self._by_segment(panel):
             dt = self._param(pk, u[mask])[0]
             e_x, e_r = seg.displacement(self.base[pk], dt)
             ex[mask] = self.sign[pk] * e_x
@@ -178,12 +181,7 @@ class PanelSet:
         panel, u_from, u_to = np.broadcast_arrays(np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float))
         dx = np.empty(u_from.shape)
         dr = np.empty(u_from.shape)
-        seg_of = self.segment_index[panel]
-        for s, seg in enumerate(self.segments):
-            mask = seg_of == s
-            if not mask.any():
-                continue
-            pk = panel[mask]
+        for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
             t_from = self.base[pk] + self.da[pk] + half * (u_from[mask] + 1.0)
             step = half * (u_to[mask] - u_from[mask])  # exact for plain panels
