@@ -612,11 +612,12 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         arc = _segment_arc_length(seg, seg.t0, t1)
         if arc <= 0:
             continue
-        # next to a corner whose s^1 term is not polynomial in the substituted panel (q not an
-        # integer: cone shoulder, table shoulder), three times the panels (measured on the 30 deg
-        # cone at depth: identity error 1.8e-6 -> 7e-7 for 32 more unknowns)
+        # a straight segment next to a corner whose s^1 term is not polynomial in the substituted
+        # panel (q not an integer: a cone's shoulder): three times the panels (measured on the
+        # 30 deg cone at depth: identity error 1.8e-6 -> 7e-7 for 32 more unknowns; on curved
+        # segments the gain does not pay for its cost)
         ends = [turning[k - 1] if k > 0 else 0.0, turning[k] if k < len(segs) - 1 else _shoulder_turning(nose)]
-        rough = any(abs(corner_power(a) - round(corner_power(a))) > 1e-9 for a in ends)
+        rough = isinstance(seg, Line) and any(abs(corner_power(a) - round(corner_power(a))) > 1e-9 for a in ends)
         n = _count(arc, scale, ref, 4.8 if rough else 1.6, minimum=1 if isinstance(seg, SplineCurve) else 2)
         if isinstance(seg, SplineCurve):
             n = max(n, int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) + 1)
