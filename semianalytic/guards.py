@@ -117,10 +117,12 @@ def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_de
 
     estimate = _estimated_nose_panels(nose, refinement, levels)
     if estimate > EXACT_PLAN_PANELS:
-        length = (max_depth_nose_lengths - 1) * nose.length
+        length = (max_depth_nose_lengths - 1) * max(nose.length, nose.radius)
         shank = levels + max(0.0, math.log2(max(length / nose.radius, 1.0)) * refinement) + 2
         return order * (estimate + shank)
-    layout = halfspace_layout(nose, max_depth_nose_lengths * nose.length, LayoutOptions(order, refinement, levels))
+    # the tables' depth unit: L_h, or the radius for a flat nose (L_h = 0)
+    scale = nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    layout = halfspace_layout(nose, max_depth_nose_lengths * scale, LayoutOptions(order, refinement, levels))
     return float(order * sum(len(p.panels) for p in layout.pieces))
 
 

@@ -73,7 +73,7 @@ def test_coefficients_penetrate_run_sweep(name, env, capsys):
     capsys.readouterr()
     assert _all_finite(json.loads((out / "results.json").read_text()))
     sw = env / f"sweep_{name}"
-    assert main(["sweep", case, "--out", str(sw), "--vary", "impact.striking_velocity=0.5,0.9",
+    assert main(["sweep", case, "--out", str(sw), "--vary", "impact.striking_velocity=500 m/s,900 m/s",
                  "--scheduler", "inline", "--no-progress", "--json"]) == 0
     capsys.readouterr()
     rows = [ln.split(",") for ln in next(sw.glob("*.csv")).read_text().splitlines() if ln and not ln.startswith("#")]

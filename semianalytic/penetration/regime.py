@@ -180,7 +180,7 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
                            density: float, target_density: float, target_resistance: float, rod_strength: float,
                            mass: float | None = None) -> float:
     """U_e [m/s]: the lowest U_s >= U_y at which the eroding rod is consumed down to its nose
-    length (module docstring).  NaN if U_y is NaN (no yielding predicted)."""
+    length, or to its radius where the nose is shorter (module docstring).  NaN if U_y is NaN (no yielding predicted)."""
     _check_strengths(target_resistance, rod_strength, target_density, density)
     if not math.isfinite(yield_velocity):
         return math.nan
@@ -188,9 +188,12 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
     rho_p, Y_p, rho_t, R_t = density, rod_strength, target_density, target_resistance
     v_e = _erosion_end(rho_p, Y_p, rho_t, R_t)
     # L_r(U) = L0 exp(-k I(U)) = l_n  <=>  I(U) = ln(L0 / l_n) / k, I increasing
-    target = math.log(L0 / nose_length) * Y_p / rho_p if nose_length > 0 else math.inf
-    if not math.isfinite(target):
+    # a nose shorter than the radius (flat, blunted) counts as one radius long: the rod has lost
+    # its nose region once consumed to within a radius of its end (sphere and ogives unchanged)
+    l_n = max(nose_length, 0.5 * diameter)
+    if not l_n < L0:
         return math.inf
+    target = math.log(L0 / l_n) * Y_p / rho_p
     v_hi = max(2.0 * v_e, 4000.0)
     while True:
         q = _Quadrature(v_e, v_hi, rho_p, Y_p, rho_t, R_t, n_grid=512)
