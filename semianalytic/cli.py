@@ -25,6 +25,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "nanostrength": ("semianalytic.nanostrength.cli", "theoretical strength of diamond-like nanoparticles (Part III)"),
     "run": ("semianalytic.run.cli", "run everything a case asks for and write a report"),
     "sweep": ("semianalytic.sweep.cli", "parallel parameter sweeps and Monte-Carlo studies"),
+    "optimize": ("semianalytic.optimize.cli", "nose-shape optimisation with the BEM in the loop (depth or deep drag)"),
     "demo": ("semianalytic.demo", "run the main job on a bundled case and say where its report is"),
 }
 

@@ -257,7 +257,27 @@ def _clear_results(out: Path) -> None:
             p.unlink()
 
 
-def _connect(scheduler: str | None, workers: int):
+# Engine choice (issue 14): a LocalCluster costs about LOCAL_START_SECONDS to start and warm
+# up (reports/bench_sweep.md), so it pays only for work well above that; one BEM table costs
+# about GEOMETRY_SECONDS, a cheap (vectorised) case microseconds.
+LOCAL_START_SECONDS = 4.0
+GEOMETRY_SECONDS = 1.0
+
+
+def choose_engine(scheduler: str | None, n_cases: int, n_geometries: int, seconds_per_case: float = 0.0,
+                  workers: int = 2) -> str:
+    """The engine of a sweep: the ``scheduler`` given (``inline``, ``local`` or an address), else
+    ``inline`` when the work is cheap (velocity and material sweeps on one table: microseconds
+    per case) and ``local`` when it is not (a geometry sweep builds one BEM table per design)."""
+    if scheduler:
+        return scheduler.strip()
+    if workers < 2:
+        return "inline"
+    work = max(n_geometries - 1, 0) * GEOMETRY_SECONDS + n_cases * seconds_per_case
+    return "local" if work > 2.0 * LOCAL_START_SECONDS else "inline"
+
+
+def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address (InputError if it cannot be used)."""
     sched = (scheduler or "local").strip()
@@ -280,6 +300,9 @@ def _connect(scheduler: str | None, workers: int):
             client.close()
         raise InputError("--scheduler", f"cannot use the dask scheduler {sched!r}: {exc}") from None
     return client, None, sched
+
+
+_connect = connect  # old name
 
 
 def run_sweep(
@@ -327,7 +350,9 @@ def run_sweep(
     summary = SweepSummary(out, store.path, spec.n_cases, len(done), len(pending))
     draws = spec.draws() if spec.samplers else {}
     t_prep = time.perf_counter()
-    client, cluster, summary.scheduler = _connect(scheduler, workers) if len(pending) else (None, None, "none")
+    rcases = _resource_cases(case, spec, kernel, pending, draws) if len(pending) else {}
+    engine = choose_engine(scheduler, len(pending), len(rcases), getattr(kernel, "seconds_per_case", 0.0), workers)
+    client, cluster, summary.scheduler = connect(engine, workers) if len(pending) else (None, None, "none")
     try:
         # from here on the folder is written
         if fresh and force:
@@ -338,7 +363,6 @@ def run_sweep(
         if len(pending) == 0:
             return summary
         # shared resources (coefficient tables), one per geometry
-        rcases = _resource_cases(case, spec, kernel, pending, draws)
         if len(rcases) > 20:
             print(f"warning: {len(rcases)} distinct nose geometries: each needs its own BEM coefficient table "
                   "(seconds each, cached on disk)", file=sys.stderr)
