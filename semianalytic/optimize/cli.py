@@ -30,7 +30,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")
     parser.add_argument("--popsize", type=int, default=5, help="differential evolution: population per variable (default 5)")
     parser.add_argument("--maxiter", type=int, default=12, help="differential evolution: generations (default 12)")
-    parser.add_argument("--tol", type=float, default=1e-3, help="differential evolution: relative tolerance (default 1e-3)")
+    parser.add_argument("--tol", type=float, default=1e-5, help="differential evolution: relative tolerance of the population's objectives (default 1e-5)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--resolution", type=float, default=1e-3, help="designs rounded to this fraction of each range")
     parser.add_argument("--confirm", type=int, default=5, help="confirmation grid: points per variable (0: none)")

@@ -150,7 +150,7 @@ def optimise(
     cache_dir: str | None = None,
     popsize: int = 5,
     maxiter: int = 12,
-    tol: float = 1e-3,
+    tol: float = 1e-5,
     seed: int = 0,
     resolution: float = 1e-3,
     confirm: int = 5,

@@ -39,6 +39,10 @@ _GEOMETRY_PREFIXES = (
 )
 
 
+# keys a penetration kernel evaluates on arrays (Monte Carlo): the resistance fields, the densities, the mass
+_ARRAY_PREFIXES = ("target.resistance.", "target.density", "projectile.density", "projectile.mass")
+
+
 def geometry_key(case: Case) -> str:
     """A content key of everything the coefficient table depends on."""
     p = case.require("projectile")
@@ -74,6 +78,7 @@ class PenetrationKernel:
     cache_dir: str | None = None
     coefficients: Any = None  # a fixed DragCoefficients (e.g. ConstantCoefficients) instead of the BEM table
     full: bool = False
+    vectorised: bool = True  # Monte-Carlo samples on arrays (False: each sample validated as its own case)
     name: str = "penetration"
     fast_keys: frozenset = frozenset({VELOCITY_KEY})
     # per-process cache of unit-resistance depth profiles (see _rigid); not part of the identity
@@ -98,6 +103,81 @@ class PenetrationKernel:
 
     def check_fast(self, key: str, values: np.ndarray) -> None:
         _check_velocities(np.asarray(values, float))
+
+    # keys evaluated on arrays (Monte Carlo, issue 14): the case is validated once per batch at the
+    # corners of the sampled ranges, then each sample only changes R_t, rho, m and U_s
+    def is_array_key(self, key: str) -> bool:
+        if self.full or not self.vectorised:
+            return False
+        return key.startswith(_ARRAY_PREFIXES) and key.count(".") == (2 if key.startswith("target.resistance.") else 1)
+
+    def evaluate_arrays(self, case: Case, coefficients, arrays: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Rigid depth, U_sC and the yield flag per sample (see :func:`semianalytic.penetration.batch.final_depths`).
+
+        R_t per sample from the case's resistance model with the sampled fields replaced (its
+        closed form: eqs. (16)-(19), Part IV eq. (6)); rho, m per sample; one table for all."""
+        import dataclasses
+
+        from semianalytic.geometry import projectile_from_section
+        from semianalytic.penetration import critical as crit
+        from semianalytic.penetration.batch import final_depths
+        from semianalytic.penetration.curve import PenetrationSetup
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        U = np.asarray(arrays[VELOCITY_KEY], float)
+        n = U.size
+        psec = case.require("projectile")
+        status = np.full(n, "ok", dtype=object)
+        message = np.full(n, "", dtype=object)
+        base = resistance_from_case(case)
+        res_fields = {k.rsplit(".", 1)[1]: np.asarray(v, float) for k, v in arrays.items() if k.startswith("target.resistance.")}
+        if res_fields:
+            R = np.empty(n)
+            model, kw = type(base), {f.name: getattr(base, f.name) for f in dataclasses.fields(base)}
+            cols = {f: v.tolist() for f, v in res_fields.items()}
+            for i in range(n):
+                try:
+                    for f, v in cols.items():
+                        kw[f] = v[i]
+                    R[i] = model(**kw).pressure(psec.diameter)
+                except (ValueError, ArithmeticError, InputError) as exc:
+                    R[i], status[i], message[i] = np.nan, "invalid", f"target.resistance: {exc}"
+        else:
+            R = np.full(n, float(base.pressure(psec.diameter)))
+        rho = np.broadcast_to(np.asarray(arrays.get("target.density", case.require("target").density), float), (n,))
+        proj = projectile_from_section(psec)
+        rho_p = None
+        if "projectile.mass" in arrays:
+            m = np.asarray(arrays["projectile.mass"], float)
+        elif "projectile.density" in arrays and psec.mass is None:
+            rho_p = np.asarray(arrays["projectile.density"], float)
+            m = rho_p * proj.volume()
+        else:
+            m = np.full(n, proj.mass)
+        m = np.broadcast_to(m, (n,))
+        bad = ~(np.isfinite(R) & (R > 0) & (U > 0))
+        status[bad & (status == "ok")] = "invalid"
+        message[bad & (message == "")] = "R_t and U_s must be positive"
+        ok = ~bad
+        depth = np.full(n, np.nan)
+        if ok.any():
+            depth[ok] = final_depths(coefficients, m[ok], rho[ok], R[ok], U[ok])
+        setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+        Usc = np.full(n, np.nan)
+        if setup.rod is not None and setup.yield_stress is not None:
+            ci = setup.critical_inputs()
+            dens = np.full(n, ci.density) if rho_p is None else rho_p
+            Rl, rl, ml, dl = R.tolist(), rho.tolist(), m.tolist(), dens.tolist()
+            for i in np.flatnonzero(ok).tolist():
+                c = crit.CriticalInputs(ci.youngs_modulus, dl[i], ml[i], ci.diameter, ci.A, ci.B, ci.C, rl[i], Rl[i])
+                Usc[i] = crit.critical_velocity(setup.yield_stress, c, setup.phi)
+        return {
+            "depth_rigid_m": depth,
+            "critical_velocity_m_s": Usc,
+            "yields": np.where(np.isfinite(Usc), U >= Usc, False),
+            "_status": status,
+            "_message": message,
+        }
 
     def affects_resource(self, key: str) -> bool:
         return self.coefficients is None and key.startswith(_GEOMETRY_PREFIXES)
@@ -179,6 +259,9 @@ class CavityKernel:
 
     def check_fast(self, key, values):  # no fast keys
         pass
+
+    def is_array_key(self, key: str) -> bool:
+        return False
 
     def affects_resource(self, key: str) -> bool:
         return False
