@@ -171,10 +171,10 @@ def _ranges_valid(payload: Payload, values: Mapping[str, np.ndarray], keys: list
     for corner in itertools.product(*ends):
         over = {k: raw_value(v, units[k], k in integer) for k, v in zip(keys, corner)}
         try:
-            _parse_cached(payload.raw_json, json.dumps(over, sort_keys=True), payload.case_path)
+            case = _parse_cached(payload.raw_json, json.dumps(over, sort_keys=True), payload.case_path)
         except InputError:
             return False
-    return True
+    return payload.kernel.accepts_arrays(case, keys)
 
 
 def _evaluate_arrays(payload: Payload, ids: np.ndarray, values, slow: list[str], vector: list[str]) -> list[dict]:

@@ -111,6 +111,23 @@ class PenetrationKernel:
             return False
         return key.startswith(_ARRAY_PREFIXES) and key.count(".") == (2 if key.startswith("target.resistance.") else 1)
 
+    def accepts_arrays(self, case: Case, keys) -> bool:
+        """The sampled resistance fields are fields of the case's resistance model (not the cavity
+        model's nested material, whose R_t is a Part II solve per sample)."""
+        import dataclasses
+
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        res = [k.rsplit(".", 1)[1] for k in keys if k.startswith("target.resistance.")]
+        if not res:
+            return True
+        try:
+            model = resistance_from_case(case)
+        except InputError:
+            return False
+        names = {f.name for f in dataclasses.fields(model)}
+        return all(f in names for f in res)
+
     def evaluate_arrays(self, case: Case, coefficients, arrays: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Rigid depth, U_sC and the yield flag per sample (see :func:`semianalytic.penetration.batch.final_depths`).
 
@@ -261,6 +278,9 @@ class CavityKernel:
         pass
 
     def is_array_key(self, key: str) -> bool:
+        return False
+
+    def accepts_arrays(self, case: Case, keys) -> bool:
         return False
 
     def affects_resource(self, key: str) -> bool:
