@@ -133,3 +133,30 @@ def test_unreachable_scheduler(case_file, tmp_path, capsys):
                "--scheduler", "tcp://127.0.0.1:9", "--no-progress"])
     assert rc == 2 and "error: --scheduler" in capsys.readouterr().err
     assert not (tmp_path / "o").exists()
+
+
+def test_deep_drag_of_a_cone_and_the_exact_rod_depth(tmp_path, monkeypatch):
+    # a cone's deep drag over its half angle, and an ogive's exact-rod depth: the optimum is the
+    # best design the search evaluated, and a sharper cone has the smaller Bbar (the BEM's deep
+    # limit decreases with the half angle; the grid spans 15-40 deg, far apart against the
+    # coarse table's error)
+    from semianalytic.case import load_case
+    from semianalytic.optimize.case import build_problem
+    from semianalytic.optimize.evaluate import optimise
+
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
+    p = tmp_path / "cone.toml"
+    p.write_text(CASE.format(shank="59.3 mm").replace('nose = "ogive"\ncrh = 3.0', 'nose = "cone"\nhalf_angle = "20 deg"'))
+    problem = build_problem(load_case(p), ["projectile.half_angle=15 deg:40 deg"], "deep_drag", ["caliber"])
+    res = optimise(problem, popsize=2, maxiter=1, confirm=0, classic_noses=False)
+    ok = [r for r in res["history"] if r["status"] == "ok" and r["phase"] in ("search", "start")]
+    assert res["optimum"]["objective"] <= min(r["objective"] for r in ok) + 1e-15
+    by_angle = sorted((r["x"][0], r["objective"]) for r in ok if "x" in r)
+    assert by_angle[0][1] < by_angle[-1][1]
+    q = tmp_path / "ogive.toml"
+    q.write_text(CASE.format(shank="59.3 mm"))
+    problem = build_problem(load_case(q), ["projectile.crh=2:4"], "depth", ["length"], depth_model="exact-rod")
+    res = optimise(problem, popsize=2, maxiter=1, confirm=0, classic_noses=False)
+    assert res["optimum"]["status"] == "ok" and len(res["optimum"]["depths_m"]) == 2
+    assert all(math.isclose(r["length_m"], res["fixed_length_m"], rel_tol=1e-12)
+               for r in res["history"] if r["status"] == "ok" and r["phase"] != "classic")

@@ -155,6 +155,7 @@ def optimise(
     resolution: float = 1e-3,
     confirm: int = 5,
     confirm_half_width: float = 0.04,
+    classic_noses: bool = True,
     on_done: Callable[[int], None] | None = None,
 ) -> dict:
     """Differential evolution over the problem's bounds, then the confirmation grid and the
@@ -210,9 +211,9 @@ def optimise(
             "points": [{"x": p.tolist(), "objective": float(fi), "status": r["status"]} for p, fi, r in zip(pts, f, recs)],
         }
     classic = {}
-    recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
-    for name, r in zip(CLASSIC_NOSES, recs):
-        classic[name] = r
+    if classic_noses:
+        recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
+        classic = dict(zip(CLASSIC_NOSES, recs))
     return {
         "variables": [{"key": v.key, "low": v.low, "high": v.high, "unit": v.unit} for v in problem.variables],
         "objective": problem.objective,
