@@ -20,7 +20,18 @@ def _shown(var: dict, value: float) -> str:
 def _design_text(result: dict, rec: dict) -> str:
     if "x" in rec:
         return ", ".join(f"{v['key'].split('.', 1)[1]} = {_shown(v, x)}" for v, x in zip(result["variables"], rec["x"]))
-    return ", ".join(f"{k.split('.', 1)[1]} = {v}" for k, v in rec["overrides"].items())
+    return ", ".join(f"{k.split('.', 1)[1]} = {_short(v)}" for k, v in rec["overrides"].items())
+
+
+def _short(v) -> str:
+    """A case-file value shown with 4 significant digits ("16.7786548 deg" -> "16.78 deg")."""
+    if isinstance(v, float):
+        return f"{v:.4g}"
+    head, _, unit = str(v).partition(" ")
+    try:
+        return f"{float(head):.4g} {unit}".strip()
+    except ValueError:
+        return str(v)
 
 
 def _value_text(result: dict, rec: dict | None) -> str:
@@ -50,7 +61,7 @@ def noses_figure(result: dict):
     """The best nose against the starting one and the classic noses, each labelled with its objective."""
     from matplotlib.figure import Figure
 
-    fig = Figure(figsize=(7.0, 4.2), layout="constrained")
+    fig = Figure(figsize=(7.0, 4.6), layout="constrained")
     ax = fig.add_subplot()
     curves = [("optimum", result["optimum"], dict(color="C3", lw=2.4))]
     if result.get("start"):
@@ -67,7 +78,7 @@ def noses_figure(result: dict):
     ax.set_aspect("equal")
     ax.set_xlabel("x from the tip [mm]")
     ax.set_ylabel("r [mm]")
-    ax.legend(fontsize=7, loc="center left", bbox_to_anchor=(1.0, 0.5))
+    ax.legend(fontsize=7, loc="upper center", bbox_to_anchor=(0.5, -0.2), ncol=2)
     ax.set_title("best nose against the start and the classic noses", fontsize=9)
     return fig
 
@@ -96,6 +107,13 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
     for name, rec in result["classic"].items():
         rows.append([name, _design_text(result, rec), _value_text(result, rec)])
     doc.table(["design", "parameters", "objective"], rows)
+    for v, x in zip(result["variables"], result["optimum"].get("x", [])):
+        side = "upper" if x >= v["high"] - 0.01 * (v["high"] - v["low"]) else (
+            "lower" if x <= v["low"] + 0.01 * (v["high"] - v["low"]) else None)
+        if side:
+            doc.note(f"The optimum of {v['key']} lies on its {side} bound ({_shown(v, x)}): within these bounds and "
+                     "constraints the objective still improves towards it; the bound, not the physics of the model, "
+                     "stops the search. Widen it or add a constraint to find where the improvement ends.")
     if result["objective"] == "depth" and result["optimum"].get("depths_m"):
         vel = result["striking_velocities_m_s"]
         hdr = ["U_s [m/s]", "optimum [mm]"] + (["start [mm]"] if result.get("start") else []) + list(result["classic"])
