@@ -18,7 +18,24 @@ import numpy as np
 
 from semianalytic.penetration.motion import _NODES, _Q, _X, ConstantCoefficientSolution, _panels, deep_coefficients
 
-__all__ = ["final_depths"]
+__all__ = ["final_depths", "chebyshev_weights"]
+
+
+def chebyshev_weights(x, lo: float, hi: float, n: int):
+    """(nodes, W): the n Chebyshev-Lobatto points of [lo, hi] and the barycentric interpolation
+    weights W (len(x), n), so that f(x) ~ W @ f(nodes) for f smooth on [lo, hi]."""
+    x = np.asarray(x, float)
+    j = np.arange(n)
+    nodes = lo + 0.5 * (hi - lo) * (np.cos(np.pi * j / (n - 1)) + 1.0)
+    bw = (-1.0) ** j
+    bw[0] *= 0.5
+    bw[-1] *= 0.5
+    with np.errstate(divide="ignore", invalid="ignore"):
+        c = bw[None, :] / (x[:, None] - nodes[None, :])
+    hit = ~np.isfinite(c)
+    rows = hit.any(axis=1)
+    c[rows] = hit[rows].astype(float)
+    return nodes, c / c.sum(axis=1, keepdims=True)
 
 
 def final_depths(coefficients, mass, target_density, resistance_pa, U0, *, n_ratio: int = 8) -> np.ndarray:
@@ -39,18 +56,7 @@ def final_depths(coefficients, mass, target_density, resistance_pa, U0, *, n_rat
         r_k = uniq
         W = (r[:, None] == r_k[None, :]).astype(float)
     else:
-        lo, hi = r.min(), r.max()
-        j = np.arange(n_ratio)
-        x_k = np.cos(np.pi * j / (n_ratio - 1))  # Chebyshev-Lobatto points, barycentric weights (-1)^j / 2 at the ends
-        r_k = lo + 0.5 * (hi - lo) * (x_k + 1.0)
-        bw = (-1.0) ** j
-        bw[0] *= 0.5
-        bw[-1] *= 0.5
-        with np.errstate(divide="ignore", invalid="ignore"):
-            c = bw[None, :] / (r[:, None] - r_k[None, :])
-        hit = ~np.isfinite(c)
-        c[hit.any(axis=1)] = hit[hit.any(axis=1)].astype(float)
-        W = c / c.sum(axis=1, keepdims=True)
+        r_k, W = chebyshev_weights(r, float(r.min()), float(r.max()), n_ratio)
     P, F_k, G_k = _profiles(coefficients, r_k, g_max=g.max())
     A = np.asarray(coefficients.A(P), float)
     C = np.asarray(coefficients.C(P), float)
