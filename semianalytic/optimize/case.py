@@ -176,6 +176,12 @@ def build_problem(
             raise InputError(v.flag, f"applies to a {' or '.join(kinds)} nose; the case's nose is {psec.nose!r}")
         if kinds is None and name not in ProjectileSection.model_fields:
             raise InputError(v.flag, f"this version's [projectile] has no {name!r} key")
+        if name == "meplat_diameter" and not v.high < psec.diameter:
+            raise InputError(v.flag, f"the meplat must be smaller than the diameter {psec.diameter * 1e3:g} mm; "
+                                     f"got HIGH = {v.high * 1e3:g} mm")
+        if name == "tip_radius" and not v.high < 0.5 * psec.diameter:
+            raise InputError(v.flag, f"the tip radius must be below d/2 = {psec.diameter * 500:g} mm; "
+                                     f"got HIGH = {v.high * 1e3:g} mm")
     for c in constraints:
         if c not in CONSTRAINTS:
             raise InputError("--constraint", f"must be one of {', '.join(CONSTRAINTS)}; got {c!r}")
@@ -224,6 +230,7 @@ def check_bounds(problem: Problem) -> None:
             shown = ", ".join(f"{v.key.split('.', 1)[1]} = {xi:g} {v.unit}".rstrip() for v, xi in zip(problem.variables, x))
             raise InputError(f"--constraint {exc.constraint}", f"cannot be met at the bounds' corner {shown}: {exc}") from None
         except InputError as exc:
-            var = next((v for v in problem.variables if v.key == exc.field), problem.variables[0])
+            var = next((v for v in problem.variables if v.key == exc.field or str(exc.field).endswith(v.key.split(".")[-1])),
+                       problem.variables[0])
             lo, hi = (f"{b:g} {var.unit}".strip() for b in (var.low, var.high))
             raise InputError(var.flag, f"bounds {lo}:{hi} outside the nose's validity: {exc}") from None

@@ -32,6 +32,8 @@ _GEOMETRY_PREFIXES = (
     "projectile.diameter",
     "projectile.half_angle",
     "projectile.corner_radius",
+    "projectile.meplat_diameter",
+    "projectile.tip_radius",
     "projectile.points",
     "bem.",
     "coefficients.depths",
@@ -46,7 +48,8 @@ _ARRAY_PREFIXES = ("target.resistance.", "target.density", "projectile.density",
 def geometry_key(case: Case) -> str:
     """A content key of everything the coefficient table depends on."""
     p = case.require("projectile")
-    nose = {k: getattr(p, k) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius")}
+    nose = {k: getattr(p, k, None) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius", "meplat_diameter",
+                                             "tip_radius")}
     nose["points"] = p.points_si() if p.points else None
     opts = {
         "order": case.bem.order,
