@@ -88,6 +88,11 @@ class PenetrationKernel:
     _profiles: dict = field(default_factory=dict, compare=False, repr=False)
 
     @property
+    def seconds_per_case(self) -> float:
+        """Rough cost of a case for the engine choice: microseconds on arrays, more with ``full``."""
+        return 2e-3 if self.full else 0.0
+
+    @property
     def columns(self) -> tuple[str, ...]:
         cols = ("depth_rigid_m", "critical_velocity_m_s", "yields")
         if self.full:
@@ -312,6 +317,7 @@ class CavityKernel:
 
     name: str = "cavity"
     fast_keys: frozenset = frozenset()
+    seconds_per_case: float = 2e-3  # one Part II solve, plus validating its case (engine choice)
     columns: tuple[str, ...] = (
         "cavity_pressure_Pa", "sigma_star_Pa", "theta_star", "theta_k", "a_over_b", "c_over_b",
     )
