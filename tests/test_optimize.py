@@ -107,6 +107,8 @@ def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys):
         (["--vary", "projectile.crh=1:4", "--objective", "deep_drag", "--constraint", "mass"], "--constraint"),
         (["--vary", "projectile.crh=1:4", "--objective", "speed"], "--objective"),
         (["--vary", "projectile.crh=1:12", "--constraint", "mass"], "--constraint mass"),
+        (["--vary", "projectile.crh=1:4", "--vary", "projectile.meplat_diameter=0 mm:7.11 mm"], "--vary projectile.meplat_diameter"),
+        (["--vary", "projectile.tip_radius=0 mm:9 mm"], "--vary projectile.tip_radius"),
     ],
 )
 def test_bad_input_exits_2_naming_the_flag(tmp_path, monkeypatch, capsys, args, flag):
