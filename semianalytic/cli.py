@@ -29,6 +29,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "run": ("semianalytic.run.cli", "run everything a case asks for and write a report"),
     "calibrate": ("semianalytic.calibration.cli", "Bayesian calibration of target parameters on measured depths, predictive intervals, cross-validation"),
     "sweep": ("semianalytic.sweep.cli", "parallel parameter sweeps and Monte-Carlo studies"),
+    "optimize": ("semianalytic.optimize.cli", "nose-shape optimisation with the BEM in the loop (depth or deep drag)"),
     "demo": ("semianalytic.demo", "run the main job on a bundled case and say where its report is"),
 }
 

@@ -43,8 +43,6 @@ from dataclasses import dataclass, replace
 from typing import Literal
 
 import numpy as np
-from scipy.integrate import quad
-from scipy.optimize import brentq
 
 from semianalytic.nanostrength.crystal import Crystal
 
@@ -113,6 +111,7 @@ class _Law:
                 continue
             k = bad[0]
             lo = 0.0 if k == 0 else e[k - 1]
+            from scipy.optimize import brentq  # imported when needed (start-up time)
             root = brentq(lambda x: float(self.stress_slope(x)), lo, e[k], xtol=1e-14, rtol=1e-13)
             out.append((abs(float(self.stress(root))), abs(root)))
         (st, et), (sc, ec) = out
@@ -126,6 +125,7 @@ class _Law:
         """int_{d_0}^{d_0 (1+e)} sigma(u) du [J/m^2], by quadrature of the stress: Part III,
         eq. (15) with d_max = d_0 (1 + e).  Equals :meth:`deformation_energy` for the
         reference measure; for the current one it differs by the weight d_0/d."""
+        from scipy.integrate import quad  # imported when needed (start-up time)
         val, _ = quad(lambda x: float(self.stress(x)), 0.0, e, epsabs=0.0, epsrel=1e-12, limit=200)
         return val * self.d0
 
@@ -254,6 +254,7 @@ def _calibrate_side(crystal: Crystal, x: float, sigma: float, measure: Measure) 
     for branch in (0, 1):
         f = np.array([residual(p, branch) for p in ps])
         for j in np.nonzero(np.isfinite(f[:-1]) & np.isfinite(f[1:]) & (np.sign(f[:-1]) != np.sign(f[1:])))[0]:
+            from scipy.optimize import brentq  # imported when needed (start-up time)
             p = brentq(residual, ps[j], ps[j + 1], args=(branch,), xtol=1e-14, rtol=1e-14)
             A = _peak_amplitudes(K, p, x, measure)[branch]
             out.append((A / abs(x) ** p, p))
@@ -304,6 +305,7 @@ def calibrate_uber(crystal: Crystal, measure: Measure = "current") -> UberLaw:
 
         if not f(1e-6) < 0 < f(1e3):
             raise CalibrationError(crystal.name, "the universal binding-energy relation cannot reach this tensile strength")
+        from scipy.optimize import brentq  # imported when needed (start-up time)
         lam = brentq(f, 1e-6, 1e3, xtol=1e-15, rtol=1e-14)
     phi_b = E * crystal.d0 * lam**2
     return UberLaw(phi_b, crystal.d0, lam * crystal.d0, measure)

@@ -42,8 +42,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="penetration: also quasi-rigid and elastic depths (slower, case by case)")
     parser.add_argument("--format", dest="fmt", choices=["csv", "parquet"], default="csv")
     parser.add_argument("--scheduler", default=None,
-                        help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process; "
-                             "default: a local cluster")
+                        help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process, 'local' "
+                             "starts a local cluster; default: chosen from the work (inline for cheap cases, "
+                             "a local cluster for geometry sweeps)")
     parser.add_argument("--workers", type=integer(1, 256), default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--batch-size", type=integer(1, 10_000_000), default=None, help="cases per task (default: automatic)")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")

@@ -114,6 +114,9 @@ def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
     columns = spec.columns
     slow = [k for k in spec.keys if k not in kernel.fast_keys]
     fast = [k for k in spec.keys if k in kernel.fast_keys]
+    arrays = [k for k in slow if getattr(kernel, "is_array_key", lambda _: False)(k)]
+    if arrays and _ranges_valid(payload, values, arrays):
+        return _evaluate_arrays(payload, ids, values, [k for k in slow if k not in arrays], fast + arrays)
 
     groups: dict[tuple, list[int]] = defaultdict(list)
     for j in range(len(ids)):
@@ -154,6 +157,59 @@ def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
         for j, r in zip(idx, base_rows):
             rows[j] = r
     return rows  # type: ignore[return-value]
+
+
+def _ranges_valid(payload: Payload, values: Mapping[str, np.ndarray], keys: list[str]) -> bool:
+    """Monte Carlo: the case with each sampled field at the ends of its range in this batch (every
+    corner of the box) is valid.  The fields' validity is a range (bounds, and monotone
+    conditions like eq. (16)'s E > 3 Y (1 - nu)), so then every sample in the box is valid;
+    otherwise the batch goes case by case (each invalid sample reported)."""
+    import itertools
+
+    units, integer = payload.spec.units(), payload.spec.integer_keys()
+    ends = [(float(np.min(values[k])), float(np.max(values[k]))) for k in keys]
+    for corner in itertools.product(*ends):
+        over = {k: raw_value(v, units[k], k in integer) for k, v in zip(keys, corner)}
+        try:
+            case = _parse_cached(payload.raw_json, json.dumps(over, sort_keys=True), payload.case_path)
+        except InputError:
+            return False
+    return payload.kernel.accepts_arrays(case, keys)
+
+
+def _evaluate_arrays(payload: Payload, ids: np.ndarray, values, slow: list[str], vector: list[str]) -> list[dict]:
+    """Rows of a batch whose sampled fields are evaluated on arrays (kernel.evaluate_arrays): one
+    validated case per combination of the remaining slow (grid) keys."""
+    spec, kernel = payload.spec, payload.kernel
+    units, integer, columns = spec.units(), spec.integer_keys(), spec.columns
+    groups: dict[tuple, list[int]] = defaultdict(list)
+    for j in range(len(ids)):
+        groups[tuple(float(values[k][j]) for k in slow)].append(j)
+    out_rows: list[dict] = [None] * len(ids)  # type: ignore[list-item]
+    names = list(kernel.columns)
+    for gvals, idx in groups.items():
+        idx = np.asarray(idx)
+        overrides = {k: raw_value(v, units[k], k in integer) for k, v in zip(slow, gvals)}
+        inputs = {columns[k]: values[k][idx] for k in spec.keys}
+        try:
+            case = _parse_cached(payload.raw_json, json.dumps(overrides, sort_keys=True), payload.case_path)
+            resource = payload.resources.get(kernel.resource_key(case))
+            if resource is None:
+                resource = kernel.prepare(case)
+            res = kernel.evaluate_arrays(case, resource, {k: values[k][idx] for k in vector})
+            status, message = res["_status"], res["_message"]
+        except InputError as exc:
+            res = {c: np.full(len(idx), np.nan) for c in names}
+            status, message = np.full(len(idx), "invalid", object), np.full(len(idx), str(exc), object)
+        cols = {c: np.asarray(res[c]).tolist() for c in names}
+        ins = {c: v.tolist() for c, v in inputs.items()}
+        st, msg = status.tolist(), message.tolist()
+        for n, j in enumerate(idx.tolist()):
+            row = {"case_id": int(ids[j]), **{c: v[n] for c, v in ins.items()}, "status": st[n], "message": msg[n]}
+            for c in names:
+                row[c] = cols[c][n]
+            out_rows[j] = row
+    return out_rows
 
 
 def warm_up() -> bool:
@@ -257,7 +313,27 @@ def _clear_results(out: Path) -> None:
             p.unlink()
 
 
-def _connect(scheduler: str | None, workers: int):
+# Engine choice (issue 14): a LocalCluster costs about LOCAL_START_SECONDS to start and warm
+# up (reports/bench_sweep.md), so it pays only for work well above that; one BEM table costs
+# about GEOMETRY_SECONDS, a cheap (vectorised) case microseconds.
+LOCAL_START_SECONDS = 4.0
+GEOMETRY_SECONDS = 1.0
+
+
+def choose_engine(scheduler: str | None, n_cases: int, n_geometries: int, seconds_per_case: float = 0.0,
+                  workers: int = 2) -> str:
+    """The engine of a sweep: the ``scheduler`` given (``inline``, ``local`` or an address), else
+    ``inline`` when the work is cheap (velocity and material sweeps on one table: microseconds
+    per case) and ``local`` when it is not (a geometry sweep builds one BEM table per design)."""
+    if scheduler:
+        return scheduler.strip()
+    if workers < 2:
+        return "inline"
+    work = max(n_geometries - 1, 0) * GEOMETRY_SECONDS + n_cases * seconds_per_case
+    return "local" if work > 2.0 * LOCAL_START_SECONDS else "inline"
+
+
+def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address (InputError if it cannot be used)."""
     sched = (scheduler or "local").strip()
@@ -280,6 +356,9 @@ def _connect(scheduler: str | None, workers: int):
             client.close()
         raise InputError("--scheduler", f"cannot use the dask scheduler {sched!r}: {exc}") from None
     return client, None, sched
+
+
+_connect = connect  # old name
 
 
 def run_sweep(
@@ -327,7 +406,9 @@ def run_sweep(
     summary = SweepSummary(out, store.path, spec.n_cases, len(done), len(pending))
     draws = spec.draws() if spec.samplers else {}
     t_prep = time.perf_counter()
-    client, cluster, summary.scheduler = _connect(scheduler, workers) if len(pending) else (None, None, "none")
+    rcases = _resource_cases(case, spec, kernel, pending, draws) if len(pending) else {}
+    engine = choose_engine(scheduler, len(pending), len(rcases), getattr(kernel, "seconds_per_case", 0.0), workers)
+    client, cluster, summary.scheduler = connect(engine, workers) if len(pending) else (None, None, "none")
     try:
         # from here on the folder is written
         if fresh and force:
@@ -338,7 +419,6 @@ def run_sweep(
         if len(pending) == 0:
             return summary
         # shared resources (coefficient tables), one per geometry
-        rcases = _resource_cases(case, spec, kernel, pending, draws)
         if len(rcases) > 20:
             print(f"warning: {len(rcases)} distinct nose geometries: each needs its own BEM coefficient table "
                   "(seconds each, cached on disk)", file=sys.stderr)

@@ -32,6 +32,8 @@ _GEOMETRY_PREFIXES = (
     "projectile.diameter",
     "projectile.half_angle",
     "projectile.corner_radius",
+    "projectile.meplat_diameter",
+    "projectile.tip_radius",
     "projectile.points",
     "bem.",
     "coefficients.depths",
@@ -39,10 +41,15 @@ _GEOMETRY_PREFIXES = (
 )
 
 
+# keys a penetration kernel evaluates on arrays (Monte Carlo): the resistance fields, the densities, the mass
+_ARRAY_PREFIXES = ("target.resistance.", "target.density", "projectile.density", "projectile.mass")
+
+
 def geometry_key(case: Case) -> str:
     """A content key of everything the coefficient table depends on."""
     p = case.require("projectile")
-    nose = {k: getattr(p, k) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius")}
+    nose = {k: getattr(p, k, None) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius", "meplat_diameter",
+                                             "tip_radius")}
     nose["points"] = p.points_si() if p.points else None
     opts = {
         "order": case.bem.order,
@@ -74,10 +81,16 @@ class PenetrationKernel:
     cache_dir: str | None = None
     coefficients: Any = None  # a fixed DragCoefficients (e.g. ConstantCoefficients) instead of the BEM table
     full: bool = False
+    vectorised: bool = True  # Monte-Carlo samples on arrays (False: each sample validated as its own case)
     name: str = "penetration"
     fast_keys: frozenset = frozenset({VELOCITY_KEY})
     # per-process cache of unit-resistance depth profiles (see _rigid); not part of the identity
     _profiles: dict = field(default_factory=dict, compare=False, repr=False)
+
+    @property
+    def seconds_per_case(self) -> float:
+        """Rough cost of a case for the engine choice: microseconds on arrays, more with ``full``."""
+        return 2e-3 if self.full else 0.0
 
     @property
     def columns(self) -> tuple[str, ...]:
@@ -98,6 +111,91 @@ class PenetrationKernel:
 
     def check_fast(self, key: str, values: np.ndarray) -> None:
         _check_velocities(np.asarray(values, float))
+
+    # keys evaluated on arrays (Monte Carlo, issue 14): the case is validated once per batch at the
+    # corners of the sampled ranges, then each sample only changes R_t, rho, m and U_s
+    def is_array_key(self, key: str) -> bool:
+        if self.full or not self.vectorised:
+            return False
+        return key.startswith(_ARRAY_PREFIXES) and key.count(".") == (2 if key.startswith("target.resistance.") else 1)
+
+    def accepts_arrays(self, case: Case, keys) -> bool:
+        """The sampled resistance fields are fields of the case's resistance model (not the cavity
+        model's nested material, whose R_t is a Part II solve per sample)."""
+        import dataclasses
+
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        res = [k.rsplit(".", 1)[1] for k in keys if k.startswith("target.resistance.")]
+        if not res:
+            return True
+        try:
+            model = resistance_from_case(case)
+        except InputError:
+            return False
+        names = {f.name for f in dataclasses.fields(model)}
+        return all(f in names for f in res)
+
+    def evaluate_arrays(self, case: Case, coefficients, arrays: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
+        """Rigid depth, U_sC and the yield flag per sample (see :func:`semianalytic.penetration.batch.final_depths`).
+
+        R_t per sample from the case's resistance model with the sampled fields replaced (its
+        closed form: eqs. (16)-(19), Part IV eq. (6)); rho, m per sample; one table for all."""
+        import dataclasses
+
+        from semianalytic.geometry import projectile_from_section
+        from semianalytic.penetration import critical as crit
+        from semianalytic.penetration.batch import final_depths
+        from semianalytic.penetration.curve import PenetrationSetup
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        U = np.asarray(arrays[VELOCITY_KEY], float)
+        n = U.size
+        psec = case.require("projectile")
+        status = np.full(n, "ok", dtype=object)
+        message = np.full(n, "", dtype=object)
+        base = resistance_from_case(case)
+        res_fields = {k.rsplit(".", 1)[1]: np.asarray(v, float) for k, v in arrays.items() if k.startswith("target.resistance.")}
+        if res_fields:
+            R, bad_msg = resistance_per_sample(base, res_fields, psec.diameter)
+            status[bad_msg != ""] = "invalid"
+            message[:] = bad_msg
+        else:
+            R = np.full(n, float(base.pressure(psec.diameter)))
+        rho = np.broadcast_to(np.asarray(arrays.get("target.density", case.require("target").density), float), (n,))
+        proj = projectile_from_section(psec)
+        rho_p = None
+        if "projectile.mass" in arrays:
+            m = np.asarray(arrays["projectile.mass"], float)
+        elif "projectile.density" in arrays and psec.mass is None:
+            rho_p = np.asarray(arrays["projectile.density"], float)
+            m = rho_p * proj.volume()
+        else:
+            m = np.full(n, proj.mass)
+        m = np.broadcast_to(m, (n,))
+        bad = ~(np.isfinite(R) & (R > 0) & (U > 0))
+        status[bad & (status == "ok")] = "invalid"
+        message[bad & (message == "")] = "R_t and U_s must be positive"
+        ok = ~bad
+        depth = np.full(n, np.nan)
+        if ok.any():
+            depth[ok] = final_depths(coefficients, m[ok], rho[ok], R[ok], U[ok])
+        setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+        Usc = np.full(n, np.nan)
+        if setup.rod is not None and setup.yield_stress is not None:
+            ci = setup.critical_inputs()
+            dens = np.full(n, ci.density) if rho_p is None else rho_p
+            Rl, rl, ml, dl = R.tolist(), rho.tolist(), m.tolist(), dens.tolist()
+            for i in np.flatnonzero(ok).tolist():
+                c = crit.CriticalInputs(ci.youngs_modulus, dl[i], ml[i], ci.diameter, ci.A, ci.B, ci.C, rl[i], Rl[i])
+                Usc[i] = crit.critical_velocity(setup.yield_stress, c, setup.phi)
+        return {
+            "depth_rigid_m": depth,
+            "critical_velocity_m_s": Usc,
+            "yields": np.where(np.isfinite(Usc), U >= Usc, False),
+            "_status": status,
+            "_message": message,
+        }
 
     def affects_resource(self, key: str) -> bool:
         return self.coefficients is None and key.startswith(_GEOMETRY_PREFIXES)
@@ -163,12 +261,63 @@ class PenetrationKernel:
         }
 
 
+def _pressures(base, cols: Mapping[str, list], diameter) -> tuple[np.ndarray, np.ndarray]:
+    """R_t of the model ``base`` with the fields in ``cols`` replaced, sample by sample."""
+    import dataclasses
+
+    n = len(next(iter(cols.values())))
+    R = np.empty(n)
+    msg = np.full(n, "", dtype=object)
+    model, kw = type(base), {f.name: getattr(base, f.name) for f in dataclasses.fields(base)}
+    for i in range(n):
+        try:
+            for f, v in cols.items():
+                kw[f] = v[i]
+            R[i] = model(**kw).pressure(diameter)
+        except (ValueError, ArithmeticError, InputError) as exc:
+            R[i], msg[i] = np.nan, f"target.resistance: {exc}"
+    return R, msg
+
+
+def resistance_per_sample(base, fields: Mapping[str, np.ndarray], diameter, n_nodes: int = 17):
+    """R_t per sample: the resistance model's closed form (Part I, eqs. (16)-(19), Part IV, eq. (6))
+    with the sampled fields replaced.  For one or two sampled fields and many samples, R_t is
+    evaluated on a Chebyshev grid over the samples' box and interpolated (it is smooth there:
+    the box's corners are valid cases); the interpolation is checked against the closed form at
+    three samples and used only if it agrees to 1e-11, else every sample is evaluated."""
+    n = len(next(iter(fields.values())))
+    names = list(fields)
+    if len(names) <= 2 and n > 4 * n_nodes ** len(names):
+        from semianalytic.penetration.batch import chebyshev_weights
+
+        axes, Ws = [], []
+        for f in names:
+            lo, hi = float(np.min(fields[f])), float(np.max(fields[f]))
+            if hi > lo:
+                nodes, W = chebyshev_weights(fields[f], lo, hi, n_nodes)
+            else:
+                nodes, W = np.array([lo]), np.ones((n, 1))
+            axes.append(nodes)
+            Ws.append(W)
+        mesh = np.meshgrid(*axes, indexing="ij")
+        grid_R, grid_msg = _pressures(base, {f: m.ravel().tolist() for f, m in zip(names, mesh)}, diameter)
+        if np.all(np.isfinite(grid_R)):
+            grid_R = grid_R.reshape([len(a) for a in axes])
+            R = Ws[0] @ grid_R if len(names) == 1 else np.einsum("si,sj,ij->s", Ws[0], Ws[1], grid_R)
+            probe = np.unique([0, n // 2, n - 1])
+            exact, _ = _pressures(base, {f: np.asarray(fields[f])[probe].tolist() for f in names}, diameter)
+            if np.all(np.abs(R[probe] - exact) <= 1e-11 * np.abs(exact)):
+                return R, np.full(n, "", dtype=object)
+    return _pressures(base, {f: np.asarray(v, float).tolist() for f, v in fields.items()}, diameter)
+
+
 @dataclass(frozen=True)
 class CavityKernel:
     """Part II: the brittle cavity-expansion solution of the case's ``[material]``."""
 
     name: str = "cavity"
     fast_keys: frozenset = frozenset()
+    seconds_per_case: float = 2e-3  # one Part II solve, plus validating its case (engine choice)
     columns: tuple[str, ...] = (
         "cavity_pressure_Pa", "sigma_star_Pa", "theta_star", "theta_k", "a_over_b", "c_over_b",
     )
@@ -179,6 +328,12 @@ class CavityKernel:
 
     def check_fast(self, key, values):  # no fast keys
         pass
+
+    def is_array_key(self, key: str) -> bool:
+        return False
+
+    def accepts_arrays(self, case: Case, keys) -> bool:
+        return False
 
     def affects_resource(self, key: str) -> bool:
         return False

@@ -256,6 +256,9 @@ class SweepSpec:
     def units(self) -> dict[str, str]:
         return {**{a.key: a.unit for a in self.axes}, **{s.key: s.unit for s in self.samplers}}
 
+    def sampled_keys(self) -> set[str]:
+        return {s.key for s in self.samplers}
+
     def integer_keys(self) -> set[str]:
         return {a.key for a in self.axes if a.integer}
 

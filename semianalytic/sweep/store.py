@@ -34,6 +34,11 @@ def results_path(out: Path, fmt: str) -> Path:
 
 
 def _cell(v) -> str:
+    t = type(v)
+    if t is float:  # the common case first (rows hold Python floats from .tolist())
+        return repr(v) if math.isfinite(v) else ""
+    if t is str:
+        return v
     if v is None:
         return ""
     if isinstance(v, (bool, np.bool_)):

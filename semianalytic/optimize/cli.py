@@ -1,0 +1,65 @@
+"""``python -m semianalytic optimize CASE --out DIR --vary KEY=LOW:HIGH ... --objective depth|deep_drag``.
+
+Nose-shape optimisation with the BEM in the loop (see :mod:`semianalytic.optimize.evaluate`).
+Example (Fig. 5 projectile, mass fixed, into the Fig. 15a target)::
+
+    python -m semianalytic optimize cases/optimize_fig5_into_fig15a.toml --out out/opt \\
+        --vary projectile.crh=0.5:8 --objective depth --constraint mass
+"""
+
+from __future__ import annotations
+
+import argparse
+import shlex
+import sys
+from pathlib import Path
+
+from semianalytic.errors import InputError
+
+
+def add_arguments(parser: argparse.ArgumentParser) -> None:
+    parser.add_argument("case", help="case file (TOML) with the starting projectile (and target, impact for depth)")
+    parser.add_argument("--out", default=None, help="output folder: optimum.json, history.json/.csv, noses.png, report.md")
+    parser.add_argument("--report", default=None, help="also write a Markdown report (and its figure beside it) here")
+    parser.add_argument("--force", action="store_true", help="overwrite --out / --report")
+    parser.add_argument("--vary", action="append", default=[], metavar="KEY=LOW:HIGH",
+                        help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
+                             "projectile.meplat_diameter, projectile.tip_radius (repeatable)")
+    parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
+    parser.add_argument("--depth-model", default="rigid", help="rigid or exact-rod (elastic projectile, errata item 5)")
+    parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")
+    parser.add_argument("--popsize", type=int, default=5, help="differential evolution: population per variable (default 5)")
+    parser.add_argument("--maxiter", type=int, default=12, help="differential evolution: generations (default 12)")
+    parser.add_argument("--tol", type=float, default=1e-5, help="differential evolution: relative tolerance of the population's objectives (default 1e-5)")
+    parser.add_argument("--seed", type=int, default=0)
+    parser.add_argument("--resolution", type=float, default=1e-3, help="designs rounded to this fraction of each range")
+    parser.add_argument("--confirm", type=int, default=5, help="confirmation grid: points per variable (0: none)")
+    parser.add_argument("--scheduler", default=None, help="dask scheduler tcp://HOST:PORT, 'inline' or 'local' (default)")
+    parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
+    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
+    parser.add_argument("--no-progress", action="store_true")
+    parser.add_argument("--json", action="store_true", help="print the optimum as JSON")
+
+
+def run(args: argparse.Namespace) -> int:
+    from semianalytic.optimize.pipeline import run_optimize
+
+    if args.out is None and args.report is None and not args.json:
+        raise InputError("--out", "give an output folder (--out DIR), --report FILE.md or --json")
+    command = "python -m semianalytic optimize " + " ".join(shlex.quote(a) for a in sys.argv[2:])
+    result = run_optimize(args, command)
+    o = result["optimum"]
+    if args.json:
+        import json
+
+        from semianalytic.report.output import json_safe
+
+        print(json.dumps(json_safe({k: v for k, v in result.items() if k != "history"}), indent=2))
+    else:
+        xs = ", ".join(f"{v['key']} = {x:.6g}" for v, x in zip(result["variables"], o["x"]))
+        print(f"optimum: {xs}; objective {o['objective']:.8g} ({result['objective']}); "
+              f"{result['n_designs_total']} designs in {result['seconds_total']:.1f} s")
+        g = result.get("confirmation")
+        if g:
+            print(f"confirmation grid: best {g['best_objective']:.8g}, confirmed: {'yes' if g['confirmed'] else 'NO'}")
+    return 0 if o["status"] == "ok" else 1
