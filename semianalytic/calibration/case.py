@@ -30,7 +30,7 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
-from semianalytic.calibration.models import MODELS, ShotSet
+from semianalytic.calibration.names import MODELS
 from semianalytic.calibration.priors import HalfNormal, LogNormal, Normal, Uniform
 from semianalytic.errors import InputError
 from semianalytic.schema import Section
@@ -150,6 +150,7 @@ def load_shot_set(case, projectile_mass: float, *, minimum: int = MIN_SHOTS) -> 
     """The case's ``[data]`` shots as a :class:`ShotSet` (SI), each with its own mass where the
     data give one, else the projectile's.  Bad input (file missing or empty, a column absent,
     a non-positive value, fewer than ``minimum`` shots): InputError naming the field."""
+    from semianalytic.calibration.models import ShotSet  # the models load on use
     from semianalytic.penetration.validation import load_shots
 
     data = case.section("data")

@@ -15,7 +15,7 @@ from semianalytic.errors import InputError
 
 
 def add_arguments(parser) -> None:
-    from semianalytic.calibration.models import MODELS
+    from semianalytic.calibration.names import MODELS
 
     parser.add_argument("case", metavar="CASE.toml", help="case with [projectile], [target], [data] (and [calibration])")
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")

@@ -45,10 +45,7 @@ __all__ = ["MODELS", "PHYSICALLY_CONSISTENT", "ShotSet", "DepthModelInputs", "mo
 
 # the keys of semianalytic.penetration.validation.MODEL_LABELS (its labels are used by the report;
 # that module reads CSV files, so a pure model does not import it)
-MODELS = ("rigid", "quasi_rigid", "elastic", "elastic_exact_rod", "forrestal", "chen_li")
-# Quasi-rigid start plus the exact rod's bounded vibration energy: the model the exact rod
-# and the FEM support (the paper's W2 grows without bound, errata item 5).
-PHYSICALLY_CONSISTENT = "elastic_exact_rod"
+from semianalytic.calibration.names import MODELS, PHYSICALLY_CONSISTENT  # noqa: E402,F401
 
 
 @dataclass(frozen=True)

@@ -12,7 +12,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy import special, stats
 
 __all__ = ["LogNormal", "Normal", "Uniform", "HalfNormal", "Prior"]
 
@@ -33,6 +32,8 @@ class LogNormal:
         return np.where(x > 0, out, -np.inf)
 
     def ppf(self, q):
+        from scipy import special  # scipy.stats/special load on use: case loading stays light
+
         return self.median * np.exp(self.sigma * special.ndtri(np.asarray(q, float)))
 
     def describe(self, unit_scale: float = 1.0, unit: str = "") -> str:
@@ -50,6 +51,8 @@ class Normal:
         return -0.5 * z * z - math.log(self.sd * math.sqrt(2 * math.pi))
 
     def ppf(self, q):
+        from scipy import stats
+
         return stats.norm.ppf(np.asarray(q, float), self.mean, self.sd)
 
     def describe(self, unit_scale: float = 1.0, unit: str = "") -> str:
@@ -86,6 +89,8 @@ class HalfNormal:
         return np.where(x > 0, -0.5 * z * z + math.log(math.sqrt(2 / math.pi) / self.scale), -np.inf)
 
     def ppf(self, q):
+        from scipy import stats
+
         return stats.halfnorm.ppf(np.asarray(q, float), scale=self.scale)
 
     def describe(self, unit_scale: float = 1.0, unit: str = "") -> str:

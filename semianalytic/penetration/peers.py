@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 __all__ = [
     "ogive_nose_factor",
@@ -181,6 +180,8 @@ def tate_penetration(length: float, rod_density: float, rod_strength: float, tar
     for ev in (erosion_ends, consumed):
         ev.terminal, ev.direction = True, -1
     t_scale = length / V
+    from scipy.integrate import solve_ivp  # loaded on use: loading a case stays light
+
     sol = solve_ivp(rhs, (0.0, 1e4 * t_scale), [V, length, 0.0], method="DOP853", rtol=rtol,
                     atol=[rtol * V, rtol * length, rtol * length], events=(erosion_ends, consumed))
     v, L, P = sol.y[:, -1]
