@@ -40,6 +40,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--w1", choices=W1_MODELS, default="neglect",
                         help="lateral-compression energy W1 of eq. (28) (default: neglect, as the paper)")
     parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--contact", choices=("full", "separated"), default=None,
+                        help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
+    parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
     parser.add_argument("--report", metavar="DIR", default=None, help="write a markdown report with plots into DIR")
     parser.add_argument("--report-name", default=None, help="report file stem (default: validation_<data name>)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
@@ -109,12 +112,25 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             p(f"    {key:<18} mean {st['mean'] * 100:+6.1f} %   mean |e| {st['mean_abs'] * 100:5.1f} %   max |e| {st['max_abs'] * 100:5.1f} %")
 
 
+def _warn_separation(result: dict) -> None:
+    """Under full contact, say on stderr where the pressure of eq. (9) would separate (eq. (15))."""
+    onset = result.get("separation_onset_m") or []
+    hits = [(U, P) for U, P in zip(result["striking_velocity_m_s"], onset) if P is not None]
+    if hits and result.get("contact") == "full":
+        first = ", ".join(f"{U:.0f} m/s at P = {P * 1e3:.2f} mm" for U, P in hits[:3])
+        print(f"warning: {result['case']}: the contact pressure (eq. (9)) turns negative on the nose for {len(hits)} "
+              f"striking velocities ({first}{', ...' if len(hits) > 3 else ''}): the target would separate (eq. (15)); "
+              "full contact is assumed (try --contact separated)", file=sys.stderr)
+
+
 def run(args) -> int:
     from semianalytic.io import check_report_target
     from semianalytic.cache import coefficients_for_case
     from semianalytic.penetration.evaluate import evaluate_case
 
-    cases = _load(args.cases)
+    from semianalytic.cache import override_coefficients
+
+    cases = [override_coefficients(c, contact=args.contact, tolerance=args.tolerance) for c in _load(args.cases)]
     if args.report is not None:
         from semianalytic.penetration.report import report_path
 
@@ -127,6 +143,7 @@ def run(args) -> int:
                   "constant Abar, Bbar, Cbar instead", file=sys.stderr)
         results.append(evaluate_case(case, coefficients, w1=args.w1))
         descs.append(desc)
+        _warn_separation(results[-1])
     if args.json:
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
         print(json.dumps(objs[0] if len(objs) == 1 else {"cases": objs}, indent=1, allow_nan=True))
