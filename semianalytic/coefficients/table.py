@@ -54,7 +54,10 @@ INTERPOLATED = CONTROLLED + ("phi_tip",)
 BREAK_OFFSET = 1e-6  # knots at b (1 -+ BREAK_OFFSET) beside a breakpoint b (relative)
 NEAR_BREAK = 1e-3  # closer than this (relative) to a breakpoint: fourth-order difference in P
 FLAT_TIP_DEPTH = 1e-8  # a flat tip's first solve, in radii (the coefficients jump at P = 0+)
-MAX_ROUNDS = 40  # bisection rounds (each halves the failing intervals)
+MAX_ROUNDS = 40
+MAX_SOLVES = 400  # bisection stops (estimates kept) once this many depths are solved
+NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is noise-limited
+ROUND_OFF = 1e-12  # relative round-off of the BEM's quadrature sums: the floor of every error estimate  # bisection rounds (each halves the failing intervals)
 _KINDS = {"root": 0, "mid": 1, "deep": 2}
 
 
@@ -544,6 +547,7 @@ class _Builder:
         self.knots = [_PieceKnots(p) for p in self.pieces]
         self.progress = progress
         self.solves = 0
+        self.noise_limited = 0
         self.limit_err: dict = {}
 
     # one solve
@@ -614,9 +618,15 @@ class _Builder:
             out[name] = max(abs(r[name]) for pk in self.knots for r in pk.rows) or 1.0
         return out
 
-    def refine(self, max_rounds: int = MAX_ROUNDS):
-        """Bisect every interval until the interpolant and a direct solve at its midpoint agree."""
+    def refine(self, max_rounds: int = MAX_ROUNDS, max_solves: int = MAX_SOLVES):
+        """Bisect every interval until the interpolant and a direct solve at its midpoint agree.
+
+        An interval whose discrepancy no longer shrinks under bisection (less than a factor
+        1/NOISE_RATIO per halving) is limited by the BEM's own noise in P, not by the
+        interpolation: it is accepted with its discrepancy as the estimate (above the
+        tolerance; counted in ``noise_limited``)."""
         pending = {i: list(zip(pk.v[:-1], pk.v[1:])) for i, pk in enumerate(self.knots)}
+        parent: dict = {}
         for _ in range(max_rounds):
             if not any(pending.values()):
                 break
@@ -633,6 +643,7 @@ class _Builder:
                 solved[i] = (pred, [s[0] for s in solved[i]])
             scale = self.scales()
             new = {}
+            budget = self.solves < max_solves
             for i, vs in tests.items():
                 pred, rows = solved[i]
                 pk = self.knots[i]
@@ -641,18 +652,29 @@ class _Builder:
                     disc = {q: abs(float(pred[q][k]) - rows[k][q]) for q in INTERPOLATED}
                     worst = max(disc[q] / (self.tol * scale[q]) for q in CONTROLLED)
                     tiny = (b - a) <= 1e-7 * max(abs(b), 1e-300) if pk.piece.kind != "deep" or a > 0 else False
-                    if worst > 1.0 and not tiny:
+                    up = parent.get((i, a, b))
+                    # an interval at a piece end may hold a singularity (log-like at a corner): never noise
+                    inner = a > pk.v[0] and b < pk.v[-1]
+                    stalled = inner and up is not None and worst > NOISE_RATIO * up[0]
+                    if worst > 1.0 and not tiny and not stalled and budget:
                         nxt += [(a, m), (m, b)]
+                        parent[(i, a, m)] = parent[(i, m, b)] = (worst, disc)
                     else:
+                        if worst > 1.0:
+                            self.noise_limited += 1
+                            if up is not None:
+                                disc = {q: max(disc[q], up[1][q]) for q in INTERPOLATED}
                         pk.err[(a, m)] = pk.err[(m, b)] = disc
                 new[i] = nxt
             self.update_limit()
             self.extend_deep(new, scale)
             pending = new
         else:
-            for i, ivs in pending.items():  # out of rounds: keep the last discrepancy, honestly
+            for i, ivs in pending.items():  # out of rounds: the parent's discrepancy, honestly
                 for a, b in ivs:
-                    self.knots[i].err[(a, b)] = {q: math.inf for q in INTERPOLATED}
+                    up = parent.get((i, a, b))
+                    self.knots[i].err[(a, b)] = up[1] if up else {q: math.inf for q in INTERPOLATED}
+                    self.noise_limited += 1
 
     def extend_deep(self, pending: dict, scale: dict):
         """Deeper solves until the extrapolated deep limit is within half the tolerance."""
@@ -700,7 +722,8 @@ class _Builder:
         resid = max(abs(r["B_bernoulli"] - r["dA_dP"]) for pk in self.knots for r in pk.rows if r is not None)
         for q in ("B_body", "B_literal", "B_bernoulli"):
             out[q] = max(out[q], resid)
-        return out
+        scale = self.scales()
+        return {q: max(e, ROUND_OFF * scale[q]) for q, e in out.items()}  # no estimate below round-off
 
     def table(self, options: dict, bem_err: dict) -> CoefficientTable:
         return assemble_table(self.nose, self.knots, self.kinks, self.limit_err, bem_err, options, self.tol)
@@ -829,6 +852,7 @@ def coefficient_table(
             b.initial()
             b.refine()
             options["tolerance"] = tol
+            options["noise_limited_intervals"] = b.noise_limited
         bem_err = b.bem_errors() if bem_error else {}
         return b.table(options, bem_err)
     finally:
