@@ -46,7 +46,7 @@ from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_d
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose
 
-TABLE_VERSION = 5  # bump when the numerics change, to invalidate caches
+TABLE_VERSION = 6  # (5: certified tables; 6: with the corner-aware BEM) bump when the numerics change, to invalidate caches
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")  # error-controlled coefficients
@@ -54,10 +54,10 @@ INTERPOLATED = CONTROLLED + ("phi_tip",)
 BREAK_OFFSET = 1e-6  # knots at b (1 -+ BREAK_OFFSET) beside a breakpoint b (relative)
 NEAR_BREAK = 1e-3  # closer than this (relative) to a breakpoint: fourth-order difference in P
 FLAT_TIP_DEPTH = 1e-8  # a flat tip's first solve, in radii (the coefficients jump at P = 0+)
-MAX_ROUNDS = 40
+MAX_ROUNDS = 40  # bisection rounds (each halves the failing intervals)
 MAX_SOLVES = 400  # bisection stops (estimates kept) once this many depths are solved
 NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is noise-limited
-ROUND_OFF = 1e-12  # relative round-off of the BEM's quadrature sums: the floor of every error estimate  # bisection rounds (each halves the failing intervals)
+ROUND_OFF = 1e-12  # relative round-off of the BEM's quadrature sums: the floor of every error estimate
 _KINDS = {"root": 0, "mid": 1, "deep": 2}
 
 
