@@ -28,6 +28,9 @@ from semianalytic.coefficients.table import (
 from semianalytic.errors import InputError
 
 TOL = 1e-5  # the default tolerance: relative to each coefficient's largest magnitude over the table
+# cornered noses cost 2-3 times the knots of smooth ones at 1e-5; CI checks them looser (the
+# slow study below and reports/bem_coefficients.md at 1e-5)
+CI_TOL = {"ogive": TOL, "sphere": TOL, "cone": 1e-3, "flat": 1e-4, "table": 1e-3}
 FIG5 = "cases/fig5_ogive.toml"
 
 
@@ -38,7 +41,7 @@ def tables():
     def get(kind):
         if kind not in cache:
             nose = study_nose(kind)
-            cache[kind] = (nose, coefficient_table(nose))
+            cache[kind] = (nose, coefficient_table(nose, tolerance=CI_TOL[kind]))
         return cache[kind]
 
     return get
@@ -58,8 +61,8 @@ def test_table_against_direct_solves_at_random_depths(tables, kind, seed):
     for q in CONTROLLED:
         assert study[q]["bounded"] == study[q]["n"], (q, study[q])
         if table.options["noise_limited_intervals"] == 0:
-            # the target; 1e-5 is the table's tolerance, with no slack
-            assert study[q]["max_rel_error"] <= TOL, (q, study[q])
+            # the target: the table's tolerance, with no slack
+            assert study[q]["max_rel_error"] <= CI_TOL[kind], (q, study[q])
 
 
 def test_estimates_bound_the_error_against_a_refined_bem(tables):
@@ -249,9 +252,11 @@ def test_separated_contact_equals_full_without_separation_and_changes_little_wit
 
 
 def test_contact_flag_bad_value_exits_2(capsys):
-    with pytest.raises(SystemExit) as exc:
-        main(["penetrate", PIEK, "--contact", "partial"])
-    assert exc.value.code == 2
+    try:
+        rc = main(["penetrate", PIEK, "--contact", "partial"])
+    except SystemExit as exc:  # argparse's own exit
+        rc = exc.code
+    assert rc == 2
     assert "--contact" in capsys.readouterr().err
 
 

@@ -57,7 +57,9 @@ FLAT_TIP_DEPTH = 1e-8  # a flat tip's first solve, in radii (the coefficients ju
 MAX_ROUNDS = 40  # bisection rounds (each halves the failing intervals)
 MAX_SOLVES = 400  # bisection stops (estimates kept) once this many depths are solved
 NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is noise-limited
-ROUND_OFF = 1e-12  # relative round-off of the BEM's quadrature sums: the floor of every error estimate
+# floor of every error estimate, relative to the coefficient's largest magnitude: phi at P is the
+# mean of the difference stencil's solves (error O(h^2), about 1e-8; coefficients/depth.py)
+ROUND_OFF = 1e-8
 _KINDS = {"root": 0, "mid": 1, "deep": 2}
 
 
@@ -151,7 +153,10 @@ def depth_pieces(nose: Nose) -> tuple[list[Piece], list[float]]:
     kinks = list(bps)
     if len(ends) == 1:  # no breakpoint (a flat nose with a sharp edge): split at the radius
         ends.append(nose.radius)
-    pieces = [Piece("root", 0.0, ends[1], ends[1])]
+    # from first contact: in sqrt(P) on a rounded or flat tip (A ~ P^3/2, B ~ P^1/2), in P on a
+    # pointed one (A ~ P^3, B ~ P^2: polynomial in P; exactly so on a cone)
+    pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-9 and not flat_tip(nose)
+    pieces = [Piece("mid" if pointed else "root", 0.0, ends[1], ends[1])]
     pieces += [Piece("mid", a, b, a) for a, b in zip(ends[1:-1], ends[2:])]
     pieces.append(Piece("deep", ends[-1], math.inf, ends[-1]))
     return pieces, kinks
@@ -585,12 +590,12 @@ class _Builder:
                     v_lo = float(p.v(p.P_lo * (1 + d))) if p.P_lo in self.kinks else float(p.v(p.P_lo))
                     v_hi = float(p.v(p.P_hi * (1 - d))) if p.P_hi in self.kinks else float(p.v(p.P_hi))
                     vs = list(np.linspace(v_lo, v_hi, 6))
-                    if p.kind == "root":
+                    if p.P_lo == 0.0:
                         vs = vs[1:]
                         if self.flat:
                             vs.insert(0, float(p.v(FLAT_TIP_DEPTH * self.nose.radius)))
                 self._add_solved(pk, vs)
-            if p.kind == "root" and not self.flat:  # first contact: everything vanishes
+            if p.P_lo == 0.0 and not self.flat:  # first contact: everything vanishes
                 pk.add(0.0, {k: 0.0 for k in INTERPOLATED + ("dA_dP", "dphi_tip_dP")}, None, 0)
         self.update_limit()
 
