@@ -42,10 +42,6 @@ def parse_depths(text: str, nose_length: float, field: str = "--at") -> list[flo
 
 def parse_tolerance(value, field: str = "--tolerance") -> float:
     """A table tolerance: a number in (0, 0.1) (relative to each coefficient's largest magnitude)."""
-    try:
-        tol = float(value)
-    except (TypeError, ValueError):
-        raise InputError(field, f"expected a number in (0, 0.1), e.g. 1e-5; got {value!r}") from None
-    if not (math.isfinite(tol) and 0 < tol < 0.1):
-        raise InputError(field, f"expected a number in (0, 0.1), e.g. 1e-5; got {value!r}")
-    return tol
+    from semianalytic.coefficients.table import check_tolerance
+
+    return check_tolerance(value, field)

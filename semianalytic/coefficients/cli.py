@@ -96,7 +96,12 @@ def _run_projectile(case, args) -> int:
     options.update(n_depths=n_depths) if n_depths is not None else options.update(tolerance=tolerance)
 
     def build():
-        return cached_coefficient_table(nose, args.cache_dir, **options)
+        try:
+            return cached_coefficient_table(nose, args.cache_dir, **options)
+        except InputError as exc:  # name the flag when the flag set it
+            if exc.field == "coefficients.max_depth_nose_lengths" and args.max_depth:
+                raise InputError("--max-depth", exc.message) from None
+            raise
 
     if args.at is not None:
         out = rows_at(case, args.at, reading=reading, interpolated=args.interpolated, order=order,
