@@ -105,6 +105,12 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
             f" {'YES (outside the model)' if r['yields'] else 'no'}"
         )
+    est = result.get("depth_error_estimate_m")
+    if est:
+        worst = {k: max((e / d for e, d in zip(est[k], result[f"depth_{k}_m"]) if d and math.isfinite(d)), default=math.nan)
+                 for k in est}
+        p("  estimated numerical error of the depths (coefficient tables + integrator), at most: "
+          + ", ".join(f"{k.replace('_', ' ')} {v:.1e}" for k, v in worst.items()) + " relative")
     val = result.get("validation")
     if val:
         p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
