@@ -53,7 +53,7 @@ CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")  # error-controlle
 INTERPOLATED = CONTROLLED + ("phi_tip",)
 BREAK_OFFSET = 1e-6  # knots at b (1 -+ BREAK_OFFSET) beside a breakpoint b (relative)
 NEAR_BREAK = 1e-3  # closer than this (relative) to a breakpoint: fourth-order difference in P
-FLAT_TIP_DEPTH = 1e-8  # a flat tip's first solve, in radii (the coefficients jump at P = 0+)
+FLAT_TIP_DEPTH = 1e-2  # a flat tip's first solve, in radii (the coefficients jump at P = 0+; constant below)
 MAX_ROUNDS = 40  # bisection rounds (each halves the failing intervals)
 MAX_SOLVES = 400  # bisection stops (estimates kept) once this many depths are solved
 NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is noise-limited
@@ -751,8 +751,8 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
             if not deep and k == 0 and a > 0 and p.kind == "root":  # flat tip: constant below the first solve
                 rows.append({"P_lo": 0.0, "kind": 1, "scale": 1.0, "v0": 0.0,
                              **{f"coef_{q}": [0.0] * 5 + [pk.rows[0][q]] for q in INTERPOLATED}})
-                for q in INTERPOLATED:
-                    errs[q].append(pk.err.get((a, b), {}).get(q, math.inf))
+                for q in INTERPOLATED:  # twice the change over the next interval (X0 + c P^alpha, alpha >= 0.3)
+                    errs[q].append(2.0 * abs(pk.rows[1][q] - pk.rows[0][q]) + pk.err.get((a, b), {}).get(q, math.inf))
             rows.append({"P_lo": P_lo, "kind": _KINDS[p.kind], "scale": p.scale, "v0": float(a),
                          **{f"coef_{q}": _coef6(sp[q], float(a), pk.rows[0][q]) for q in INTERPOLATED}})
             e = pk.err.get((float(a), float(b)), {})
