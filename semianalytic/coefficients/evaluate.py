@@ -56,8 +56,16 @@ def table_output(table, nose, reading: str) -> dict:
     """The table as one JSON-able dict: columns over the knots with their error estimates,
     the deep limit with its error, the tolerance and the knots' count."""
     area = math.pi * nose.diameter**2 / 4
-    v = table.values
     P = table.depth
+    v = table.values
+    if isinstance(table.options.get("depths"), list):  # a fixed grid: exactly the depths asked for
+        P = np.asarray(table.options["depths"], float)
+        v = {k: np.asarray(table._eval(k, P)) for k in ("A", "B_body", "B_literal", "B_bernoulli", "C", "phi_tip")}
+        v["dA_dP"] = np.asarray(table.dA_dP(P))
+        keep = np.isin(table.depth, P)
+        unknowns = table.unknowns[keep] if keep.sum() == len(P) else np.full(len(P), int(table.unknowns.max()))
+    else:
+        unknowns = table.unknowns
     lim = table.limits
     le = table.limit_errors
     be = table.bem_errors
@@ -77,10 +85,10 @@ def table_output(table, nose, reading: str) -> dict:
         "A_err_m3": np.asarray(table.error("A", P)).tolist(),
         "B_err_m2": np.asarray(table.error(f"B_{reading}", P)).tolist(),
         "C_err_m2": np.asarray(table.error("C", P)).tolist(),
-        "unknowns": table.unknowns.tolist(),
+        "unknowns": np.asarray(unknowns).tolist(),
         "reading": reading,
         "tolerance": table.tolerance,
-        "knots": len(P),
+        "knots": len(table.depth),
         "breakpoints_m": list(table.kinks),
         "nose_length_m": nose.length,
         "diameter_m": nose.diameter,

@@ -612,6 +612,9 @@ class _Builder:
             row[name], err[name] = val, e
             if name == "A":
                 row["dA_dv"], row["d2A_dv2"] = slope, curv
+        for name in list(err):  # too few deep solves to extrapolate: the value itself
+            if not math.isfinite(err[name]):
+                err[name] = abs(row[name])
         row["C"], err["C"] = math.pi * self.nose.radius**2, 0.0  # exact once the nose is in
         row["dA_dP"] = row["dphi_tip_dP"] = 0.0
         pk.add(0.0, row, None, 0)
@@ -852,7 +855,7 @@ def coefficient_table(
         if depths is not None:
             b.initial(fixed_depths=np.asarray(depths, float))
             _fixed_errors(b)
-            options["depths"] = len(depths)
+            options["depths"] = [float(P) for P in depths]
         else:
             b.initial()
             b.refine()
@@ -870,8 +873,8 @@ def _fixed_errors(b: _Builder):
     with the knots left out (the interval estimate is that discrepancy)."""
     for pk in b.knots:
         n = len(pk.v)
-        for k in range(n - 1):
-            pk.err[(pk.v[k], pk.v[k + 1])] = {q: math.inf for q in INTERPOLATED}
+        for k in range(n - 1):  # at least the change across the interval
+            pk.err[(pk.v[k], pk.v[k + 1])] = {q: abs(pk.rows[k + 1][q] - pk.rows[k][q]) for q in INTERPOLATED}
         if n < 3:
             continue
         keep = list(range(0, n, 2)) + ([n - 1] if (n - 1) % 2 else [])
@@ -879,8 +882,8 @@ def _fixed_errors(b: _Builder):
         sp = sub.splines()
         for k in range(1, n - 1, 2):
             pred = _evaluate_splines(sp, np.array([pk.v[k]]))
-            disc = {q: abs(float(pred[q][0]) - pk.rows[k][q]) for q in INTERPOLATED}
-            pk.err[(pk.v[k - 1], pk.v[k])] = pk.err[(pk.v[k], pk.v[k + 1])] = disc
+            for key in ((pk.v[k - 1], pk.v[k]), (pk.v[k], pk.v[k + 1])):
+                pk.err[key] = {q: max(pk.err[key][q], abs(float(pred[q][0]) - pk.rows[k][q])) for q in INTERPOLATED}
 
 
 def default_depths(nose: Nose, n_depths: int = 60, max_depth_nose_lengths: float = 300.0) -> np.ndarray:
