@@ -124,9 +124,17 @@ class SplineCurve:
 
     def between_knots(self) -> tuple["SplineCurve", ...]:
         """The curve cut at its knots: one segment per interval, so that panels never
-        straddle a knot (where the third derivative jumps)."""
+        straddle a knot (where the third derivative jumps).  Built once per curve; the
+        pieces share its splines."""
+        return self._between_knots
+
+    @cached_property
+    def _between_knots(self) -> tuple["SplineCurve", ...]:
         k = self.knots
-        return tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
+        pieces = tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
+        for p in pieces:
+            p.__dict__["_splines"] = self._splines  # same curve: share the fitted splines
+        return pieces
 
     @cached_property
     def _splines(self):

@@ -132,6 +132,18 @@ def test_identity_and_refinement(name, lengths):
     assert abs(work.A - fine.A) <= 2e-8 * abs(fine.A)
 
 
+ALL = [(n, m) for n in NOSES for m in (0.5, 1.0, 2.0, 5.0, 20.0)]
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("name,lengths", ALL, ids=[f"{n}-{m}Lh" for n, m in ALL])
+def test_identity_and_refinement_every_target_depth(name, lengths):
+    """Issue 10's full target grid (0.5 ... 20 nose lengths), as in reports/bem_corners.md."""
+    if lengths == 1.0:
+        lengths = 1.0001  # P = L_h changes the layout's topology
+    test_identity_and_refinement(name, lengths)
+
+
 def test_more_grading_does_not_diverge():
     """Before issue 10, 16-18 grading levels put B_body of the cone 3.5% off (tiny panels
     lost their digits): now every level count stays within the target of the fine value."""

@@ -99,3 +99,10 @@ def test_issue_table_nose_in_a_subprocess(env):
     assert proc.returncode == 0, proc.stderr
     assert "Traceback" not in proc.stderr
     assert _all_finite(json.loads(proc.stdout))
+
+
+@pytest.mark.parametrize("name", ["body_flat_cylinder", "body_double_cone"])
+def test_cornered_bodies_coefficients(name, capsys):
+    assert main(["coefficients", str(ROOT / "cases" / f"{name}.toml"), "--json"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert _all_finite(d) and 0.1 < d["added_mass_coefficient"] < 1.0

@@ -202,10 +202,17 @@ class PairQuadrature:
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif node_targets:  # targets are nodes of ps: differences through the anchors
-            ax, ar, ex, er = ps.split(pan, self.u)
-            tax, tar, tex, ter = (a[t] for a in ps.node_split)
-            delta = ((tax - ax) + (tex - ex), (tar - ar) + (ter - er))
+        elif node_targets and ps.tiny_panels.any():
+            # targets are nodes of ps: on panels graded far below their distance from the
+            # origin, differences through the shared anchors (a corner) keep their digits
+            sel = np.nonzero(ps.tiny_panels[pan])[0]
+            if sel.size:
+                ax, ar, ex, er = ps.split(pan[sel], self.u[sel])
+                tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
+                dx, dr = xt[t] - x, rt[t] - r
+                dx[sel] = (tax - ax) + (tex - ex)
+                dr[sel] = (tar - ar) + (ter - er)
+                delta = (dx, dr)
         out = []
         for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J, delta):
             if isinstance(ker, tuple):
