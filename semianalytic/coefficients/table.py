@@ -46,7 +46,7 @@ from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_d
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose
 
-TABLE_VERSION = 6  # (5: certified tables; 6: with the corner-aware BEM) bump when the numerics change, to invalidate caches
+TABLE_VERSION = 7  # (5: certified tables; 6-7: with the corner-aware BEM) bump when the numerics change, to invalidate caches
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")  # error-controlled coefficients
