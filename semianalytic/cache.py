@@ -82,12 +82,13 @@ def cached_coefficient_table(nose, cache_dir: str | os.PathLike | None = None, *
     return table
 
 
-def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False):
+def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False, tolerance=None):
     """(coefficients, description, fallback) for a case.
 
     ``source="bem"``: the BEM table of the case's nose (cached on disk), in the B reading of
     ``[coefficients] reading`` (errata item 2a); ``"paper"``: the paper's quoted constants
-    (:func:`semianalytic.penetration.curve.paper_coefficients`).  ``fallback`` is True when "bem" was asked for but the table
+    (:func:`semianalytic.penetration.curve.paper_coefficients`).  ``tolerance`` overrides
+    ``[coefficients] tolerance`` (the table's relative interpolation error).  ``fallback`` is True when "bem" was asked for but the table
     module is not available (then the paper's constants are used).
     """
     from semianalytic.errors import InputError
@@ -108,19 +109,37 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
         )
     from semianalytic.geometry import nose_from_section
 
-    kwargs = dict(
-        order=case.bem.order,
-        n_depths=case.coefficients.depths,
-        max_depth_nose_lengths=case.coefficients.max_depth_nose_lengths,
-        progress=progress,
-    )
+    cs = case.coefficients
+    tolerance = cs.tolerance if tolerance is None else tolerance
+    kwargs = dict(order=case.bem.order, max_depth_nose_lengths=cs.max_depth_nose_lengths, progress=progress)
+    if cs.depths is not None:  # a fixed grid
+        kwargs["n_depths"] = cs.depths
+    else:
+        kwargs["tolerance"] = tolerance
     refinement = getattr(case.bem, "refinement", None)
     if refinement is not None:  # else the table's own default
         kwargs["refinement"] = refinement
-    table = cached_coefficient_table(nose_from_section(psec), cache_dir, **kwargs).with_reading(case.coefficients.reading)
+    table = cached_coefficient_table(nose_from_section(psec), cache_dir, **kwargs).with_reading(cs.reading)
     ref = f"refinement {refinement:g}" if refinement is not None else "default refinement"
+    grid = f"{cs.depths} fixed depths" if cs.depths is not None else f"{len(table.depth)} adaptive knots, tolerance {tolerance:g}"
     desc = (
-        f"BEM table (order {case.bem.order}, {ref}, {case.coefficients.depths} depths "
-        f"to {case.coefficients.max_depth_nose_lengths:g} nose lengths, B reading '{case.coefficients.reading}')"
+        f"BEM table (order {case.bem.order}, {ref}, {grid}, to the deep limit; B reading '{cs.reading}')"
     )
     return table, desc, False
+
+
+def override_coefficients(case, *, contact: str | None = None, tolerance=None):
+    """The case with ``[coefficients] contact`` / ``tolerance`` replaced by command-line flags
+    (``--contact``, ``--tolerance``; None keeps the case's value)."""
+    import dataclasses
+
+    from semianalytic.coefficients.case import parse_tolerance
+
+    updates = {}
+    if contact is not None:
+        updates["contact"] = contact
+    if tolerance is not None:
+        updates["tolerance"] = parse_tolerance(tolerance)
+    if not updates:
+        return case
+    return dataclasses.replace(case, coefficients=case.coefficients.model_copy(update=updates))

@@ -226,9 +226,11 @@ class BemSection(Section):
 class CoefficientsSection(Section):
     """``[coefficients]``: the A(P), B(P), C(P) table (all optional)."""
 
-    depths: int = Field(default=60, ge=8, le=2000)
+    depths: int | None = Field(default=None, ge=8, le=2000)  # a fixed grid instead of the adaptive knots
     max_depth_nose_lengths: float = Field(default=300.0, gt=1.0)
     reading: Literal["body", "literal", "bernoulli"] = "body"
+    tolerance: float = Field(default=1e-5, gt=0.0, lt=0.1, description="relative interpolation error of the table")
+    contact: Literal["full", "separated"] = Field(default="full", description="contact region of eq. (15) in eq. (11)")
 
 
 # Other analyses' sections: name -> "module:Model" (imported only when used).

@@ -17,15 +17,23 @@ from semianalytic.coefficients import READINGS
 
 
 def add_arguments(parser) -> None:
-    from semianalytic.cli_types import integer, number
+    from semianalytic.cli_types import integer, number, output_dir
 
     parser.add_argument("case", help="TOML case file with [projectile]+[target] or [body]")
     parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
-    parser.add_argument("--depths", type=integer(8, 2000), default=None, help="number of depths (default: [coefficients].depths, 60)")
+    parser.add_argument("--depths", type=integer(8, 2000), default=None,
+                        help="a fixed grid of this many depths instead of the adaptive knots (default: adaptive)")
     parser.add_argument("--max-depth", type=number(1.0, 1e6, low_open=True), default=None, help="deepest depth in nose lengths (default 300)")
     parser.add_argument("--reading", choices=READINGS, default=None, help="reading of B for B_m2 (errata item 2a)")
     parser.add_argument("--refinement", type=number(0.0, 8.0, low_open=True), default=None, help="BEM panel-count multiplier")
     parser.add_argument("--order", type=integer(2, 16), default=None, help="Gauss points per panel")
+    parser.add_argument("--tolerance", default=None,
+                        help="relative interpolation error of the table, in (0, 0.1) (default: [coefficients].tolerance, 1e-5)")
+    parser.add_argument("--at", default=None, metavar="DEPTHS",
+                        help="rows at these depths only: lengths with units ('10 mm,59.0 mm') or nose lengths ('0.5Lh,5Lh')")
+    parser.add_argument("--interpolated", action="store_true",
+                        help="with --at: the values of the table the dynamics uses (default: direct BEM solves)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
 
 
 def run(args) -> int:
@@ -73,7 +81,10 @@ def _run_body(case, args) -> int:
 
 
 def _run_projectile(case, args) -> int:
-    from semianalytic.coefficients.table import coefficient_table
+    from semianalytic.cache import cached_coefficient_table
+    from semianalytic.coefficients.case import parse_tolerance
+    from semianalytic.coefficients.evaluate import rows_at, table_output
+    from semianalytic.errors import InputError
     from semianalytic.geometry import nose_from_section
 
     from semianalytic.guards import check_coefficients
@@ -83,45 +94,37 @@ def _run_projectile(case, args) -> int:
     reading = args.reading or case.coefficients.reading
     n_depths = args.depths or case.coefficients.depths
     max_depth = args.max_depth or case.coefficients.max_depth_nose_lengths
-    if n_depths < 8:
-        from semianalytic.errors import InputError
-
+    tolerance = parse_tolerance(args.tolerance) if args.tolerance is not None else case.coefficients.tolerance
+    if n_depths is not None and n_depths < 8:
         raise InputError("--depths", "needs at least 8 depths")
-    table = coefficient_table(
-        nose,
-        order=args.order or case.bem.order,
-        refinement=args.refinement or case.bem.refinement or 0.3,
-        n_depths=n_depths,
-        max_depth_nose_lengths=max_depth,
-        progress=not args.json and sys.stderr.isatty(),
-    )
-    area = math.pi * nose.diameter**2 / 4
+    order = args.order or case.bem.order
+    refinement = args.refinement or case.bem.refinement or 0.3
+    options = dict(order=order, refinement=refinement, max_depth_nose_lengths=max_depth,
+                   progress=not args.json and sys.stderr.isatty())
+    options.update(n_depths=n_depths) if n_depths is not None else options.update(tolerance=tolerance)
+
+    def build():
+        try:
+            return cached_coefficient_table(nose, args.cache_dir, **options)
+        except InputError as exc:  # name the flag when the flag set it
+            if exc.field == "coefficients.max_depth_nose_lengths" and args.max_depth:
+                raise InputError("--max-depth", exc.message) from None
+            raise
+
+    if args.at is not None:
+        out = rows_at(case, args.at, reading=reading, interpolated=args.interpolated, order=order,
+                      refinement=refinement, table_factory=build)
+        if args.json:
+            print(json.dumps(out))
+        else:
+            _print_rows(case, nose, out)
+        return 0
+    if args.interpolated:
+        raise InputError("--interpolated", "needs --at DEPTHS (the depths to read from the table)")
+    table = build()
+    out = table_output(table, nose, reading)
     v = table.values
-    out = {
-        "depth_m": table.depth.tolist(),
-        "A_m3": v["A"].tolist(),
-        "B_m2": v[f"B_{reading}"].tolist(),
-        "B_body_m2": v["B_body"].tolist(),
-        "B_literal_m2": v["B_literal"].tolist(),
-        "B_bernoulli_m2": v["B_bernoulli"].tolist(),
-        "C_m2": v["C"].tolist(),
-        "A_bar_m": (v["A"] / area).tolist(),
-        "B_bar": (v[f"B_{reading}"] / area).tolist(),
-        "C_bar": (v["C"] / area).tolist(),
-        "phi_tip_m": v["phi_tip"].tolist(),
-        "dA_dP_m2": v["dA_dP"].tolist(),
-        "unknowns": table.unknowns.tolist(),
-        "reading": reading,
-        "nose_length_m": nose.length,
-        "diameter_m": nose.diameter,
-        "deep_limit": {
-            "A_bar_m": table.limits["A"] / area,
-            "B_bar_body": table.limits["B_body"] / area,
-            "B_bar_literal": table.limits["B_literal"] / area,
-            "B_bar_bernoulli": table.limits["B_bernoulli"] / area,
-            "C_bar": table.limits["C"] / area,
-        },
-    }
+    area = math.pi * nose.diameter**2 / 4
     if args.json:
         print(json.dumps(out))
         return 0
@@ -140,4 +143,15 @@ def _run_projectile(case, args) -> int:
         f"deep limit: Abar = {d['A_bar_m'] * 1e3:.5f} mm, Bbar body/literal/bernoulli = "
         f"{d['B_bar_body']:.5f}/{d['B_bar_literal']:.5f}/{d['B_bar_bernoulli']:.1e}, Cbar = {d['C_bar']:.5f}"
     )
+    ea, eb = max(out["A_err_m3"]) / max(map(abs, out["A_m3"])), max(out["B_err_m2"]) / max(map(abs, out["B_m2"]))
+    print(f"{out['knots']} knots; estimated error (interpolation + BEM) at most {ea:.1e} of max |A|, {eb:.1e} of max |B|"
+          + (f" (tolerance {out['tolerance']:g})" if out["tolerance"] else ""))
     return 0
+
+
+def _print_rows(case, nose, out) -> None:
+    print(f"{case.title}: {nose.kind} nose, {out['source']} values (B reading {out['reading']})")
+    print(f"{'P [mm]':>10} {'Abar [mm]':>12} {'Bbar':>10} {'Cbar':>9} {'A_err [m3]':>11} {'B_err [m2]':>11}")
+    for r in out["rows"]:
+        print(f"{r['depth_m'] * 1e3:10.4f} {r['A_bar_m'] * 1e3:12.7f} {r['B_bar']:10.6f} {r['C_bar']:9.6f} "
+              f"{r['A_err_m3']:11.1e} {r['B_err_m2']:11.1e}")

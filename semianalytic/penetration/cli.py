@@ -54,6 +54,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--report", metavar="DIR", default=None, type=output_dir, help="write a markdown report with plots into DIR")
     parser.add_argument("--report-name", default=None, type=file_stem, help="report file stem (default: validation_<data name>)")
+    parser.add_argument("--contact", choices=("full", "separated"), default=None,
+                        help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
+    parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
@@ -124,6 +127,12 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             f" {_fmt(result['depth_eroding_m'][i], 1e3):>8} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} |"
             f" {'YES (outside the model)' if r['yields'] else 'no'}"
         )
+    est = result.get("depth_error_estimate_m")
+    if est:
+        worst = {k: max((e / d for e, d in zip(est[k], result[f"depth_{k}_m"]) if d and math.isfinite(d)), default=math.nan)
+                 for k in est}
+        p("  estimated numerical error of the depths (coefficient tables + integrator), at most: "
+          + ", ".join(f"{k.replace('_', ' ')} {v:.1e}" for k, v in worst.items()) + " relative")
     if "depth_quantiles_m" in result:
         p(f"  predictive depth from {result['posterior_file']}: median [5 %, 95 %] mm")
         for model, q in result["depth_quantiles_m"].items():
@@ -136,12 +145,25 @@ def _print_text(result: dict, desc: str, file=None) -> None:
             p(f"    {key:<18} mean {st['mean'] * 100:+6.1f} %   mean |e| {st['mean_abs'] * 100:5.1f} %   max |e| {st['max_abs'] * 100:5.1f} %")
 
 
+def _warn_separation(result: dict) -> None:
+    """Under full contact, say on stderr where the pressure of eq. (9) would separate (eq. (15))."""
+    onset = result.get("separation_onset_m") or []
+    hits = [(U, P) for U, P in zip(result["striking_velocity_m_s"], onset) if P is not None]
+    if hits and result.get("contact") == "full":
+        first = ", ".join(f"{U:.0f} m/s at P = {P * 1e3:.2f} mm" for U, P in hits[:3])
+        print(f"warning: {result['case']}: the contact pressure (eq. (9)) turns negative on the nose for {len(hits)} "
+              f"striking velocities ({first}{', ...' if len(hits) > 3 else ''}): the target would separate (eq. (15)); "
+              "full contact is assumed (try --contact separated)", file=sys.stderr)
+
+
 def run(args) -> int:
     from semianalytic.io import check_report_target
     from semianalytic.cache import coefficients_for_case
     from semianalytic.penetration.evaluate import evaluate_case
 
-    cases = _load(args.cases)
+    from semianalytic.cache import override_coefficients
+
+    cases = [override_coefficients(c, contact=args.contact, tolerance=args.tolerance) for c in _load(args.cases)]
     if args.coefficients == "bem":  # refuse before solving what would not fit in memory
         from semianalytic.guards import check_coefficients
 
@@ -164,6 +186,7 @@ def run(args) -> int:
             quantiles = predict_with_posterior(case, coefficients, args.posterior)
         results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model), **quantiles))
         descs.append(desc)
+        _warn_separation(results[-1])
         for line in results[-1]["warnings"]:
             print(f"{line} [{case.path or case.title}]", file=sys.stderr)
     if args.json:

@@ -78,6 +78,7 @@ class PenetrationSetup:
     poisson_ratio: float | None = None
     yield_stress: float | None = None
     phi: float = 1.0
+    contact: str = "full"  # "separated": eq. (11) over the wetted part of eq. (15) (BEM tables only)
 
     @classmethod
     def from_case(cls, case, coefficients, *, mass: float | None = None, require_material: bool = True):
@@ -107,7 +108,8 @@ class PenetrationSetup:
             if psec.yield_stress is not None:
                 lam = crit.slenderness(projectile.length, psec.diameter)
                 phi = crit.buckling_factor(psec.buckling, lam, psec.youngs_modulus, psec.yield_stress, psec.buckling_table)
-        return cls(coefficients, m, float(tsec.density), R, rod, psec.poisson_ratio, psec.yield_stress, float(phi))
+        return cls(coefficients, m, float(tsec.density), R, rod, psec.poisson_ratio, psec.yield_stress, float(phi),
+                   contact=case.coefficients.contact)
 
     def critical_inputs(self) -> crit.CriticalInputs:
         A, B, C = deep_coefficients(self.coefficients)
@@ -234,6 +236,7 @@ def penetration_curve(
     elastic: bool = True,
     n_grid: int = 512,
     rtol: float | None = None,
+    panel_scale: float = 1.0,
 ) -> dict[str, np.ndarray]:
     """Every Part I projectile model for each striking velocity (arrays, SI; keys carry units).
 
@@ -253,7 +256,16 @@ def penetration_curve(
     U = np.atleast_1d(np.asarray(striking_velocities, float))
     if U.size == 0 or np.any(~np.isfinite(U)) or np.any(U <= 0):
         raise InputError("impact.striking_velocities", "must be positive (m/s)")
-    prof = depth_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa, float(U.max()))
+    if setup.contact == "separated":
+        from semianalytic.penetration.motion import separated_profile
+
+        if not hasattr(setup.coefficients, "nodes"):
+            raise InputError("coefficients.contact", "'separated' needs the BEM table's surface solution (not constant coefficients)")
+        prof = separated_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa,
+                                 rtol=1e-10 * panel_scale)
+    else:
+        prof = depth_profile(setup.coefficients, setup.mass, setup.target_density, setup.resistance_pa, float(U.max()),
+                             panel_scale=panel_scale)
     rigid = _stops(prof, U, n_grid)
     nan = np.full(U.shape, np.nan)
     out = {

@@ -13,7 +13,20 @@ import numpy as np
 
 from semianalytic.errors import InputError
 
-__all__ = ["evaluate_case"]
+__all__ = ["evaluate_case", "contact_summary"]
+
+
+def contact_summary(setup, U) -> dict:
+    """``contact`` (the mode) and ``separation_onset_m``: per striking velocity, the first depth
+    at which the full-contact pressure of eq. (9) would separate (eq. (15)), or None."""
+    from semianalytic.penetration.motion import depth_profile, separation_onset
+
+    coef = setup.coefficients
+    if not hasattr(coef, "nodes"):
+        return {"contact": setup.contact, "separation_onset_m": [None] * len(U)}
+    prof = depth_profile(coef, setup.mass, setup.target_density, setup.resistance_pa, float(np.max(U)))
+    return {"contact": setup.contact,
+            "separation_onset_m": separation_onset(coef, setup.mass, setup.target_density, setup.resistance_pa, prof, U)}
 
 
 def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, part1_model: str | None = None) -> dict:
@@ -69,6 +82,10 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
     )
     for key, val in res.items():
         out[key] = np.asarray(val).tolist()
+    from semianalytic.penetration.accuracy import depth_error_estimate
+
+    out["depth_error_estimate_m"] = depth_error_estimate(setup, U, res, w1=w1)
+    out.update(contact_summary(setup, U))
     pe = peer_depths(case, setup, U)
     out["depth_forrestal_m"] = pe["forrestal"].tolist()
     out["depth_chen_li_m"] = pe["chen_li"].tolist()

@@ -440,3 +440,158 @@ def final_depth(coefficients, mass: float, target_density: float, resistance_pa:
         return np.zeros_like(U0)[()]
     prof = depth_profile(coefficients, mass, target_density, resistance_pa, float(np.max(U0)))
     return prof.final_depth(U0)
+
+
+# --------------------------------------------------------------------------------------
+# the contact region of eq. (15) in eq. (11): coefficients of the wetted part
+
+
+class WettedCorrection:
+    """A(P, u), B(P, u), C(P, u) of the wetted part of the nose (Part I, eqs. (11), (15)).
+
+    At each table knot the surface solution stored with it gives, for a speed u, the
+    deceleration of eq. (11) with the pressure integrated over the wetted part only
+    (:func:`semianalytic.coefficients.contact.separated_acceleration`, a fixed point in
+    du/dt); the change of A, B, C from full contact is interpolated linearly in P between
+    knots and added to the table's (full-contact) values.  No BEM solve per step.
+    """
+
+    def __init__(self, table, mass: float, target_density: float, resistance_pa: float, reading: str | None = None):
+        self.table = table
+        self.mass, self.rho, self.R = float(mass), float(target_density), float(resistance_pa)
+        self.reading = reading or getattr(table, "reading", "body")
+        self.depth = np.asarray(table.depth, float)
+        self._full = []
+        from semianalytic.coefficients.contact import pressure_terms
+
+        for nodes in table.nodes:
+            phi, q = pressure_terms(nodes, self.reading)
+            wn = nodes["weight"] * nodes["nx"]
+            self._full.append((float(np.sum(wn * phi)), float(np.sum(wn * q)), float(np.sum(wn))))
+
+    def _delta(self, k: int, u: float) -> np.ndarray:
+        from semianalytic.coefficients.contact import separated_acceleration
+
+        _, wet = separated_acceleration(self.table.nodes[k], self.reading, self.mass, self.rho, u, self.R)
+        return np.subtract(wet, self._full[k])
+
+    def coefficients(self, P: float, u: float) -> tuple[float, float, float]:
+        """(A_w, B_w, C_w) at depth P and speed u [m^3, m^2, m^2]."""
+        t = self.table
+        full = np.array([float(t.A(P)), float(t.B(P, self.reading)), float(t.C(P))])
+        d = self.depth
+        k = int(np.searchsorted(d, P))
+        if k == 0:
+            delta = self._delta(0, u) * (P / d[0] if d[0] > 0 else 1.0)
+        elif k >= len(d):
+            delta = self._delta(len(d) - 1, u)
+        else:
+            w = (P - d[k - 1]) / (d[k] - d[k - 1])
+            delta = (1 - w) * self._delta(k - 1, u) + w * self._delta(k, u)
+        A, B, C = full + delta
+        return float(A), float(B), float(C)
+
+    def acceleration(self, P: float, u: float) -> float:
+        """du/dt of Part I, eq. (11) with the wetted coefficients."""
+        A, B, C = self.coefficients(P, u)
+        return -(0.5 * self.rho * B * u * u + C * self.R) / (self.mass + self.rho * A)
+
+
+@dataclass(frozen=True, eq=False)
+class SeparatedProfile:
+    """u^2(P) of Part I, eq. (11) with the contact region of eq. (15) for each start velocity
+    (one integration in P per velocity, w = u^2, dw/dP = 2 du/dt; DOP853 with an event at
+    w = 0).  Offers the methods of :class:`DepthProfile` that the models use."""
+
+    wetted: WettedCorrection
+    rtol: float = 1e-10
+    _runs: dict = field(default_factory=dict, repr=False)
+
+    def _run(self, U0: float):
+        U0 = float(U0)
+        if U0 not in self._runs:
+            wc = self.wetted
+            d = float(wc.table.diameter)
+
+            def rhs(P, y):
+                w = max(y[0], 0.0)
+                return [2.0 * wc.acceleration(max(P, 0.0), math.sqrt(w))]
+
+            def stop(P, y):
+                return y[0]
+
+            stop.terminal, stop.direction = True, -1
+            A8, B8, C8 = deep_coefficients(wc.table)
+            P_end = 10.0 * ConstantCoefficientSolution(A8, B8, C8, wc.mass, wc.rho, wc.R, U0).final_depth + 100.0 * d
+            sol = solve_ivp(rhs, (0.0, P_end), [U0 * U0], method="DOP853", rtol=self.rtol, atol=self.rtol * U0 * U0,
+                            events=stop, dense_output=True)
+            if U0 == 0.0:
+                self._runs[U0] = (0.0, None, 0.0)
+            else:
+                if sol.status != 1 or not len(sol.t_events[0]):
+                    raise RuntimeError(f"eq. (11) with separation did not stop before P = {P_end:g} m")
+                P_f = float(sol.t_events[0][0])
+                slope = -2.0 * wc.acceleration(P_f, 0.0)  # -dw/dP at the stop
+                self._runs[U0] = (P_f, sol.sol, slope)
+        return self._runs[U0]
+
+    def final_depth(self, U0):
+        U0 = np.asarray(U0, float)
+        return np.array([self._run(u)[0] for u in U0.ravel()]).reshape(U0.shape)[()]
+
+    def speed2(self, U0, P):
+        U0 = np.asarray(U0, float)
+        P = np.asarray(P, float)
+        U0b, Pb = np.broadcast_arrays(U0, P)
+        out = np.empty(Pb.shape)
+        for idx in np.ndindex(Pb.shape[:-1] if Pb.ndim > 1 else ()):
+            u = float(U0b[idx].ravel()[0]) if Pb.ndim > 1 else float(U0b.ravel()[0])
+            P_f, dense, _ = self._run(u)
+            row = Pb[idx]
+            if dense is None:
+                out[idx] = 0.0
+            else:
+                out[idx] = np.where(row <= P_f, dense(np.minimum(row, P_f))[0], 0.0)
+        return out
+
+    def F(self, P):
+        return np.zeros_like(np.asarray(P, float))
+
+    def dG(self, P):
+        """-dw/dP at the stop of the run whose final depth is P (used for the time at the stop)."""
+        P = np.asarray(P, float)
+        lookup = {run[0]: run[2] for run in self._runs.values()}
+        return np.array([lookup.get(float(p), np.nan) for p in P.ravel()]).reshape(P.shape)
+
+
+def separated_profile(table, mass: float, target_density: float, resistance_pa: float, rtol: float = 1e-10):
+    """The :class:`SeparatedProfile` of a BEM table (Part I, eqs. (11), (15))."""
+    return SeparatedProfile(WettedCorrection(table, mass, target_density, resistance_pa), rtol)
+
+
+def separation_onset(table, mass: float, target_density: float, resistance_pa: float, profile, U0) -> list:
+    """Per start velocity: the first knot depth [m] at which the full-contact pressure of
+    eq. (9) would turn negative somewhere on the nose (eq. (15)), or None."""
+    from semianalytic.coefficients.contact import pressure_terms
+
+    reading = getattr(table, "reading", "body")
+    rho, R, m = float(target_density), float(resistance_pa), float(mass)
+    P_k = np.asarray(table.depth, float)
+    out = []
+    for U in np.atleast_1d(np.asarray(U0, float)):
+        P_f = float(profile.final_depth(U))
+        hit = None
+        inside = np.nonzero(P_k < P_f)[0]
+        if inside.size:
+            u2 = np.maximum(profile.speed2(U, P_k[inside]), 0.0)
+            for k, w in zip(inside, u2):
+                nodes = table.nodes[k]
+                phi, q = pressure_terms(nodes, reading)
+                A, B, C = float(table.A(P_k[k])), float(table.B(P_k[k])), float(table.C(P_k[k]))
+                a = -(0.5 * rho * B * w + C * R) / (m + rho * A)
+                p = rho * phi * a + q * rho * w / 2 + R
+                if np.any((p <= 0) & (nodes["nx"] > 1e-12)):
+                    hit = float(P_k[k])
+                    break
+        out.append(hit)
+    return out

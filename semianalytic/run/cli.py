@@ -23,6 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render (VTK files are still written)")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
     parser.add_argument("--json", action="store_true", help="print results.json to stdout as well")
+    parser.add_argument("--contact", choices=("full", "separated"), default=None,
+                        help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
+    parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -33,7 +36,8 @@ def run(args: argparse.Namespace) -> int:
     check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
     out = Path(args.out)
     results = run_case(
-        args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir
+        args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir,
+        contact=args.contact, tolerance=args.tolerance,
     )
     if args.json:
         print(json.dumps(results, indent=2, default=str))

@@ -27,8 +27,10 @@ from semianalytic.run.registry import Step, _mm, _projectile, select_steps
 __all__ = ["run_case", "introduction"]
 
 
-def run_case(case_path, out, *, force: bool = False, only=None, render: bool = True, cache_dir=None) -> dict:
-    """Run a case into ``out``; returns the results dict (also written to ``out/results.json``)."""
+def run_case(case_path, out, *, force: bool = False, only=None, render: bool = True, cache_dir=None,
+             contact=None, tolerance=None) -> dict:
+    """Run a case into ``out``; returns the results dict (also written to ``out/results.json``).
+    ``contact`` / ``tolerance`` override ``[coefficients]`` (flags ``--contact``, ``--tolerance``)."""
     from semianalytic.case import load_case
     from semianalytic.report.document import Document, to_markdown
     from semianalytic.report.html import to_html
@@ -39,6 +41,10 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     t0 = time.perf_counter()
     case = load_case(case_path)
     identity = case_identity(case_path)
+    if contact is not None or tolerance is not None:
+        from semianalytic.cache import override_coefficients
+
+        case = override_coefficients(case, contact=contact, tolerance=tolerance)
     run_section = case.section("run") or RunSection()
     steps, skipped = select_steps(case, run_section, only)
     check_output_dir(out, force)

@@ -38,6 +38,7 @@ _GEOMETRY_PREFIXES = (
     "bem.",
     "coefficients.depths",
     "coefficients.max_depth_nose_lengths",
+    "coefficients.tolerance",
 )
 
 
@@ -56,6 +57,7 @@ def geometry_key(case: Case) -> str:
         "refinement": case.bem.refinement,
         "depths": case.coefficients.depths,
         "max_depth_nose_lengths": case.coefficients.max_depth_nose_lengths,
+        "tolerance": case.coefficients.tolerance,
     }
     return json.dumps({"nose": nose, "options": opts}, sort_keys=True, default=repr)
 

@@ -1,0 +1,120 @@
+"""Studies behind the coefficient reports: the certified tables against direct BEM solves at
+random depths, their cost, and the effect of the contact region of eq. (15) on the depths.
+
+Called by ``python -m semianalytic bench-bem`` (which writes the reports) and by the tests.
+"""
+
+from __future__ import annotations
+
+import math
+import time
+
+import numpy as np
+
+__all__ = ["STUDY_NOSES", "study_nose", "random_depths", "table_error_study", "certified_timing", "contact_effect"]
+
+
+def study_nose(kind: str, diameter: float = 7.11e-3):
+    """The noses of the table studies (Fig. 5 ogive and sphere; 30-degree cone; flat; a table nose)."""
+    from semianalytic import geometry as g
+
+    if kind == "ogive":
+        return g.ogive_nose(diameter, 3.0)
+    if kind == "sphere":
+        return g.sphere_nose(diameter)
+    if kind == "cone":
+        return g.cone_nose(diameter, math.radians(30.0))
+    if kind == "flat":
+        return g.flat_nose(diameter)
+    if kind == "table":
+        pts = [[0, 0], [2e-3, 1.8e-3], [4e-3, 2.7e-3], [6e-3, 3.2e-3], [8e-3, 0.5 * diameter]]
+        return g.table_nose([(x * diameter / 7.11e-3, r * diameter / 7.11e-3) for x, r in pts], diameter)
+    raise ValueError(f"unknown study nose {kind!r}")
+
+
+STUDY_NOSES = ("ogive", "sphere", "cone", "flat", "table")
+
+
+def random_depths(nose, n: int, seed: int) -> np.ndarray:
+    """Seeded random depths: a third in 0.9-1.3 L_h (just past the shoulder, where the
+    coefficients change fastest), the rest log-uniform from 0.01 to 200 nose lengths."""
+    rng = np.random.default_rng(seed)
+    L = nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    k = n // 3
+    near = rng.uniform(0.9, 1.3, k)
+    far = np.exp(rng.uniform(math.log(0.01), math.log(200.0), n - k))
+    return np.sort(np.concatenate([near, far])) * L
+
+
+def table_error_study(nose, table, depths) -> dict:
+    """Per coefficient (A, B_body, B_literal, B_bernoulli, C): the largest |interpolated -
+    direct| over the depths relative to the coefficient's largest magnitude, and the smallest
+    ratio of the table's error estimate to that actual difference."""
+    from semianalytic.coefficients.table import CONTROLLED, direct_coefficients
+
+    rows = direct_coefficients(nose, depths, order=table.options["order"], refinement=table.options["refinement"],
+                               levels=table.options["levels"])
+    scale = table.max_abs
+    out = {}
+    for q in CONTROLLED:
+        direct = np.array([r[q] for r in rows])
+        interp = np.asarray(table._eval(q, np.asarray(depths, float)))
+        actual = np.abs(interp - direct)
+        est = np.asarray(table.error(q, np.asarray(depths, float)))
+        out[q] = {
+            "max_rel_error": float(np.max(actual) / scale[q]),
+            "min_estimate_ratio": float(np.min(est / np.maximum(actual, 1e-300))),
+            "bounded": int(np.sum(est >= actual)),
+            "n": len(depths),
+        }
+    return out
+
+
+def certified_timing(kind: str, repeats: int = 2, tolerance: float = 1e-5) -> dict:
+    """Best wall time of a certified table and of the legacy 60-depth table, in the same run."""
+    from semianalytic.coefficients.table import coefficient_table
+
+    nose = study_nose(kind)
+    best = {"certified": math.inf, "fixed60": math.inf}
+    table = None
+    for _ in range(repeats):
+        t = time.perf_counter()
+        table = coefficient_table(nose, tolerance=tolerance)
+        best["certified"] = min(best["certified"], time.perf_counter() - t)
+        t = time.perf_counter()
+        coefficient_table(nose, n_depths=60, bem_error=False)
+        best["fixed60"] = min(best["fixed60"], time.perf_counter() - t)
+    return {"nose": kind, "knots": len(table.depth), **best}
+
+
+def contact_effect(case_paths, cache_dir=None) -> list[dict]:
+    """Depths of each case with full contact and with the contact region of eq. (15)
+    (``separated``), the relative change, and where the full-contact pressure would separate."""
+    import dataclasses
+
+    from semianalytic.cache import coefficients_for_case
+    from semianalytic.case import load_case
+    from semianalytic.penetration.evaluate import contact_summary
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+    out = []
+    for path in case_paths:
+        case = load_case(path)
+        table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
+        setup = PenetrationSetup.from_case(case, table, require_material=False)
+        U = np.asarray(case.impact.striking_velocities, float)
+        elastic = setup.rod is not None and setup.yield_stress is not None
+        t = time.perf_counter()
+        full = penetration_curve(dataclasses.replace(setup, contact="full"), U, elastic=elastic)
+        t_full = time.perf_counter() - t
+        t = time.perf_counter()
+        sep = penetration_curve(dataclasses.replace(setup, contact="separated"), U, elastic=elastic)
+        t_sep = time.perf_counter() - t
+        onset = contact_summary(setup, U)["separation_onset_m"]
+        rel = {k: float(np.nanmax(np.abs(sep[k] / full[k] - 1.0))) if np.any(np.isfinite(full[k])) else math.nan
+               for k in ("depth_rigid_m", "depth_elastic_exact_rod_m")}
+        out.append({"case": str(path), "velocities": len(U), "separating": sum(p is not None for p in onset),
+                    "onset_velocity_m_s": min((u for u, p in zip(U, onset) if p is not None), default=None),
+                    "max_rel_change_rigid": rel["depth_rigid_m"], "max_rel_change_elastic_exact_rod": rel["depth_elastic_exact_rod_m"],
+                    "time_full_s": t_full, "time_separated_s": t_sep})
+    return out

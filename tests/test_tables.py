@@ -1,0 +1,273 @@
+"""Certified coefficient tables (issue 11): the table against direct BEM solves at seeded
+random depths it did not choose (0.9-1.3 L_h included), error estimates that bound the
+actual errors, breakpoints, the deep limit, ``coefficients --at``, the penetration depth's
+error estimate and the contact region of eq. (15).
+
+The references are independent of the interpolation under test: direct BEM solves at
+exactly the test depths (same discretisation: the interpolation error alone), refined BEM
+solves (higher order and more panels: the total error), and the equation of motion solved
+again on a table 100 times tighter.
+"""
+
+from __future__ import annotations
+
+import json
+import math
+
+import numpy as np
+import pytest
+
+from semianalytic.cli import main
+from semianalytic.coefficients.study import random_depths, study_nose, table_error_study
+from semianalytic.coefficients.table import (
+    CONTROLLED,
+    breakpoints,
+    coefficient_table,
+    direct_coefficients,
+)
+from semianalytic.errors import InputError
+
+TOL = 1e-5  # the default tolerance: relative to each coefficient's largest magnitude over the table
+# cornered noses cost 2-3 times the knots of smooth ones at 1e-5; CI checks them looser (the
+# slow study below and reports/bem_coefficients.md at 1e-5)
+CI_TOL = {"ogive": TOL, "sphere": TOL, "cone": 1e-3, "flat": 1e-4, "table": 1e-3}
+FIG5 = "cases/fig5_ogive.toml"
+
+
+@pytest.fixture(scope="module")
+def tables():
+    cache = {}
+
+    def get(kind):
+        if kind not in cache:
+            nose = study_nose(kind)
+            cache[kind] = (nose, coefficient_table(nose, tolerance=CI_TOL[kind]))
+        return cache[kind]
+
+    return get
+
+
+@pytest.mark.parametrize("kind,seed", [("ogive", 11), ("sphere", 12), ("cone", 13), ("flat", 14), ("table", 15)])
+def test_table_against_direct_solves_at_random_depths(tables, kind, seed):
+    """20 seeded random depths per nose, a third of them in 0.9-1.3 L_h (past the shoulder,
+    where the old table was 10-93 % off): interpolated within the tolerance of the direct
+    solve, and the table's own estimate at least the actual difference at every depth."""
+    nose, table = tables(kind)
+    depths = random_depths(nose, 20, seed)
+    L = nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    assert np.sum((depths >= 0.9 * L) & (depths <= 1.3 * L)) >= 6
+    assert not np.any(np.isin(depths, table.depth))  # off the knots
+    study = table_error_study(nose, table, depths)
+    for q in CONTROLLED:
+        assert study[q]["bounded"] == study[q]["n"], (q, study[q])
+        if table.options["noise_limited_intervals"] == 0:
+            # the target: the table's tolerance, with no slack
+            assert study[q]["max_rel_error"] <= CI_TOL[kind], (q, study[q])
+
+
+def test_estimates_bound_the_error_against_a_refined_bem(tables):
+    """Total error (interpolation + BEM discretisation) against refined BEM solves (order 10,
+    twice the panels) at depths the table did not choose."""
+    nose, table = tables("ogive")
+    depths = random_depths(nose, 6, 21)
+    ref = direct_coefficients(nose, depths, order=10, refinement=0.6, levels=8)
+    for q in CONTROLLED:
+        actual = np.abs(np.asarray(table._eval(q, depths)) - np.array([r[q] for r in ref]))
+        assert np.all(actual <= np.asarray(table.error(q, depths))), q
+
+
+def test_breakpoint_depth_gives_finite_values():
+    """A depth at a breakpoint (L_h (1 + 1e-9) on a cone, where the layout changes topology)
+    is finite in the table and in a direct solve, and lies between the one-sided values."""
+    nose = study_nose("cone")
+    assert breakpoints(nose) == pytest.approx([nose.length], rel=1e-12)
+    P = nose.length * (1 + 1e-9)
+    row = direct_coefficients(nose, [P])[0]
+    lo, hi = direct_coefficients(nose, [nose.length * (1 - 1e-6), nose.length * (1 + 1e-6)])
+    for q in CONTROLLED:
+        assert math.isfinite(row[q])
+        assert min(lo[q], hi[q]) <= row[q] <= max(lo[q], hi[q])
+
+
+def test_breakpoints_from_the_meridian():
+    """Kinks where the meridian's segments join and at L_h (a flat nose with a rounded edge:
+    the edge's end at P = r_c; a smooth ogive: only L_h)."""
+    from semianalytic.geometry import flat_nose, ogive_nose
+
+    assert breakpoints(ogive_nose(7.11e-3, 3.0)) == pytest.approx([ogive_nose(7.11e-3, 3.0).length])
+    assert breakpoints(flat_nose(7.11e-3, 1e-3)) == pytest.approx([1e-3])
+
+
+def test_deep_limit_and_evaluation_past_the_table(tables):
+    """The deep limit against a direct solve 10^4 nose lengths deep (never a knot), within
+    the table's error estimate there; evaluation at any depth is finite."""
+    nose, table = tables("sphere")
+    P = 1e4 * nose.length
+    direct = direct_coefficients(nose, [P])[0]
+    for q in ("A", "B_body", "C"):
+        assert abs(float(table._eval(q, P)) - direct[q]) <= float(table.error(q, P)), q
+    assert np.all(np.isfinite(table.B(np.array([0.0, nose.length, 1e9]))))
+
+
+def test_a_table_stopped_short_of_the_deep_limit_is_an_error():
+    with pytest.raises(InputError) as exc:
+        coefficient_table(study_nose("sphere"), max_depth_nose_lengths=3.0)
+    assert exc.value.field == "coefficients.max_depth_nose_lengths"
+
+
+def test_hermite_A_agrees_with_its_derivative(tables):
+    """dA/dP of the interpolant against the BEM's B_bernoulli (= dA/dP, errata 2a) at random
+    depths: the derivative of a 1e-5 interpolant, so 1e-3 of max |B_bernoulli|."""
+    nose, table = tables("ogive")
+    depths = random_depths(nose, 8, 31)
+    rows = direct_coefficients(nose, depths)
+    scale = table.max_abs["B_bernoulli"]
+    for P, r in zip(depths, rows):
+        assert abs(float(table.dA_dP(P)) - r["B_bernoulli"]) <= 1e-3 * scale
+
+
+# --- the command line -------------------------------------------------------------------
+
+
+def _json(capsys, argv):
+    rc = main(argv)
+    cap = capsys.readouterr()
+    assert rc == 0, cap.err
+    return json.loads(cap.out)
+
+
+KEYS = ("depth_m", "A_m3", "B_m2", "B_literal_m2", "B_bernoulli_m2", "C_m2", "A_bar_m", "B_bar", "C_bar",
+        "phi_tip_m", "dA_dP_m2", "A_err_m3", "B_err_m2", "C_err_m2")
+
+
+def test_cli_at_direct_and_interpolated(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
+    direct = _json(capsys, ["coefficients", FIG5, "--at", "10 mm,59.0 mm", "--json"])["rows"]
+    assert [r["depth_m"] for r in direct] == pytest.approx([0.010, 0.059], rel=1e-12)
+    assert all(set(KEYS) <= set(r) for r in direct)
+    interp = _json(capsys, ["coefficients", FIG5, "--at", "10 mm,59.0 mm", "--interpolated", "--json"])["rows"]
+    assert all(set(KEYS) <= set(r) for r in interp)
+    for d, i in zip(direct, interp):  # the table within its estimate of the direct solve
+        assert abs(d["A_m3"] - i["A_m3"]) <= i["A_err_m3"] + d["A_err_m3"]
+        assert abs(d["B_m2"] - i["B_m2"]) <= i["B_err_m2"] + d["B_err_m2"]
+        assert abs(d["C_m2"] - i["C_m2"]) <= i["C_err_m2"] + d["C_err_m2"]
+    lh = _json(capsys, ["coefficients", FIG5, "--at", "0.5Lh,1Lh", "--json"])
+    assert [r["depth_m"] for r in lh["rows"]] == pytest.approx([0.5 * lh["nose_length_m"], lh["nose_length_m"]])
+    assert all(math.isfinite(r["B_m2"]) for r in lh["rows"])
+
+
+@pytest.mark.parametrize(
+    "argv,field",
+    [
+        (["--at", "5"], "--at"),
+        (["--at", "3 kg"], "--at"),
+        (["--at", "-1 mm"], "--at"),
+        (["--at", "1 mm,,2 mm"], "--at"),
+        (["--at", "xLh"], "--at"),
+        (["--tolerance", "tight"], "--tolerance"),
+        (["--tolerance", "0"], "--tolerance"),
+        (["--tolerance=-1e-5"], "--tolerance"),
+        (["--tolerance", "0.1"], "--tolerance"),
+    ],
+)
+def test_cli_bad_input(capsys, tmp_path, monkeypatch, argv, field):
+    monkeypatch.chdir(tmp_path)
+    rc = main(["coefficients", str(__import__("pathlib").Path(__file__).parent.parent / FIG5), *argv, "--json"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err.startswith(f"error: {field}"), err
+    assert list(tmp_path.iterdir()) == []  # nothing written
+
+
+def test_cli_too_shallow_table_names_the_key(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path))
+    case = tmp_path / "shallow.toml"
+    case.write_text(open(FIG5).read() + "\n[coefficients]\nmax_depth_nose_lengths = 3\n")
+    rc = main(["coefficients", str(case), "--json"])
+    err = capsys.readouterr().err.strip()
+    assert rc == 2 and err.startswith("error: coefficients.max_depth_nose_lengths"), err
+
+
+# --- penetration: error estimates and the contact region --------------------------------
+
+PIEK = "cases/piekutowski1999_var4340.toml"
+
+
+def test_depth_error_estimate_bounds_a_tighter_table(capsys, tmp_path, monkeypatch):
+    """penetrate's depth_error_estimate_m against the depths recomputed on a table 100 times
+    tighter with a finer integration, at striking velocities not in the case."""
+    from semianalytic.case import load_case
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.penetration.accuracy import MODEL_KEYS, depth_error_estimate
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+    case = load_case(PIEK)
+    nose = nose_from_section(case.projectile)
+    U = np.array([555.0, 1033.0])
+    table = coefficient_table(nose).with_reading(case.coefficients.reading)
+    setup = PenetrationSetup.from_case(case, table, require_material=False)
+    nominal = penetration_curve(setup, U)
+    est = depth_error_estimate(setup, U, nominal)
+    assert set(est) == set(MODEL_KEYS)
+    tight = coefficient_table(nose, tolerance=1e-7, max_depth_nose_lengths=3000).with_reading(case.coefficients.reading)
+    ref = penetration_curve(PenetrationSetup.from_case(case, tight, require_material=False), U, n_grid=2048,
+                            panel_scale=0.25)
+    for k, key in MODEL_KEYS.items():
+        actual = np.abs(np.asarray(nominal[key]) - np.asarray(ref[key]))
+        assert np.all(actual <= np.asarray(est[k])), (k, actual, est[k])
+    # the issue's target: the rigid depth's estimated numerical error below 1e-6 relative
+    assert np.all(np.asarray(est["rigid"]) / nominal["depth_rigid_m"] < 1e-6)
+
+
+def test_penetrate_json_keys_and_separation_warning(capsys, tmp_path, monkeypatch):
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path))
+    out = _json(capsys, ["penetrate", "cases/fig14_sphere_6061T651.toml", "--json"])
+    est = out["depth_error_estimate_m"]
+    assert set(est) == {"rigid", "quasi_rigid", "elastic", "elastic_exact_rod"}
+    assert all(len(v) == len(out["striking_velocity_m_s"]) for v in est.values())
+    assert out["contact"] == "full"
+    # Fig. 14: the sphere separates near the shoulder at the highest velocities (eq. (15))
+    assert out["separation_onset_m"][-1] is not None and out["separation_onset_m"][0] is None
+    main(["penetrate", "cases/fig14_sphere_6061T651.toml"])
+    assert "separate" in capsys.readouterr().err
+
+
+def test_separated_contact_equals_full_without_separation_and_changes_little_with_it(tmp_path):
+    """With no negative pressure the wetted coefficients are the full ones (same depth to the
+    integrators' tolerance); on the Fig. 14 sphere at 1.5 km/s the separation near the
+    shoulder changes the rigid depth by less than 1e-4 (measured ~1e-6; see the report)."""
+    import dataclasses
+
+    from semianalytic.case import load_case
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+    case = load_case("cases/fig14_sphere_6061T651.toml")
+    table = coefficient_table(nose_from_section(case.projectile))
+    setup = PenetrationSetup.from_case(case, table, require_material=False)
+    U = np.array([400.0, 1500.0])
+    full = penetration_curve(setup, U, elastic=False)
+    sep = penetration_curve(dataclasses.replace(setup, contact="separated"), U, elastic=False)
+    assert sep["depth_rigid_m"][0] == pytest.approx(full["depth_rigid_m"][0], rel=1e-8)
+    assert sep["depth_rigid_m"][1] == pytest.approx(full["depth_rigid_m"][1], rel=1e-4)
+
+
+def test_contact_flag_bad_value_exits_2(capsys):
+    try:
+        rc = main(["penetrate", PIEK, "--contact", "partial"])
+    except SystemExit as exc:  # argparse's own exit
+        rc = exc.code
+    assert rc == 2
+    assert "--contact" in capsys.readouterr().err
+
+
+@pytest.mark.slow
+@pytest.mark.parametrize("kind", ["ogive", "sphere", "cone", "flat", "table"])
+def test_table_study_200_depths(kind):
+    """The issue's target study: 200 random depths per nose (numbers in reports/bem_coefficients.md)."""
+    nose = study_nose(kind)
+    table = coefficient_table(nose)
+    study = table_error_study(nose, table, random_depths(nose, 200, 1000))
+    for q in CONTROLLED:
+        assert study[q]["bounded"] == study[q]["n"], (q, study[q])
+        if table.options["noise_limited_intervals"] == 0:
+            assert study[q]["max_rel_error"] <= TOL, (q, study[q])
