@@ -100,6 +100,8 @@ class ProjectileSection(Section):
     crh: float | None = Field(default=None, description="ogive caliber radius head psi = s/d")
     half_angle: Angle | None = None
     corner_radius: NonNegativeLength | None = None
+    meplat_diameter: NonNegativeLength | None = Field(default=None, description="ogive/cone: flat tip of this diameter (truncated nose)")
+    tip_radius: NonNegativeLength | None = Field(default=None, description="ogive/cone: spherically blunted tip of this radius")
     points: list[tuple[float, float]] | None = None
     points_unit: LengthUnit | None = None
     # material (Part I, section 2: elastic projectile and critical velocity)
@@ -142,6 +144,12 @@ class ProjectileSection(Section):
         the lengths against it.  Raises ``InputError``."""
         from semianalytic.geometry import nose_from_section
 
+        uses = {"crh": ("ogive",), "half_angle": ("cone",), "corner_radius": ("flat",),
+                "meplat_diameter": ("ogive", "cone"), "tip_radius": ("ogive", "cone"),
+                "points": ("table",), "points_unit": ("table",)}
+        for key, kinds in uses.items():
+            if getattr(self, key) is not None and self.nose not in kinds:
+                raise InputError(f"projectile.{key}", f"has no use for a '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")
         nose = nose_from_section(self)
         if self.length is not None:
             shank = self.length - nose.length

@@ -288,11 +288,41 @@ class Nose:
         dx, dr = (float(v) for v in s.derivative(s.t0))
         return math.atan2(abs(dr), abs(dx))
 
+    def corners(self, tol: float = 1e-9) -> list[tuple[float, float, float]]:
+        """Corners of the nose found from its geometry (tangent jumps), tip to shoulder:
+        (x, r, turning angle in rad, > 0 convex) in the body frame (tip at x = 0, body
+        along -x).  A conical tip (half-angle below 90 deg) counts as a corner with its
+        turning angle pi/2 - half-angle; the shoulder counts where the last tangent is not
+        along the shank."""
+        out = []
+        half = self.tip_half_angle()
+        if half < 0.5 * math.pi - tol:
+            out.append((0.0, 0.0, 0.5 * math.pi - half))
+        turning = Meridian(self.segments, closed=False).corners(tol) if len(self.segments) > 1 else []
+        for seg, ang in zip(self.segments[:-1], turning):
+            if ang:
+                x, r = seg.point(seg.t1)
+                out.append((float(x), float(r), ang))
+        seg = self.segments[-1]
+        dx, dr = (float(v) for v in seg.derivative(seg.t1))
+        shoulder = math.atan2(dr, -dx)  # from the last tangent to the shank direction (-1, 0)
+        if abs(shoulder) > tol:
+            out.append((-self.length, self.radius, shoulder))
+        return out
 
-def ogive_nose(diameter: float, crh: float) -> Nose:
+    @property
+    def corner_positions(self) -> tuple[float, ...]:
+        """Axial distances back from the tip [m] of the corners (:meth:`corners`): the
+        depths P at which a corner enters the target, where A, B, C change character."""
+        return tuple(-x for x, _, _ in self.corners())
+
+
+def ogive_nose(diameter: float, crh: float, meplat_diameter: float = 0.0, tip_radius: float = 0.0) -> Nose:
     """Tangent ogive of caliber radius head psi = s/d (Fig. 5: psi = 3; psi = 0.5 is a hemisphere).
 
     Arc of radius s = psi d centred at (-L_h, R - s), nose length L_h = d sqrt(psi - 1/4).
+    ``meplat_diameter`` > 0 truncates it with a flat face of that diameter (a corner at its
+    edge); ``tip_radius`` > 0 blunts it with a sphere tangent to the arc.
     """
     if not diameter > 0:
         raise InputError("projectile.diameter", "must be positive")
@@ -300,11 +330,38 @@ def ogive_nose(diameter: float, crh: float) -> Nose:
         raise InputError("projectile.crh", f"must be >= 0.5 for a tangent ogive; got {crh!r}")
     R = 0.5 * diameter
     s = crh * diameter
+    _check_tip_options(diameter, meplat_diameter, tip_radius)
+    if meplat_diameter > 0:
+        rm = 0.5 * meplat_diameter
+        L = math.sqrt(max(s * s - (s - R + rm) ** 2, 0.0))
+        theta = math.atan2(s - R + rm, L)
+        segs = (Line((0.0, 0.0), (0.0, rm)), Arc(center=(-L, R - s), radius=s, t0=theta, t1=0.5 * math.pi))
+        return Nose("ogive", diameter, L, segs, {"crh": crh, "meplat_diameter": meplat_diameter})
     L = math.sqrt(max(2 * s * R - R * R, 0.0))
+    if tip_radius > 0:
+        b = tip_radius
+        if not b < R:
+            raise InputError("projectile.tip_radius", f"must be below d/2 = {R * 1e3:.4g} mm for an ogive")
+        rc = R - s  # ogive centre (-L, rc); the cap's centre (xb, 0) lies s - b from it
+        xb = -L + math.sqrt((s - b) ** 2 - rc * rc)
+        theta = math.atan2(-rc, xb + L)  # direction from the ogive centre through the cap's centre
+        shift = -(xb + b)  # tip to x = 0
+        cap = Arc(center=(xb + shift, 0.0), radius=b, t0=0.0, t1=theta)
+        arc = Arc(center=(-L + shift, rc), radius=s, t0=theta, t1=0.5 * math.pi)
+        return Nose("ogive", diameter, L - shift, (cap, arc), {"crh": crh, "tip_radius": tip_radius})
     theta_tip = math.atan2(s - R, L)
     arc = Arc(center=(-L, R - s), radius=s, t0=theta_tip, t1=0.5 * math.pi)
     kind = "sphere" if crh == 0.5 else "ogive"
     return Nose(kind, diameter, L, (arc,), {"crh": crh})
+
+
+def _check_tip_options(diameter: float, meplat_diameter: float, tip_radius: float) -> None:
+    if meplat_diameter and tip_radius:
+        raise InputError("projectile.tip_radius", "give either 'meplat_diameter' (flat tip) or 'tip_radius' (rounded tip), not both")
+    if not 0 <= meplat_diameter < diameter:
+        raise InputError("projectile.meplat_diameter", f"must lie in [0, d) = [0, {diameter * 1e3:.4g} mm); got {meplat_diameter * 1e3:.4g} mm")
+    if not tip_radius >= 0:
+        raise InputError("projectile.tip_radius", f"must not be negative; got {tip_radius * 1e3:.4g} mm")
 
 
 def sphere_nose(diameter: float) -> Nose:
@@ -312,12 +369,36 @@ def sphere_nose(diameter: float) -> Nose:
     return ogive_nose(diameter, 0.5)
 
 
-def cone_nose(diameter: float, half_angle: float) -> Nose:
-    """Conical nose of tip half-angle ``half_angle`` (rad): L_h = (d/2)/tan(half_angle)."""
+def cone_nose(diameter: float, half_angle: float, meplat_diameter: float = 0.0, tip_radius: float = 0.0) -> Nose:
+    """Conical nose of tip half-angle ``half_angle`` (rad): L_h = (d/2)/tan(half_angle).
+
+    ``meplat_diameter`` > 0: truncated cone with a flat face of that diameter;
+    ``tip_radius`` > 0: the apex replaced by a sphere of that radius tangent to the cone.
+    """
     if not 0 < half_angle < 0.5 * math.pi:
         raise InputError("projectile.half_angle", "must lie strictly between 0 and 90 deg")
+    _check_tip_options(diameter, meplat_diameter, tip_radius)
     R = 0.5 * diameter
+    if meplat_diameter > 0:
+        rm = 0.5 * meplat_diameter
+        L = (R - rm) / math.tan(half_angle)
+        segs = (Line((0.0, 0.0), (0.0, rm)), Line((0.0, rm), (-L, R)))
+        return Nose("cone", diameter, L, segs, {"half_angle": half_angle, "meplat_diameter": meplat_diameter})
     L = R / math.tan(half_angle)
+    if tip_radius > 0:
+        b = tip_radius
+        sb, cb = math.sin(half_angle), math.cos(half_angle)
+        if not b * cb < R:
+            raise InputError(
+                "projectile.tip_radius",
+                f"too large for this cone: the sphere must touch the cone before the shoulder (tip_radius < {R / cb * 1e3:.4g} mm)",
+            )
+        xc = -b / sb  # sphere centre behind the apex (apex at 0)
+        shift = -(xc + b)
+        tx, tr = -(b / sb) * cb * cb, b * cb  # tangent point
+        cap = Arc(center=(xc + shift, 0.0), radius=b, t0=0.0, t1=0.5 * math.pi - half_angle)
+        line = Line((tx + shift, tr), (-L + shift, R))
+        return Nose("cone", diameter, L - shift, (cap, line), {"half_angle": half_angle, "tip_radius": tip_radius})
     return Nose("cone", diameter, L, (Line((0.0, 0.0), (-L, R)),), {"half_angle": half_angle})
 
 
@@ -342,26 +423,40 @@ def table_nose(points: list[tuple[float, float]], diameter: float, field_name: s
     """
     pts = np.asarray(points, dtype=float)
     if pts.ndim != 2 or pts.shape[1] != 2 or len(pts) < 3:
-        raise InputError(field_name, "needs at least three [x, r] pairs")
-    if not np.all(np.isfinite(pts)):
-        raise InputError(field_name, "must be finite numbers")
+        raise InputError(field_name, f"needs at least three [x, r] pairs (tip, ..., shoulder); got {len(pts)}")
+
+    def bad(i: int, why: str) -> InputError:
+        x, r = pts[i]
+        return InputError(field_name, f"index {i} ([{x * 1e3:.6g}, {r * 1e3:.6g}] mm): {why}")
+
+    for i in range(len(pts)):
+        if not np.all(np.isfinite(pts[i])):
+            raise bad(i, "must be finite numbers")
     if abs(pts[0, 0]) > 0 or abs(pts[0, 1]) > 0:
-        raise InputError(field_name, "must start at the tip [0, 0]")
-    if np.any(np.diff(pts[:, 0]) < 0):
-        raise InputError(field_name, "x (distance back from the tip) must not decrease: the table is not a simple meridian")
-    if np.any(np.hypot(np.diff(pts[:, 0]), np.diff(pts[:, 1])) == 0):
-        raise InputError(field_name, "has repeated points")
-    if np.any(pts[1:, 1] <= 0):
-        raise InputError(field_name, "radius must be positive after the tip")
-    if np.any(pts[:, 1] > 0.5 * diameter * (1 + 1e-9)):
-        raise InputError(field_name, "radius exceeds half the diameter")
+        raise bad(0, "the first point is the tip and must be [0, 0] (on the axis)")
+    for i in range(1, len(pts)):
+        if pts[i, 0] < pts[i - 1, 0]:
+            raise bad(i, "x (distance back from the tip) decreases: x must increase from tip to shoulder")
+        if pts[i, 0] == pts[i - 1, 0] and pts[i, 1] == pts[i - 1, 1]:
+            raise bad(i, "repeats the previous point")
+        if pts[i, 1] < 0:
+            raise bad(i, "radius r < 0")
+        if pts[i, 1] == 0:
+            raise bad(i, "radius must be positive after the tip (the meridian would touch the axis again)")
+        if pts[i, 1] > 0.5 * diameter * (1 + 1e-9):
+            raise bad(i, f"radius exceeds half the diameter d/2 = {0.5 * diameter * 1e3:.6g} mm")
     if not math.isclose(pts[-1, 1], 0.5 * diameter, rel_tol=1e-6):
-        raise InputError(field_name, f"must end at the shoulder radius d/2 = {0.5 * diameter:g} m")
+        raise bad(len(pts) - 1, f"the last point is the shoulder: its radius must be d/2 = {0.5 * diameter * 1e3:.6g} mm")
+    if np.any(np.diff(pts[:, 0]) == 0) and np.all(np.diff(pts[:, 0]) == 0):
+        raise bad(len(pts) - 1, "all points have the same x: the nose has no length")
     spline = SplineCurve(tuple(-pts[:, 0]), tuple(pts[:, 1]))
-    t = np.linspace(spline.t0, spline.t1, 400)
-    x, r = spline.point(t)
-    if np.any(np.diff(x) > 1e-12 * diameter) or np.any(r[1:] < 0):
-        raise InputError(field_name, "the spline through the points folds back; add points or smooth the table")
+    knots = spline.knots
+    for i in range(len(pts) - 1):
+        t = np.linspace(knots[i], knots[i + 1], 41)
+        x, r = spline.point(t)
+        if np.any(np.diff(x) > 1e-9 * diameter) or np.any(r[1:] <= 0) or np.any(r > 0.5 * diameter * (1 + 1e-6)):
+            raise bad(i + 1, "the spline through the points folds back or crosses itself before this point "
+                             "(self-intersecting meridian); add points or smooth the table")
     return Nose("table", diameter, float(pts[-1, 0]), (spline,), {"points": pts.tolist()})
 
 
@@ -446,10 +541,14 @@ def table_body(points: list[tuple[float, float]], field_name: str = "body.points
 
 def nose_from_section(sec) -> Nose:
     """Build the nose of a ``[projectile]`` case section."""
-    if sec.nose in ("ogive", "sphere"):
-        return ogive_nose(sec.diameter, sec.crh if sec.nose == "ogive" else 0.5)
+    meplat = getattr(sec, "meplat_diameter", None) or 0.0
+    tip = getattr(sec, "tip_radius", None) or 0.0
+    if sec.nose == "ogive":
+        return ogive_nose(sec.diameter, sec.crh, meplat, tip)
+    if sec.nose == "sphere":
+        return ogive_nose(sec.diameter, 0.5)
     if sec.nose == "cone":
-        return cone_nose(sec.diameter, sec.half_angle)
+        return cone_nose(sec.diameter, sec.half_angle, meplat, tip)
     if sec.nose == "flat":
         return flat_nose(sec.diameter, sec.corner_radius or 0.0)
     return table_nose(sec.points_si(), sec.diameter)

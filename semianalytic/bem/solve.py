@@ -86,7 +86,8 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     j = np.argmin(d2, axis=1)
     rows = np.arange(len(pan))
     u = samples[j]
-    du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
+    with np.errstate(divide="ignore", invalid="ignore"):
+        du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
     inner = np.arange(len(pan))
     if inner.size:
         ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
@@ -99,7 +100,10 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
             ui = np.clip(ui - step, -1.0, 1.0)
         x, r, xu, ru = ps.evaluate(pi, ui)
         u[inner] = ui
-        du[inner] = np.hypot(x - xi, r - ri) / np.hypot(xu, ru)
+        dist = np.hypot(x - xi, r - ri)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            du[inner] = dist / np.hypot(xu, ru)
+        du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
     return u, du
 
 
@@ -185,7 +189,7 @@ class PairQuadrature:
             None if target_u is None else target_u[order_idx],
         )
 
-    def integrate(self, ps: PanelSet, xt, rt, kernels):
+    def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
 
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
@@ -197,6 +201,10 @@ class PairQuadrature:
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
+        elif node_targets:  # targets are nodes of ps: differences through the anchors
+            ax, ar, ex, er = ps.split(pan, self.u)
+            tax, tar, tex, ter = (a[t] for a in ps.node_split)
+            delta = ((tax - ax) + (tex - ex), (tar - ar) + (ter - er))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J, delta):
             if isinstance(ker, tuple):
@@ -299,6 +307,14 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
         _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
+    mapped = np.nonzero(np.isin(own_panel, ps.mapped))[0]
+    if mapped.size:
+        # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
+        # the node; keep the self rule's innermost pieces within half of that
+        c = ps.cluster[own_panel[mapped]]
+        gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
+        levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
+        levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
     tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
     return AssemblyPlan(self_quadrature(levels, p), near_quadrature(tgt, pan, ustar, du, p))
 
@@ -330,7 +346,7 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray
     D *= W[None, :]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
-            Sb, Db = rule.integrate(ps, xt, rt, kernels)
+            Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
             rows = rule.target[:, None]
             cols = rule.panel[:, None] * p + np.arange(p)[None, :]
             S[rows, cols] = Sb
@@ -339,6 +355,11 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray
     if mirror.size:
         S = S[:, :N] + S[:, mirror]
         D = D[:, :N] + D[:, mirror]
+    # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
+    # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
+    # that near a corner the error follows the local variation of phi, not phi itself
+    # (without it, B drifts as graded panels shrink: |grad phi| ~ s^(lambda - 1))
+    D[np.arange(N), np.arange(N)] -= D.sum(axis=1) + 0.5
     return S, D
 
 

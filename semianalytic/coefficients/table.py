@@ -24,7 +24,7 @@ from semianalytic.coefficients import READINGS
 from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_depth
 from semianalytic.geometry import Nose
 
-TABLE_VERSION = 3  # bump when the numerics change, to invalidate caches
+TABLE_VERSION = 4  # bump when the numerics change, to invalidate caches
 
 
 def default_depths(nose: Nose, n_depths: int = 60, max_depth_nose_lengths: float = 300.0) -> np.ndarray:
