@@ -162,6 +162,17 @@ def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh
     return dataclasses.replace(dm, domain=dataclasses.replace(dom, info=info))
 
 
+def _waterline_edge(dm: DomainMesh) -> float:
+    """Length of the shortest mesh edge at the waterline vertex (inf when the nose is fully wetted)."""
+    info = dm.domain.info
+    if "waterline_segment" not in info:
+        return math.inf
+    p = dm.mesh.p
+    i = int(np.argmin(p[0] ** 2 + (p[1] - info["waterline_radius"]) ** 2))
+    edges = dm.mesh.facets[:, np.any(dm.mesh.facets == i, axis=0)]
+    return float(np.min(np.hypot(*(p[:, edges[0]] - p[:, edges[1]]))))
+
+
 def singular_wetted_corners(dm: DomainMesh) -> list:
     """Corners of the wetted body where |grad phi| is unbounded (ring corners with lambda < 1)."""
     return [c for c in dm.domain.corners if not c.on_axis and c.exponent < 1.0]
@@ -187,7 +198,9 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
     t0 = time.perf_counter()
     dm = halfspace_mesh(nose, depth, options)
     sol = solve_potential(dm, far_field)
-    eps = step * depth_scale(nose)
+    # the waterline vertex slides along x = 0 while the nose moves by eps: the elements at it shear by
+    # about eps, so eps stays well below the smallest of them (graded waterline corners are tiny)
+    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm))
     Ap = solve_potential(moved_mesh(dm, eps), far_field).A
     Am = solve_potential(moved_mesh(dm, -eps), far_field).A
     dA = (Ap - Am) / (2 * eps)

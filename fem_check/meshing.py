@@ -42,7 +42,7 @@ from skfem import MeshTri1, MeshTri2
 from semianalytic.errors import InputError
 from semianalytic.geometry import Arc, Line, Meridian, Nose, SplineCurve
 
-MESH_FORMAT_VERSION = 7  # bump when the domain construction changes (invalidates the cache)
+MESH_FORMAT_VERSION = 8  # bump when the domain construction changes (invalidates the cache)
 
 # ------------------------------------------------------------------------------------
 # curve pieces
@@ -423,10 +423,6 @@ def _gmsh_session():
             gmsh.finalize()
 
 
-def _near(p, points: dict, tol: float = 1e-12) -> bool:
-    return any(abs(p[0] - q[0]) + abs(p[1] - q[1]) <= tol * (1 + abs(q[0]) + abs(q[1])) for q in points)
-
-
 def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
     """Run gmsh on ``domain`` and write the mesh (msh 4.1) to ``path`` atomically."""
     with _gmsh_session() as gmsh:
@@ -493,9 +489,8 @@ def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
             fc = fm.add("Distance")
             fm.setNumbers(fc, "PointsList", [point(c.point)])
             terms.append(f"({h} + {g}*F{fc}) * (Max(F{fc}, {rho_min!r}) / {rho0!r})^{1.0 - mu!r}")
-        refine_points = [p for p in domain.refine_points if not _near(p, graded)]
-        tip_points = [p for p in domain.tip_points if not _near(p, graded)]
-        for pts, factor in ((refine_points, options.corner), (tip_points, options.tip)):
+        # the fixed corner/tip refinements stay (Min): grading only ever refines the smooth size field
+        for pts, factor in ((domain.refine_points, options.corner), (domain.tip_points, options.tip)):
             if pts:
                 fp = fm.add("Distance")
                 fm.setNumbers(fp, "PointsList", [point(p) for p in pts])
