@@ -94,15 +94,17 @@ def _far_plot(r, ff, key, xlabel, kinds):
 
 def _halfspace(r: Report, p: dict) -> None:
     d, Lh = p["diameter_m"], p["nose_length_m"]
+    unit = p.get("depth_scale", "L_h")
     S = math.pi * d * d / 4
     rows = p["depths"]
     r.add(f"Nose: {p['nose']}, d = {fmt(d * 1e3)} mm, L_h = {fmt(Lh * 1e3)} mm. FEM: P2, h = {fmt(p['h_over_d'])} d on "
-          "the nose (graded towards the tip, the nose-shank junction and the free-surface corner or waterline), far "
+          "the nose (graded towards the corners found from the meridian: tip, nose-shank junction, waterline; see "
+          "fem_check.meshing.singular_corners), far "
           "radius 20 (d + P); B from the shape finite difference of A on a moving mesh (see fem_check.coefficients). "
           "BEM: semianalytic.coefficients.table.coefficients_at (order 8, refinement 1).", "",
           f"**Largest relative BEM-FEM difference of A, B (body reading), C: {fmt(p['max_rel_diff'])}.**", "",
           "## Coefficients (normalised: Abar = 4A/(pi d^2) in mm, Bbar, Cbar)", "",
-          md_table(["P/L_h", "Abar BEM", "Abar FEM", "rel. diff A", "Bbar BEM", "Bbar FEM", "rel. diff B", "Cbar FEM",
+          md_table([f"P/{unit}", "Abar BEM", "Abar FEM", "rel. diff A", "Bbar BEM", "Bbar FEM", "rel. diff B", "Cbar FEM",
                     "rel. diff C", "FEM dofs", "FEM s", "BEM s"],
                    [[x["depth_over_Lh"], x["A_bem"] / S * 1e3, x["A_fem"] / S * 1e3, x["rel_diff"]["A"], x["B_bem"] / S,
                      x["B_fem"] / S, x["rel_diff"]["B"], x["C_fem"] / S, x["rel_diff"]["C"], x["fem_dofs"], x["fem_seconds"],
@@ -110,8 +112,9 @@ def _halfspace(r: Report, p: dict) -> None:
           "### The other B readings (errata item 2a) and phi_tip", "",
           "B_literal as a relative difference; B_bernoulli and dA/dP tend to zero at depth, so their differences are "
           "given in Bbar units (divided by pi d^2/4). Last column: the FEM's own identity B_bernoulli = dA/dP (errata "
-          "2a), which the FEM does not impose (B_bernoulli comes from surface integrals, dA/dP from the depth derivative).", "",
-          md_table(["P/L_h", "Bbar literal FEM", "rel. diff", "Bbar bernoulli FEM", "diff", "dA/dP / S FEM", "diff",
+          "2a), which the FEM does not impose (B_bernoulli comes from surface integrals, dA/dP from the depth derivative) "
+          "except at a ring corner with lambda < 1, where G is taken from the shape form (see the Corners section).", "",
+          md_table([f"P/{unit}", "Bbar literal FEM", "rel. diff", "Bbar bernoulli FEM", "diff", "dA/dP / S FEM", "diff",
                     "phi_tip rel. diff", "FEM abs(B_bern - dA/dP)/S"],
                    [[x["depth_over_Lh"], x["B_literal_fem"] / S, x["rel_diff"]["B_literal"], x["B_bernoulli_fem"] / S,
                      x["bar_diff"]["B_bernoulli"], x["dA_dP_fem"] / S, x["bar_diff"]["dA_dP"], x["rel_diff"]["phi_tip"],
@@ -127,7 +130,7 @@ def _halfspace(r: Report, p: dict) -> None:
     ax.semilogx(P, [x["B_fem"] / S for x in rows], "s", label="Bbar (body) FEM")
     ax.semilogx(P, [x["C_bem"] / S for x in rows], "-", label="Cbar BEM")
     ax.semilogx(P, [x["C_fem"] / S for x in rows], "^", label="Cbar FEM")
-    ax.set_xlabel("P / L_h")
+    ax.set_xlabel(f"P / {unit}")
     ax.legend(fontsize=8)
     r.figure("coefficients", fig, "A, B, C against depth: BEM lines, FEM points")
     conv = p.get("convergence")

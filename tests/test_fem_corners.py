@@ -90,20 +90,19 @@ def test_fem_flat_nose_converges_at_the_graded_rate():
     assert gaps[0] > gaps[1] > gaps[2] and gaps[2] < 3e-3
 
 
-@pytest.mark.parametrize("kind", ["cone", pytest.param("flat", marks=pytest.mark.xfail(
-    reason="issue 10: main's BEM B_body at a flat rim is 2.5e-3 low (FEM error 2e-5); the corner-aware BEM fixes it",
-    strict=False))])
+@pytest.mark.parametrize("kind", ["cone", "flat"])
 def test_fem_and_bem_agree_at_one_depth_on_cornered_noses(kind):
     from semianalytic.coefficients.table import coefficients_at
 
-    nose = cone_nose(D, math.radians(30)) if kind == "cone" else flat_nose(D)
+    nose = cone_nose(D, math.radians(15)) if kind == "cone" else flat_nose(D)  # cases/cone30.toml, flat_nose.toml
     P = 2 * (nose.length if kind == "cone" else D / 2)
     f = halfspace_coefficients(nose, P, MeshOptions(h=0.08))
     bem = coefficients_at(nose, [P])
-    # FEM error at h = 0.08 d from the refinement study (reports/fem_verify_*): A 6e-5 (cone), 4e-5 (flat);
-    # B 5e-5 (cone), 2e-5 (flat).  3x that, rounded: 2e-4.
+    # the FEM's own error at h = 0.08 d, from its refinement (reports/fem_verify_cone30.md, fem_verify_flat.md;
+    # observed orders 3-4): A 4e-5 to 5e-5 (both noses), B 1e-4 (cone), 5e-6 (flat).  Tolerances about 3x that:
+    # the BEM (converged to 1e-6 and better) adds nothing visible, so a failure means the FEM or the BEM broke.
     assert abs(f.A / bem["A"][0] - 1) < 2e-4
-    assert abs(f.B_body / bem["B_body"][0] - 1) < 2e-4
+    assert abs(f.B_body / bem["B_body"][0] - 1) < 3e-4
 
 
 @pytest.mark.slow
@@ -125,3 +124,34 @@ def test_refinement_study_meets_issue_10_targets(case, tmp_path, capsys):
         assert abs(st["diff"]["A"]["fem_minus_bem"]) < 1e-4 and st["diff"]["A"]["fem_error_bar"] < 1e-4
         assert abs(st["diff"]["B_body"]["fem_minus_bem"]) < 1e-3 and st["diff"]["B_body"]["fem_error_bar"] < 1e-3
         assert st["extrapolated"]["A"]["order"] > 3.0  # predicted 4
+
+
+def test_verify_cli_on_a_flat_nose_depths_in_radii(capsys):
+    import json
+    from pathlib import Path
+
+    from fem_check.cli import main
+
+    case = Path(__file__).resolve().parents[1] / "cases" / "flat_nose.toml"
+    assert main(["verify", str(case), "--quick", "--depths", "3", "--h", "0.16", "--json", "--no-report"]) == 0
+    d = json.loads(capsys.readouterr().out)
+    assert d["depth_scale"] == "radius" and d["depths"][0]["depth_m"] == pytest.approx(3 * D / 2)
+    # h = 0.16 d, graded: FEM error 3e-4 (A), 1e-4 (B) by refinement at 2 radii; C = pi R^2 on the flat face
+    assert d["max_rel_diff"] < 1e-3
+
+
+@pytest.mark.parametrize("argv, field", [
+    (["--study-h", "0.1,0.2,0.05"], "--study-h"),
+    (["--study-h", "0.1,0.05"], "--study-h"),
+    (["--grading", "2"], "--grading"),
+])
+def test_verify_bad_study_options_exit_2(capsys, tmp_path, argv, field):
+    from pathlib import Path
+
+    from fem_check.cli import main
+
+    case = Path(__file__).resolve().parents[1] / "cases" / "flat_nose.toml"
+    assert main(["verify", str(case), *argv, "--out", str(tmp_path)]) == 2
+    err = capsys.readouterr().err.strip().splitlines()
+    assert len(err) == 1 and field in err[0]
+    assert not any(tmp_path.iterdir())
