@@ -248,7 +248,7 @@ def _tangent(piece: Piece, end: bool) -> np.ndarray:
     return v / np.hypot(*v)
 
 
-def singular_corners(loop, scale: float, tol: float = 1e-9) -> tuple[Corner, ...]:
+def singular_corners(loop, tol: float = 1e-9) -> tuple[Corner, ...]:
     """Corners of a boundary loop (counter-clockwise around the fluid) found from the geometry: the
     jumps of the unit tangent between consecutive pieces (joints with the far boundary excluded).
 
@@ -307,7 +307,7 @@ def body_domain(meridian: Meridian, options: MeshOptions) -> Domain:
     refine += [pieces[-1 - i][1].start for i in range(len(meridian.segments) - 1)] if len(meridian.segments) > 1 else []
     return Domain("body", tuple(pieces), (xc, 0.0), R, d, tuple(tuple(map(float, p)) for p in refine),
                   {"volume": meridian.volume(), "diameter": d, "length": length},
-                  tip_points=tuple(tuple(map(float, p)) for p in tips), corners=singular_corners(pieces, d))
+                  tip_points=tuple(tuple(map(float, p)) for p in tips), corners=singular_corners(pieces))
 
 
 def _nose_waterline(nose: Nose, depth: float) -> tuple[int, float]:
@@ -364,7 +364,7 @@ def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
         refine.append(p.start)
     info.update({"depth": depth, "nose_length": Lh, "diameter": d})
     return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info,
-                  tip_points=(tip,) if pointed else (), corners=singular_corners(pieces, d))
+                  tip_points=(tip,) if pointed else (), corners=singular_corners(pieces))
 
 
 def annulus_domain(a: float, outer: float, options: MeshOptions, interface: float | None = None) -> Domain:

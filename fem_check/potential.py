@@ -92,16 +92,14 @@ def mapping_for(mesh):
     class _RoundoffTolerantMapping(MappingIsoparametric):
         def invF(self, x, tind=None, newton_max_iters=50, newton_tol=1e-12):
             X = np.zeros(x.shape) + 0.5
+            # round-off floor of the reference coordinates: |x| eps / element size (per element)
+            size = np.sqrt(np.abs(np.linalg.det(np.moveaxis(self.DF(X, tind), (0, 1), (-2, -1))))).min(axis=-1)
+            tol = np.maximum(newton_tol, 1e3 * np.finfo(float).eps * np.abs(x).max(axis=(0, 2)) / size)
             for _ in range(newton_max_iters):
                 dX = np.einsum("ijkl,jkl->ikl", self.invDF(X, tind), x - self.F(X, tind))
                 X = np.clip(X + dX, 0.0, 1.0)
-                if (np.abs(dX).max(axis=(0, 2)) < newton_tol).all():
+                if (np.abs(dX).max(axis=(0, 2)) < tol).all():
                     return X
-            # converged to round-off? the update must be at the level of |x| eps / element size
-            size = np.sqrt(np.abs(np.linalg.det(np.moveaxis(self.DF(X, tind), (0, 1), (-2, -1))))).min(axis=-1)
-            noise = 1e3 * np.finfo(float).eps * (1 + np.abs(x).max(axis=(0, 2))) / size
-            if (np.abs(dX).max(axis=(0, 2)) < np.maximum(noise, newton_tol)).all():
-                return X
             raise RuntimeError("inverse element mapping: Newton iteration did not converge")
 
     return _RoundoffTolerantMapping(mesh, mesh.elem(), mesh.bndelem)

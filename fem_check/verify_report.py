@@ -255,9 +255,10 @@ def _refinement(r: Report, p: dict) -> None:
         err_s = [max(abs(x["B_surface"] / st["extrapolated"]["B_body"]["extrapolated"] - 1), 1e-16) for x in st["rows"]]
         axB.loglog(hs, err_s, "x:", color="grey")
     h = np.array([x["h_over_d"] for x in study[0]["rows"]])
-    for ax, q, title in ((axA, 4, "A"), (axB, 2, "B (body); grey x: surface G")):
+    for ax, qs, title in ((axA, (4,), "A"), (axB, (2, 4), "B (body); grey x: surface G")):
         lo, hi = ax.get_ylim()
-        ax.loglog(h, hi * 0.5 * (h / h[0]) ** q, "k:", label=f"h^{q}")
+        for q, style in zip(qs, ("k:", "k--") if len(qs) == 1 else ("k--", "k:")):
+            ax.loglog(h, hi * 0.5 * (h / h[0]) ** q, style, label=f"h^{q}")
         _h_ticks(ax, sorted(h.tolist()))
         ax.set_xlabel("h / d")
         ax.set_title(f"{title}: abs(X_h / X_inf - 1)", fontsize=9)
