@@ -103,25 +103,32 @@ def _recentre_waterline_edges(dm: DomainMesh, facets, nodes, x, r, curve: Piece)
         x[im], r[im] = curve.project(mid[None, :])[0]
 
 
-def moved_mesh(dm: DomainMesh, eps: float) -> DomainMesh:
-    """The mesh of depth P + eps with the topology of ``dm`` (harmonic extension of the boundary motion)."""
-    nodes, new = _boundary_motion(dm, eps)
+def moved_meshes(dm: DomainMesh, steps) -> list[DomainMesh]:
+    """The meshes of depths P + eps (eps in ``steps``) with the topology of ``dm``: harmonic extension
+    of the boundary motion, one factorisation of the Laplacian shared by all steps."""
     basis = Basis(dm.mesh, element_for(dm.order))
     if not np.allclose(basis.doflocs, dm.mesh.doflocs):
         raise RuntimeError("geometry nodes and FEM dofs are numbered differently")
-    disp_b = new - dm.mesh.doflocs[:, nodes]
-    N = basis.N
-    interior = np.setdiff1d(np.arange(N), nodes)
     K = _laplace.assemble(basis).tocsr()
-    lu = spla.splu(K[interior][:, interior].tocsc())
-    Kib = K[interior][:, nodes]
-    doflocs = dm.mesh.doflocs.copy()
-    doflocs[:, nodes] = new
-    for c in range(2):
-        doflocs[c, interior] += lu.solve(-(Kib @ disp_b[c]))
-    info = dict(dm.domain.info, depth=dm.domain.info["depth"] + eps)
-    moved = dm.with_doflocs(doflocs)
-    return dataclasses.replace(moved, domain=dataclasses.replace(dm.domain, info=info))
+    lu, Kib, interior, out = None, None, None, []
+    for eps in steps:
+        nodes, new = _boundary_motion(dm, eps)
+        if lu is None:
+            interior = np.setdiff1d(np.arange(basis.N), nodes)
+            lu = spla.splu(K[interior][:, interior].tocsc())
+            Kib = K[interior][:, nodes]
+            first_nodes = nodes
+        elif not np.array_equal(nodes, first_nodes):
+            raise RuntimeError("the moved boundary nodes differ between depth steps")
+        disp_b = new - dm.mesh.doflocs[:, nodes]
+        doflocs = dm.mesh.doflocs.copy()
+        doflocs[:, nodes] = new
+        for c in range(2):
+            doflocs[c, interior] += lu.solve(-(Kib @ disp_b[c]))
+        info = dict(dm.domain.info, depth=dm.domain.info["depth"] + eps)
+        moved = dm.with_doflocs(doflocs)
+        out.append(dataclasses.replace(moved, domain=dataclasses.replace(dm.domain, info=info)))
+    return out
 
 
 @dataclass(frozen=True)
@@ -201,8 +208,9 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
     # the waterline vertex slides along x = 0 while the nose moves by eps: the elements at it shear by
     # about eps, so eps stays well below the smallest of them (graded waterline corners are tiny)
     eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm))
-    Ap = solve_potential(moved_mesh(dm, eps), far_field).A
-    Am = solve_potential(moved_mesh(dm, -eps), far_field).A
+    plus, minus = moved_meshes(dm, [eps, -eps])
+    Ap = solve_potential(plus, far_field).A
+    Am = solve_potential(minus, far_field).A
     dA = (Ap - Am) / (2 * eps)
     s = sol.surface("body")
     G = float(np.sum(s["weight"] * s["grad2"] * s["nx"]))
