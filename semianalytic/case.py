@@ -51,12 +51,12 @@ _UNIT_SCALE = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6}
 class BodySection(Section):
     """``[body]``: a closed body of revolution in unbounded fluid.
 
-    sphere: ``diameter``; spheroid (prolate or oblate): ``length`` along the axis and
-    ``diameter``; table: ``points = [[x, r], ...]`` in ``points_unit``, a meridian from one
+    sphere: ``diameter``; spheroid (prolate or oblate), cylinder (flat-ended) and double_cone
+    (two cones base to base): ``length`` along the axis and ``diameter``; table: ``points = [[x, r], ...]`` in ``points_unit``, a meridian from one
     axis point (r = 0) to the other.
     """
 
-    shape: Literal["sphere", "spheroid", "table"]
+    shape: Literal["sphere", "spheroid", "table", "cylinder", "double_cone"]
     length: Length | None = None
     diameter: Length | None = None
     points: list[tuple[float, float]] | None = None
@@ -69,9 +69,9 @@ class BodySection(Section):
                 raise ValueError("a sphere needs 'diameter' (e.g. '1 m')")
             if self.length is not None and not math.isclose(self.length, self.diameter, rel_tol=1e-12):
                 raise ValueError("a sphere's 'length' must equal its 'diameter' (or be left out)")
-        elif self.shape == "spheroid":
+        elif self.shape in ("spheroid", "cylinder", "double_cone"):
             if self.diameter is None or self.length is None:
-                raise ValueError("a spheroid needs 'length' (along the axis) and 'diameter'")
+                raise ValueError(f"a {self.shape.replace('_', ' ')} needs 'length' (along the axis) and 'diameter'")
         else:
             if not self.points or self.points_unit is None:
                 raise ValueError("a table body needs 'points' = [[x, r], ...] and 'points_unit'")
@@ -88,6 +88,8 @@ class ProjectileSection(Section):
     ``nose``: ogive (needs ``crh``, psi = s/d), sphere (hemispherical), cone (needs
     ``half_angle``), flat (optional ``corner_radius``) or table (``points = [[x, r], ...]``
     in ``points_unit``, x measured back from the tip, from (0, 0) to the shoulder at r = d/2).
+    Ogive and cone take an optional ``meplat_diameter`` (flat tip: truncated nose) or
+    ``tip_radius`` (spherically blunted tip); a key a nose kind has no use for is an error.
     ``shank_length`` is the cylindrical part: total length = shank + nose.
     """
 
@@ -149,7 +151,7 @@ class ProjectileSection(Section):
                 "points": ("table",), "points_unit": ("table",)}
         for key, kinds in uses.items():
             if getattr(self, key) is not None and self.nose not in kinds:
-                raise InputError(f"projectile.{key}", f"has no use for a '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")
+                raise InputError(f"projectile.{key}", f"has no use for the '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")
         nose = nose_from_section(self)
         if self.length is not None:
             shank = self.length - nose.length

@@ -119,6 +119,14 @@ class SplineCurve:
 
     xs: tuple[float, ...]
     rs: tuple[float, ...]
+    lo: float | None = None  # a sub-range [lo, hi] of the parameter (one interval between knots)
+    hi: float | None = None
+
+    def between_knots(self) -> tuple["SplineCurve", ...]:
+        """The curve cut at its knots: one segment per interval, so that panels never
+        straddle a knot (where the third derivative jumps)."""
+        k = self.knots
+        return tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
 
     @cached_property
     def _splines(self):
@@ -130,11 +138,11 @@ class SplineCurve:
 
     @property
     def t0(self) -> float:
-        return 0.0
+        return 0.0 if self.lo is None else self.lo
 
     @property
     def t1(self) -> float:
-        return float(self._splines[0][-1])
+        return float(self._splines[0][-1]) if self.hi is None else self.hi
 
     @property
     def knots(self) -> np.ndarray:
@@ -170,11 +178,12 @@ def _leggauss(n: int):
 def _gauss_integrate(segment: Segment, f, n: int = 48) -> float:
     """Integrate ``f(x, r, dx, dr)`` dt over a segment with composite Gauss-Legendre."""
     u, w = _leggauss(n)
-    edges = (
-        np.asarray(segment.knots)
-        if isinstance(segment, SplineCurve)
-        else np.linspace(segment.t0, segment.t1, 5)
-    )
+    if isinstance(segment, SplineCurve):
+        k = np.asarray(segment.knots)
+        inner = k[(k > segment.t0) & (k < segment.t1)]
+        edges = np.concatenate([[segment.t0], inner, [segment.t1]])
+    else:
+        edges = np.linspace(segment.t0, segment.t1, 5)
     total = 0.0
     for a, b in zip(edges[:-1], edges[1:]):
         t = 0.5 * (a + b) + 0.5 * (b - a) * u
@@ -522,6 +531,22 @@ def spheroid_body(length: float, diameter: float) -> Meridian:
     return Meridian((EllipseArc(0.0, 0.5 * length, 0.5 * diameter),))
 
 
+def cylinder_body(length: float, diameter: float) -> Meridian:
+    """Flat-ended circular cylinder (two 90 deg edges), centred on the origin."""
+    if not (length > 0 and diameter > 0):
+        raise InputError("body.length", "length and diameter must be positive")
+    h, R = 0.5 * length, 0.5 * diameter
+    return Meridian((Line((h, 0.0), (h, R)), Line((h, R), (-h, R)), Line((-h, R), (-h, 0.0))))
+
+
+def double_cone_body(length: float, diameter: float) -> Meridian:
+    """Two equal cones base to base (conical tips at x = +-length/2, an edge at x = 0)."""
+    if not (length > 0 and diameter > 0):
+        raise InputError("body.length", "length and diameter must be positive")
+    h, R = 0.5 * length, 0.5 * diameter
+    return Meridian((Line((h, 0.0), (0.0, R)), Line((0.0, R), (-h, 0.0))))
+
+
 def table_body(points: list[tuple[float, float]], field_name: str = "body.points") -> Meridian:
     """Closed meridian through user points from one axis point to the other."""
     pts = np.asarray(points, dtype=float)
@@ -565,4 +590,8 @@ def body_from_section(sec) -> Meridian:
         return sphere_body(sec.diameter)
     if sec.shape == "spheroid":
         return spheroid_body(sec.length, sec.diameter)
+    if sec.shape == "cylinder":
+        return cylinder_body(sec.length, sec.diameter)
+    if sec.shape == "double_cone":
+        return double_cone_body(sec.length, sec.diameter)
     return table_body(sec.points_si())

@@ -37,6 +37,7 @@ import scipy.linalg
 
 from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_split
 from semianalytic.bem.panels import PanelSet
+from semianalytic.errors import InputError
 from semianalytic.bem.quadrature import (
     differentiation_matrix,
     dyadic_rule,
@@ -201,10 +202,17 @@ class PairQuadrature:
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif node_targets:  # targets are nodes of ps: differences through the anchors
-            ax, ar, ex, er = ps.split(pan, self.u)
-            tax, tar, tex, ter = (a[t] for a in ps.node_split)
-            delta = ((tax - ax) + (tex - ex), (tar - ar) + (ter - er))
+        elif node_targets and ps.tiny_panels.any():
+            # targets are nodes of ps: on panels graded far below their distance from the
+            # origin, differences through the shared anchors (a corner) keep their digits
+            sel = np.nonzero(ps.tiny_panels[pan])[0]
+            if sel.size:
+                ax, ar, ex, er = ps.split(pan[sel], self.u[sel])
+                tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
+                dx, dr = xt[t] - x, rt[t] - r
+                dx[sel] = (tax - ax) + (tex - ex)
+                dr[sel] = (tar - ar) + (ter - er)
+                delta = (dx, dr)
         out = []
         for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J, delta):
             if isinstance(ker, tuple):
@@ -459,6 +467,8 @@ class SurfaceSolution:
         g = ps.nodes
         J = g.J[:n]
         dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
+        if not (np.all(np.isfinite(dphi_ds)) and np.all(np.isfinite(self.phi_nodes))):
+            raise_non_finite(ps, self.depth, "surface velocity")
         return SurfaceNodes(
             x=g.x[:n].ravel() + ps.offset,
             r=g.r[:n].ravel(),
@@ -579,5 +589,16 @@ def solve_panels(
     A = 0.5 * np.eye(N) - D
     with _single_threaded_blas():
         phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
+    if not np.all(np.isfinite(phi)):
+        raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
     return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), kind, depth=depth, volume=volume)
+
+
+def raise_non_finite(ps: PanelSet, depth: float | None, what: str = "potential"):
+    """Never a silent NaN: a solve that yields a non-finite value stops with the shape and
+    the depth named (exit status 2: the geometry is the input the solver could not handle)."""
+    where = f" at depth P = {depth * 1e3:.6g} mm" if depth is not None else ""
+    field = "projectile" if ps.label.endswith("nose") else "body"
+    raise InputError(field, f"the BEM solve of the {ps.label}{where} gave a non-finite {what}; "
+                     "check the shape (points, radii) or the [bem] options")

@@ -34,6 +34,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--out", default="reports", help="folder of the reports (default: reports)")
     parser.add_argument("--force", action="store_true", help="overwrite existing reports")
     parser.add_argument("--quick", action="store_true", help="fewer repeats and depths (for a smoke test)")
+    parser.add_argument("--corners", action="store_true", help="only the cornered-nose study: bem_corners.md/.png (issue 10)")
 
 
 def _best_time(fn, repeats: int) -> float:
@@ -207,6 +208,10 @@ def write_bench_report(rows, blas, tables, out_dir: Path, force: bool) -> list[P
 
 def run(args) -> int:
     out = Path(args.out)
+    if getattr(args, "corners", False):
+        from semianalytic.coefficients.corners_report import run_corners
+
+        return run_corners(out, args.force, args.quick)
     names = ["bench_bem.md", "bem_convergence.md", "bem_convergence.png", "bem_coefficients.md"]
     existing = [n for n in names if (out / n).exists()]
     if existing and not args.force:
