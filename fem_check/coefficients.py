@@ -103,25 +103,32 @@ def _recentre_waterline_edges(dm: DomainMesh, facets, nodes, x, r, curve: Piece)
         x[im], r[im] = curve.project(mid[None, :])[0]
 
 
-def moved_mesh(dm: DomainMesh, eps: float) -> DomainMesh:
-    """The mesh of depth P + eps with the topology of ``dm`` (harmonic extension of the boundary motion)."""
-    nodes, new = _boundary_motion(dm, eps)
+def moved_meshes(dm: DomainMesh, steps) -> list[DomainMesh]:
+    """The meshes of depths P + eps (eps in ``steps``) with the topology of ``dm``: harmonic extension
+    of the boundary motion, one factorisation of the Laplacian shared by all steps."""
     basis = Basis(dm.mesh, element_for(dm.order))
     if not np.allclose(basis.doflocs, dm.mesh.doflocs):
         raise RuntimeError("geometry nodes and FEM dofs are numbered differently")
-    disp_b = new - dm.mesh.doflocs[:, nodes]
-    N = basis.N
-    interior = np.setdiff1d(np.arange(N), nodes)
     K = _laplace.assemble(basis).tocsr()
-    lu = spla.splu(K[interior][:, interior].tocsc())
-    Kib = K[interior][:, nodes]
-    doflocs = dm.mesh.doflocs.copy()
-    doflocs[:, nodes] = new
-    for c in range(2):
-        doflocs[c, interior] += lu.solve(-(Kib @ disp_b[c]))
-    info = dict(dm.domain.info, depth=dm.domain.info["depth"] + eps)
-    moved = dm.with_doflocs(doflocs)
-    return dataclasses.replace(moved, domain=dataclasses.replace(dm.domain, info=info))
+    lu, Kib, interior, out = None, None, None, []
+    for eps in steps:
+        nodes, new = _boundary_motion(dm, eps)
+        if lu is None:
+            interior = np.setdiff1d(np.arange(basis.N), nodes)
+            lu = spla.splu(K[interior][:, interior].tocsc())
+            Kib = K[interior][:, nodes]
+            first_nodes = nodes
+        elif not np.array_equal(nodes, first_nodes):
+            raise RuntimeError("the moved boundary nodes differ between depth steps")
+        disp_b = new - dm.mesh.doflocs[:, nodes]
+        doflocs = dm.mesh.doflocs.copy()
+        doflocs[:, nodes] = new
+        for c in range(2):
+            doflocs[c, interior] += lu.solve(-(Kib @ disp_b[c]))
+        info = dict(dm.domain.info, depth=dm.domain.info["depth"] + eps)
+        moved = dm.with_doflocs(doflocs)
+        out.append(dataclasses.replace(moved, domain=dataclasses.replace(dm.domain, info=info)))
+    return out
 
 
 @dataclass(frozen=True)
@@ -136,15 +143,23 @@ class HalfspaceCoefficients:
     B_bernoulli: float
     dA_dP: float
     phi_tip: float
-    G: float  # int |grad phi|^2 n_x dS
+    G: float  # int |grad phi|^2 n_x dS, as used in the B readings (G_surface or G_shape)
     H: float  # int dphi/dx n_x dS
     Q: float  # int D phi/DP n_x dS
     n_dofs: int
     n_elements: int
     seconds: float
+    G_surface: float = math.nan  # G from the FEM surface gradient
+    G_shape: float = math.nan  # G from the shape derivative: 2 (Q - H) - dA/dP (errata 2a identity)
+    G_source: str = "surface"  # which one the B readings use
 
     def B(self, reading: str = "body") -> float:
         return {"body": self.B_body, "literal": self.B_literal, "bernoulli": self.B_bernoulli}[reading]
+
+
+def depth_scale(nose: Nose) -> float:
+    """The length scale of depths: L_h, or the radius for a flat nose (L_h = 0; as the BEM's table)."""
+    return nose.length if nose.length > 0.05 * nose.radius else nose.radius
 
 
 def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh:
@@ -154,19 +169,48 @@ def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh
     return dataclasses.replace(dm, domain=dataclasses.replace(dom, info=info))
 
 
+def _waterline_edge(dm: DomainMesh) -> float:
+    """Length of the shortest mesh edge at the waterline vertex (inf when the nose is fully wetted)."""
+    info = dm.domain.info
+    if "waterline_segment" not in info:
+        return math.inf
+    p = dm.mesh.p
+    i = int(np.argmin(p[0] ** 2 + (p[1] - info["waterline_radius"]) ** 2))
+    edges = dm.mesh.facets[:, np.any(dm.mesh.facets == i, axis=0)]
+    return float(np.min(np.hypot(*(p[:, edges[0]] - p[:, edges[1]]))))
+
+
+def singular_wetted_corners(dm: DomainMesh) -> list:
+    """Corners of the wetted body where |grad phi| is unbounded (ring corners with lambda < 1)."""
+    return [c for c in dm.domain.corners if not c.on_axis and c.exponent < 1.0]
+
+
 def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None = None,
-                           step: float = 2e-4, far_field: str = "monopole") -> HalfspaceCoefficients:
+                           step: float = 2e-4, far_field: str = "monopole", g_source: str = "auto") -> HalfspaceCoefficients:
     """A, B (three readings), C, dA/dP and phi_tip of Part I, eq. (12) by FEM at depth P.
 
-    ``step``: the depth step of the shape finite difference, as a fraction of L_h.
+    G = int |grad phi|^2 n_x dS two ways: ``G_surface`` from the FEM surface gradient, and
+    ``G_shape`` = 2 (Q - H) - dA/dP, the value that makes errata 2a's identity B_bernoulli =
+    dA/dP hold (Q and dA/dP are shape derivatives of the energy A, H a linear functional of the
+    trace: all converge at the rate of A).  At a ring corner of exponent lambda < 1 (a flat nose's
+    rim: 2/3; a cone's shoulder: pi/(pi + beta)) |grad phi|^2 ~ rho^(2 lambda - 2) on the face, and
+    the elements touching the corner miss a part ~ rho_min^(2 lambda - 1) of G_surface, which a
+    graded mesh cannot shrink fast (rho_min^(1/3) at a flat rim).  ``g_source="auto"`` takes
+    G_shape there and G_surface elsewhere (where |G_surface - G_shape| checks the identity).
+
+    ``step``: the depth step of the shape finite difference, as a fraction of L_h (of the radius
+    for a flat nose, :func:`depth_scale`).
     """
     options = options or MeshOptions()
     t0 = time.perf_counter()
     dm = halfspace_mesh(nose, depth, options)
     sol = solve_potential(dm, far_field)
-    eps = step * nose.length
-    Ap = solve_potential(moved_mesh(dm, eps), far_field).A
-    Am = solve_potential(moved_mesh(dm, -eps), far_field).A
+    # the waterline vertex slides along x = 0 while the nose moves by eps: the elements at it shear by
+    # about eps, so eps stays well below the smallest of them (graded waterline corners are tiny)
+    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm))
+    plus, minus = moved_meshes(dm, [eps, -eps])
+    Ap = solve_potential(plus, far_field).A
+    Am = solve_potential(minus, far_field).A
     dA = (Ap - Am) / (2 * eps)
     s = sol.surface("body")
     G = float(np.sum(s["weight"] * s["grad2"] * s["nx"]))
@@ -180,11 +224,17 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
         phi_w = sol.node_value((0.0, rw))
         waterline = 2 * math.pi * phi_w * rw * abs(dr) / abs(dx)
     Q = dA - waterline
+    G_surface, G_shape = G, 2 * (Q - H) - dA
+    if g_source == "auto":
+        g_source = "shape" if singular_wetted_corners(dm) else "surface"
+    if g_source not in ("surface", "shape"):
+        raise ValueError(f"g_source must be 'auto', 'surface' or 'shape'; got {g_source!r}")
+    G = G_shape if g_source == "shape" else G_surface
     return HalfspaceCoefficients(
         depth=depth, A=sol.A, C=sol.C, B_body=G + 2 * Q, B_literal=G + 2 * (Q - H),
         B_bernoulli=-G + 2 * (Q - H), dA_dP=dA, phi_tip=sol.node_value((depth, 0.0)),
         G=G, H=H, Q=Q, n_dofs=sol.n_dofs, n_elements=int(dm.mesh.t.shape[1]),
-        seconds=time.perf_counter() - t0,
+        seconds=time.perf_counter() - t0, G_surface=G_surface, G_shape=G_shape, G_source=g_source,
     )
 
 

@@ -42,7 +42,7 @@ from skfem import MeshTri1, MeshTri2
 from semianalytic.errors import InputError
 from semianalytic.geometry import Arc, Line, Meridian, Nose, SplineCurve
 
-MESH_FORMAT_VERSION = 5  # bump when the domain construction changes (invalidates the cache)
+MESH_FORMAT_VERSION = 8  # bump when the domain construction changes (invalidates the cache)
 
 # ------------------------------------------------------------------------------------
 # curve pieces
@@ -132,7 +132,13 @@ class MeshOptions:
     refines the whole mesh uniformly (needed for clean convergence rates); ``far``:
     far radius / d (for the half-space: R = far (d + P), since the image of the hole makes the
     quadrupole part of the far field grow with P);
-    ``order``: geometric order (1 straight edges, 2 curved isoparametric edges).
+    ``order``: geometric order (1 straight edges, 2 curved isoparametric edges);
+    ``grading``: at a singular corner (see :func:`singular_corners`, solution ~ rho^lambda) the
+    element size is h d (rho/rho0)^(1 - mu) within rho0 = d/2, with mu = grading * lambda / order,
+    capped at 1, down to ``corner_min`` d (the
+    graded meshes of Babuska, Kellogg and Pitkaranta: mu < lambda/order restores the optimal
+    rate h^order of the energy norm, h^(2 order) of A); 0 switches the grading off (fixed
+    ``corner``/``tip`` factors only).
     """
 
     h: float = 0.08
@@ -141,6 +147,8 @@ class MeshOptions:
     growth: float = 3.0
     far: float = 20.0
     order: int = 2
+    grading: float = 0.4  # mu = grading * lambda / order at a singular corner; 0: no grading
+    corner_min: float = 1e-7  # smallest graded element size / d (scikit-fem's element maps need > ~1e-8)
 
     def __post_init__(self):
         if not 0 < self.h <= 1:
@@ -155,6 +163,10 @@ class MeshOptions:
             raise InputError("mesh.far", f"far radius over diameter must exceed 1; got {self.far!r}")
         if self.order not in (1, 2):
             raise InputError("mesh.order", f"must be 1 or 2; got {self.order!r}")
+        if not 1e-9 <= self.corner_min <= 1:
+            raise InputError("mesh.corner_min", f"must lie in [1e-9, 1]; got {self.corner_min!r}")
+        if not 0 <= self.grading <= 1:
+            raise InputError("mesh.grading", f"must lie in [0, 1]; got {self.grading!r}")
 
     def refined(self, factor: float) -> "MeshOptions":
         """The same grading with all element sizes divided by ``factor``."""
@@ -174,6 +186,7 @@ class Domain:
     info: dict = field(default_factory=dict, compare=False)
     interfaces: tuple[tuple[str, Piece], ...] = ()  # curves embedded in the domain (material interfaces)
     tip_points: tuple[tuple[float, float], ...] = ()  # pointed tips (refined with options.tip)
+    corners: tuple[Corner, ...] = ()  # singular corners (graded with options.grading)
 
     def key(self, options: MeshOptions) -> str:
         blob = {
@@ -185,10 +198,89 @@ class Domain:
             "scale": self.length_scale,
             "refine": self.refine_points,
             "tips": self.tip_points,
+            "corners": [dataclasses.astuple(c) for c in self.corners],
             "options": dataclasses.asdict(options),
         }
         text = json.dumps(blob, sort_keys=True, default=float)
         return hashlib.sha256(text.encode()).hexdigest()[:24]
+
+
+@dataclass(frozen=True)
+class Corner:
+    """A boundary point where the solution is singular: phi - phi(corner) ~ rho^exponent.
+
+    ``angle``: the fluid's opening angle at the point (rad); ``exponent``: lambda = pi/angle at a
+    ring corner off the axis (2D corner of the meridian, Neumann on both sides), or nu + 1/2 at
+    a conical point on the axis (phi ~ rho^nu P_nu(cos psi) in 3D; the extra 1/2 is the
+    axisymmetric weight r, which makes the 3D vertex as regular as a 2D corner of exponent nu + 1/2).
+    """
+
+    point: tuple[float, float]
+    angle: float
+    exponent: float
+    on_axis: bool
+
+
+def cone_tip_exponent(half_angle: float) -> float:
+    """Smallest nu > 0 with d/dpsi P_nu(cos psi) = 0 at psi = pi - half_angle: the potential outside a
+    cone of that half-angle (Neumann on its surface) behaves as rho^nu P_nu(cos psi) near the point.
+    P_nu(x) = 2F1(-nu, nu+1; 1; (1-x)/2), so P_nu'(x) is proportional to 2F1(1-nu, nu+2; 2; (1-x)/2).
+    nu -> 1 for a needle (a thin Neumann obstacle barely disturbs a linear field), 2 for a flat tip."""
+    from scipy.optimize import brentq
+    from scipy.special import hyp2f1
+
+    z = 0.5 * (1 + math.cos(half_angle))
+    f = lambda nu: hyp2f1(1 - nu, nu + 2, 2, z)  # noqa: E731
+    grid = np.linspace(1e-6, 2.0 + 1e-9, 401)
+    vals = [f(v) for v in grid]
+    for a, b, fa, fb in zip(grid[:-1], grid[1:], vals[:-1], vals[1:]):
+        if fa == 0:
+            return float(a)
+        if fa * fb < 0:
+            return float(brentq(f, a, b, xtol=1e-14))
+    return 2.0
+
+
+def _tangent(piece: Piece, end: bool) -> np.ndarray:
+    t = piece.t1 if end else piece.t0
+    dx, dr = piece.derivative(t)
+    v = np.array([float(dx), float(dr)]) * (1.0 if piece.t1 >= piece.t0 else -1.0)
+    return v / np.hypot(*v)
+
+
+def singular_corners(loop, tol: float = 1e-9) -> tuple[Corner, ...]:
+    """Corners of a boundary loop (counter-clockwise around the fluid) found from the geometry: the
+    jumps of the unit tangent between consecutive pieces (joints with the far boundary excluded).
+
+    The fluid's opening angle at a joint is omega = pi - turn, turn the signed tangent turning
+    angle.  Off the axis the solution of the Neumann problem goes like rho^(pi/omega): singular
+    (in the gradient) for omega > pi, and below the P2 rate for omega in (pi/2, pi).  On the axis a
+    body meeting the axis at a cone of half-angle beta = pi - omega (omega: the fluid angle)
+    gives the 3D exponent nu of :func:`cone_tip_exponent`; beta = pi/2 (a flat or round tip)
+    is smooth.  Only corners with an exponent below 2 (the rate of P2) are returned."""
+    out = []
+    n = len(loop)
+    for i in range(n):
+        (tag_a, a), (tag_b, b) = loop[i], loop[(i + 1) % n]
+        if "far" in (tag_a, tag_b):
+            continue
+        ta, tb = _tangent(a, end=True), _tangent(b, end=False)
+        turn = math.atan2(ta[0] * tb[1] - ta[1] * tb[0], float(ta @ tb))
+        omega = math.pi - turn
+        if abs(turn) < tol:
+            continue
+        x, r = b.start
+        if "axis" in (tag_a, tag_b):
+            if abs(omega - 0.5 * math.pi) < tol:
+                continue
+            exponent = cone_tip_exponent(math.pi - omega) + 0.5  # half-angle beta = pi - omega
+            on_axis = True
+        else:
+            exponent = math.pi / omega
+            on_axis = False
+        if exponent < 2.0 - 1e-9:
+            out.append(Corner((float(x), float(r)), float(omega), float(exponent), on_axis))
+    return tuple(out)
 
 
 def _far_arc(center, radius, a0, a1) -> Piece:
@@ -215,7 +307,7 @@ def body_domain(meridian: Meridian, options: MeshOptions) -> Domain:
     refine += [pieces[-1 - i][1].start for i in range(len(meridian.segments) - 1)] if len(meridian.segments) > 1 else []
     return Domain("body", tuple(pieces), (xc, 0.0), R, d, tuple(tuple(map(float, p)) for p in refine),
                   {"volume": meridian.volume(), "diameter": d, "length": length},
-                  tip_points=tuple(tuple(map(float, p)) for p in tips))
+                  tip_points=tuple(tuple(map(float, p)) for p in tips), corners=singular_corners(pieces))
 
 
 def _nose_waterline(nose: Nose, depth: float) -> tuple[int, float]:
@@ -272,7 +364,7 @@ def halfspace_domain(nose: Nose, depth: float, options: MeshOptions) -> Domain:
         refine.append(p.start)
     info.update({"depth": depth, "nose_length": Lh, "diameter": d})
     return Domain("halfspace", tuple(pieces), (0.0, 0.0), Rf, d, tuple(tuple(map(float, p)) for p in refine), info,
-                  tip_points=(tip,) if pointed else ())
+                  tip_points=(tip,) if pointed else (), corners=singular_corners(pieces))
 
 
 def annulus_domain(a: float, outer: float, options: MeshOptions, interface: float | None = None) -> Domain:
@@ -387,6 +479,17 @@ def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
         g = options.h * options.growth
         hmax = 0.25 * domain.far_radius
         terms = [f"{h} + {g}*F{f1}"]
+        graded = {c.point: c for c in domain.corners} if options.grading > 0 else {}
+        rho0 = 0.5 * d  # radius of the graded zone around a corner
+        for c in graded.values():
+            # (h + g rho) (rho/rho0)^(1-mu): the smooth size field at rho0, graded inside, down to
+            # rho_min = rho0 (h/rho0)^(1/mu) where the size equals the distance
+            mu = min(1.0, options.grading * c.exponent / options.order)
+            rho_min = max(rho0 * (h / rho0) ** (1.0 / mu), options.corner_min * d)
+            fc = fm.add("Distance")
+            fm.setNumbers(fc, "PointsList", [point(c.point)])
+            terms.append(f"({h} + {g}*F{fc}) * (Max(F{fc}, {rho_min!r}) / {rho0!r})^{1.0 - mu!r}")
+        # the fixed corner/tip refinements stay (Min): grading only ever refines the smooth size field
         for pts, factor in ((domain.refine_points, options.corner), (domain.tip_points, options.tip)):
             if pts:
                 fp = fm.add("Distance")

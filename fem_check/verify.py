@@ -7,9 +7,10 @@
   (``semianalytic.coefficients.table.coefficients_at``); convergence of the BEM-FEM difference
   under refinement; for a hemispherical nose also the exact mirrored-sphere solution at P = R.
 
-Both cases include the far-field study: the error of the truncated FEM domain against the
+The far-field study (not with ``--quick``): the error of the truncated FEM domain against the
 far radius for the Robin conditions of a dipole (k = 2), a monopole (k = 1) and for a plain
-Neumann cut-off (errata item 2f).
+Neumann cut-off (errata item 2f), where an exact reference exists: a sphere or spheroid body,
+and the hemispherical nose at P = R (so only for ``nose = "sphere"`` cases).
 """
 
 from __future__ import annotations
@@ -21,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fem_check.coefficients import body_added_mass, halfspace_coefficients, halfspace_mesh
+from fem_check.coefficients import body_added_mass, depth_scale, halfspace_coefficients, halfspace_mesh
 from fem_check.meshing import MeshOptions, body_domain, build_mesh
 from fem_check.potential import solve_potential
 from semianalytic.errors import InputError
@@ -31,19 +32,37 @@ TEST_DEPTHS = (0.5, 2.0, 8.0)
 READINGS = ("body", "literal", "bernoulli")
 
 
-def hemisphere_reference(n_terms: int = 4000) -> dict:
+def legendre_half_moments(n_max: int) -> np.ndarray:
+    """I_n = int_0^1 mu P_n(mu) dmu for even n = 0, 2, ..., n_max (closed form, O(n)).
+
+    With P_n(0) from the three-term (Bonnet) recurrence at mu = 0, where its middle term
+    vanishes: P_{n+2}(0) = -(n+1)/(n+2) P_n(0); then for even n >= 2, from mu P_n =
+    ((n+1) P_{n+1} + n P_{n-1})/(2n+1) and int_0^1 P_m = (P_{m-1}(0) - P_{m+1}(0))/(2m+1):
+    I_n = -P_n(0) / ((n+2)(n-1)), and I_0 = 1/2.
+    """
+    n = np.arange(0, n_max + 1, 2)
+    ratio = np.ones(len(n))
+    ratio[1:] = -(n[1:] - 1.0) / n[1:]
+    p0 = np.cumprod(ratio)  # P_n(0) = (-1)^(n/2) (n-1)!!/n!!
+    moments = np.empty(len(n))
+    moments[0] = 0.5
+    moments[1:] = -p0[1:] / ((n[1:] + 2.0) * (n[1:] - 1.0))
+    return moments
+
+
+def hemisphere_reference(n_terms: int = 400_000) -> dict:
     """Hemispherical nose of radius a at depth P = a (errata item 1b conventions): mirrored in x = 0
     it is a full sphere with dphi/dR = -|cos(theta)|, solved by a Legendre series.
 
-    phi = sum_n c_n (a/R)^(n+1) P_n(cos theta), c_n = a g_n/(n+1), |mu| = sum g_n P_n(mu) (even n).
+    phi = sum_n c_n (a/R)^(n+1) P_n(cos theta), c_n = a g_n/(n+1), |mu| = sum g_n P_n(mu) (even n),
+    g_n = (2n+1) I_n with I_n of :func:`legendre_half_moments` (O(n) recurrence; the direct
+    Gauss-Legendre evaluation of I_n cost O(n^2) and 58% of ``verify``).
     Returns phi_tip / a and Abar / a = 4A/(pi d^2) / a (numerical notes: 0.680633550050 and
-    0.553967546980; the phi_tip series converges like n^(-3/2), hence the many terms)."""
-    from scipy.special import eval_legendre
-
+    0.553967546980).  The phi_tip series alternates with terms ~ n^(-5/2): 400,000 terms leave
+    a tail below 1e-13; Abar's terms fall like n^(-5).
+    """
     n = np.arange(0, n_terms + 1, 2)
-    x, w = np.polynomial.legendre.leggauss(n_terms // 2 + 4)
-    x, w = 0.5 * (x + 1), 0.5 * w  # Gauss rule on [0, 1]: exact for mu P_n(mu), n <= n_terms
-    I = np.array([np.sum(w * x * eval_legendre(k, x)) for k in n])  # int_0^1 mu P_n
+    I = legendre_half_moments(n_terms)
     g = (2 * n + 1) * I
     c = g / (n + 1)
     return {"phi_tip_over_a": float(c.sum()), "Abar_over_a": float(np.sum(c * 2 * I))}
@@ -110,18 +129,21 @@ def body_far_field_study(meridian, exact: float, fars=(1.5, 3.0, 6.0, 12.0), h: 
 # projectile in the half-space
 
 
-def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_refinement: float = 1.0) -> list[dict]:
+def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_refinement: float = 1.0,
+                   grading: float | None = None) -> list[dict]:
     """FEM and BEM coefficients at the given depths (in nose lengths); one dict per depth (SI)."""
     from semianalytic.coefficients.table import coefficients_at
 
-    Ps = np.asarray(depths_over_Lh, float) * nose.length
+    scale = depth_scale(nose)  # L_h, or the radius of a flat nose
+    Ps = np.asarray(depths_over_Lh, float) * scale
     t0 = time.perf_counter()
     bem = coefficients_at(nose, Ps, refinement=bem_refinement)
     t_bem = (time.perf_counter() - t0) / len(Ps)
     rows = []
     for i, P in enumerate(Ps):
-        f = halfspace_coefficients(nose, float(P), MeshOptions(h=h, order=order))
-        row = {"depth_m": float(P), "depth_over_Lh": float(P / nose.length)}
+        opts = MeshOptions(h=h, order=order) if grading is None else MeshOptions(h=h, order=order, grading=grading)
+        f = halfspace_coefficients(nose, float(P), opts)
+        row = {"depth_m": float(P), "depth_over_Lh": float(P / scale)}
         for key, fk in (("A", "A"), ("B", "B_body"), ("C", "C")):
             row[f"{key}_bem"] = float(bem[fk if key != "B" else "B_body"][i])
             row[f"{key}_fem"] = float(getattr(f, fk))
@@ -137,6 +159,8 @@ def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_re
         row["fem_bernoulli_identity"] = abs(f.B_bernoulli - f.dA_dP) / S
         row["fem_dofs"], row["fem_seconds"], row["bem_seconds"] = f.n_dofs, f.seconds, t_bem
         row["bem_unknowns"] = int(bem["unknowns"][i])
+        row["fem_G_source"] = f.G_source
+        row["fem_B_surface"] = f.G_surface + 2 * f.Q
         rows.append(row)
     return rows
 
@@ -203,6 +227,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="comma-separated depths in nose lengths L_h (default: " + ",".join(map(str, DEFAULT_DEPTHS)) + ")")
     parser.add_argument("--h", type=number(0.005, 0.5), default=0.04, help="FEM element size on the body over d (default 0.04)")
     parser.add_argument("--quick", action="store_true", help="skip the convergence and far-field studies")
+    parser.add_argument("--study-h", default="0.16,0.08,0.04,0.02",
+                        help="element sizes over d of the refinement study on cornered noses (default 0.16,0.08,0.04,0.02)")
+    parser.add_argument("--grading", type=float, default=None,
+                        help="corner grading mu = grading * lambda / 2 of the FEM meshes (default 0.4; 0: none)")
     add_output_arguments(parser, "")
 
 
@@ -220,6 +248,16 @@ def _parse_depths(text: str | None) -> tuple[float, ...]:
     return vals
 
 
+def _parse_study_h(text: str) -> tuple[float, ...]:
+    try:
+        vals = tuple(float(v) for v in text.split(",") if v.strip())
+    except ValueError:
+        raise InputError("--study-h", f"expected comma-separated element sizes over d; got {text!r}") from None
+    if len(vals) < 3 or any(not 0.005 <= v <= 0.5 for v in vals) or any(b >= a for a, b in zip(vals, vals[1:])):
+        raise InputError("--study-h", f"need at least three decreasing sizes in [0.005, 0.5]; got {text!r}")
+    return vals
+
+
 def run(args) -> int:
     from fem_check.report import Report, emit_json
     from semianalytic.case import load_case
@@ -229,6 +267,9 @@ def run(args) -> int:
     if not 0.005 <= args.h <= 0.5:
         raise InputError("--h", f"element size over d must lie in [0.005, 0.5]; got {args.h!r}")
     depths = _parse_depths(args.depths)
+    study_h = _parse_study_h(args.study_h)
+    if args.grading is not None and not 0 <= args.grading <= 1:
+        raise InputError("--grading", f"must lie in [0, 1]; got {args.grading!r}")
     if case.body is None and case.projectile is None:
         raise InputError("case", "needs a [body] or a [projectile] section")
     from semianalytic.guards import check_case, check_fem
@@ -247,15 +288,22 @@ def run(args) -> int:
             res["far_field"] = body_far_field_study(meridian, exact)
         payload = {"case": case.title, "kind": "body", **res}
     else:
+        from fem_check.refinement import has_singular_corners, refinement_study
+
         nose = nose_from_section(case.projectile)
-        rows = compare_depths(nose, depths, h=args.h)
+        rows = compare_depths(nose, depths, h=args.h, grading=args.grading)
+        scale = depth_scale(nose)
         payload = {"case": case.title, "kind": "halfspace", "nose": nose.kind, "diameter_m": nose.diameter,
-                   "nose_length_m": nose.length, "h_over_d": args.h, "depths": rows,
+                   "nose_length_m": nose.length, "depth_scale": "L_h" if scale == nose.length else "radius",
+                   "depth_scale_m": scale, "h_over_d": args.h, "depths": rows,
                    "max_rel_diff": max(r["max_rel_diff"] for r in rows)}
-        if not args.quick:
+        cornered = has_singular_corners(nose, np.asarray(depths) * scale)
+        if not args.quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
+            payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading)
+        elif not args.quick:
             payload["convergence"] = convergence_study(nose)
-            payload["far_field"] = halfspace_far_field_study()
-            if nose.kind == "sphere":
+            if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
+                payload["far_field"] = halfspace_far_field_study()
                 payload["hemisphere_exact"] = hemisphere_check()
     if report:
         from fem_check.verify_report import write_verify_report

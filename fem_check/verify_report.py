@@ -94,15 +94,17 @@ def _far_plot(r, ff, key, xlabel, kinds):
 
 def _halfspace(r: Report, p: dict) -> None:
     d, Lh = p["diameter_m"], p["nose_length_m"]
+    unit = p.get("depth_scale", "L_h")
     S = math.pi * d * d / 4
     rows = p["depths"]
     r.add(f"Nose: {p['nose']}, d = {fmt(d * 1e3)} mm, L_h = {fmt(Lh * 1e3)} mm. FEM: P2, h = {fmt(p['h_over_d'])} d on "
-          "the nose (graded towards the tip, the nose-shank junction and the free-surface corner or waterline), far "
+          "the nose (graded towards the corners found from the meridian: tip, nose-shank junction, waterline; see "
+          "fem_check.meshing.singular_corners), far "
           "radius 20 (d + P); B from the shape finite difference of A on a moving mesh (see fem_check.coefficients). "
           "BEM: semianalytic.coefficients.table.coefficients_at (order 8, refinement 1).", "",
           f"**Largest relative BEM-FEM difference of A, B (body reading), C: {fmt(p['max_rel_diff'])}.**", "",
           "## Coefficients (normalised: Abar = 4A/(pi d^2) in mm, Bbar, Cbar)", "",
-          md_table(["P/L_h", "Abar BEM", "Abar FEM", "rel. diff A", "Bbar BEM", "Bbar FEM", "rel. diff B", "Cbar FEM",
+          md_table([f"P/{unit}", "Abar BEM", "Abar FEM", "rel. diff A", "Bbar BEM", "Bbar FEM", "rel. diff B", "Cbar FEM",
                     "rel. diff C", "FEM dofs", "FEM s", "BEM s"],
                    [[x["depth_over_Lh"], x["A_bem"] / S * 1e3, x["A_fem"] / S * 1e3, x["rel_diff"]["A"], x["B_bem"] / S,
                      x["B_fem"] / S, x["rel_diff"]["B"], x["C_fem"] / S, x["rel_diff"]["C"], x["fem_dofs"], x["fem_seconds"],
@@ -110,8 +112,9 @@ def _halfspace(r: Report, p: dict) -> None:
           "### The other B readings (errata item 2a) and phi_tip", "",
           "B_literal as a relative difference; B_bernoulli and dA/dP tend to zero at depth, so their differences are "
           "given in Bbar units (divided by pi d^2/4). Last column: the FEM's own identity B_bernoulli = dA/dP (errata "
-          "2a), which the FEM does not impose (B_bernoulli comes from surface integrals, dA/dP from the depth derivative).", "",
-          md_table(["P/L_h", "Bbar literal FEM", "rel. diff", "Bbar bernoulli FEM", "diff", "dA/dP / S FEM", "diff",
+          "2a), which the FEM does not impose (B_bernoulli comes from surface integrals, dA/dP from the depth derivative) "
+          "except at a ring corner with lambda < 1, where G is taken from the shape form (see the Corners section).", "",
+          md_table([f"P/{unit}", "Bbar literal FEM", "rel. diff", "Bbar bernoulli FEM", "diff", "dA/dP / S FEM", "diff",
                     "phi_tip rel. diff", "FEM abs(B_bern - dA/dP)/S"],
                    [[x["depth_over_Lh"], x["B_literal_fem"] / S, x["rel_diff"]["B_literal"], x["B_bernoulli_fem"] / S,
                      x["bar_diff"]["B_bernoulli"], x["dA_dP_fem"] / S, x["bar_diff"]["dA_dP"], x["rel_diff"]["phi_tip"],
@@ -127,7 +130,7 @@ def _halfspace(r: Report, p: dict) -> None:
     ax.semilogx(P, [x["B_fem"] / S for x in rows], "s", label="Bbar (body) FEM")
     ax.semilogx(P, [x["C_bem"] / S for x in rows], "-", label="Cbar BEM")
     ax.semilogx(P, [x["C_fem"] / S for x in rows], "^", label="Cbar FEM")
-    ax.set_xlabel("P / L_h")
+    ax.set_xlabel(f"P / {unit}")
     ax.legend(fontsize=8)
     r.figure("coefficients", fig, "A, B, C against depth: BEM lines, FEM points")
     conv = p.get("convergence")
@@ -162,6 +165,8 @@ def _halfspace(r: Report, p: dict) -> None:
             ax.set_title(f"{name}: abs(FEM/BEM - 1)", fontsize=9)
         axA.legend(fontsize=6)
         r.figure("convergence", fig, "BEM-FEM difference of A and B under refinement")
+    if p.get("refinement"):
+        _refinement(r, p)
     hs = p.get("hemisphere_exact")
     if hs:
         r.add("## Exact check: hemispherical nose at P = R", "",
@@ -180,3 +185,82 @@ def _halfspace(r: Report, p: dict) -> None:
                        [[f["far"], f["far_radius_over_a"], f["monopole"], f["dipole"], f["neumann"]] for f in ff]), "",
               "With the monopole condition the remaining error is the discretisation error of the mesh (h = 0.05 d).", "")
         _far_plot(r, ff, "far", "far radius / (d + P)", ("monopole", "dipole", "neumann"))
+
+
+def _pm(e: dict, scale: float = 1.0) -> str:
+    if e.get("extrapolated") is None:
+        return "-"
+    return f"{e['extrapolated'] / scale:.9g} +- {e['error_bar'] / scale:.1e}"
+
+
+def _refinement(r: Report, p: dict) -> None:
+    from fem_check.refinement import PREDICTED_ORDER
+
+    d = p["diameter_m"]
+    S = math.pi * d * d / 4
+    unit = p.get("depth_scale", "L_h")
+    study = p["refinement"]
+    r.add("## Corners: FEM self-convergence and the BEM", "",
+          "A nose with corners has no closed-form potential, so the FEM is verified on its own: the element size h on "
+          "the body is halved on meshes graded towards every corner found from the meridian's tangent jumps "
+          "(fem_check.meshing.singular_corners: fluid angle omega, exponent lambda = pi/omega off the axis, nu + 1/2 at a "
+          "cone point), element size (h d + g rho) (rho/rho0)^(1 - mu) within rho0 = d/2 of a corner, mu = grading lambda/2. "
+          "Observed orders from the last three meshes, Richardson extrapolation X_inf with the error bar abs(X_inf - X_finest). "
+          f"Predicted orders (P2, mu < lambda/2): A and dA/dP {PREDICTED_ORDER['A']:g} (the energy and its shape "
+          f"derivative); B at least {PREDICTED_ORDER['B_body']:g}. "
+          "B (body reading) is taken from the shape form G = 2 (Q - H) - dA/dP where the wetted nose has a ring corner "
+          "with lambda < 1 (there the surface-gradient integral G converges only like rho_min^(2 lambda - 1)); the column "
+          "B_surface shows the surface-gradient value converging (slowly) to it, which is errata 2a's identity "
+          "B_bernoulli = dA/dP checked at a corner.", "")
+    summary = []
+    for st in study:
+        e, b, df = st["extrapolated"], st["bem"], st["diff"]
+        summary.append([st["depth_over_scale"], _pm(e["A"], S / 1e3), f"{b['A'] / S * 1e3:.9g}", df["A"]["fem_minus_bem"],
+                        df["A"]["fem_error_bar"], e["A"]["order"], _pm(e["B_body"], S), f"{b['B_body'] / S:.9g}",
+                        df["B_body"]["fem_minus_bem"], df["B_body"]["fem_error_bar"], e["B_body"]["order"],
+                        e["B_surface"]["order"]])
+    r.add("### FEM extrapolated against the BEM", "",
+          f"Abar = 4A/(pi d^2) in mm, Bbar = 4B/(pi d^2); differences relative to the BEM value (BEM: coefficients_at, "
+          f"order 8, refinement 1, {study[0]['bem']['unknowns']} unknowns at the first depth). Target of issue 10: "
+          "1e-4 in A, 1e-3 in B.", "",
+          md_table([f"P/{unit}", "Abar FEM (extrap.)", "Abar BEM", "A: FEM-BEM", "A: FEM err.", "A order",
+                    "Bbar FEM (extrap.)", "Bbar BEM", "B: FEM-BEM", "B: FEM err.", "B order", "B_surface order"], summary), "")
+    for st in study:
+        rows = st["rows"]
+        hs = [x["h_over_d"] for x in rows]
+        corners = ", ".join(f"({c['x_m'] * 1e3:.3g}, {c['r_m'] * 1e3:.3g}) mm: omega {c['angle_deg']:.1f} deg, "
+                            f"{'nu + 1/2' if c['on_axis'] else 'lambda'} = {c['exponent']:.4f}" for c in st["corners"]) or "none"
+        tab = []
+        seqs = {k: [x[k] for x in rows] for k in ("A", "B_body", "B_surface", "dA_dP")}
+        for j, x in enumerate(rows):
+            o = {}
+            for k, v in seqs.items():
+                o[k] = (math.log(abs((v[j - 1] - v[j - 2]) / (v[j] - v[j - 1]))) / math.log(2.0)
+                        if j >= 2 and v[j] != v[j - 1] and v[j - 1] != v[j - 2] else None)
+            tab.append([x["h_over_d"], x["n_dofs"], f"{x['A'] / S * 1e3:.12f}", o["A"], f"{x['B_body'] / S:.10f}", o["B_body"],
+                        f"{x['B_surface'] / S:.8f}", o["B_surface"], f"{x['dA_dP'] / S:.10f}", o["dA_dP"],
+                        abs(x["B_bernoulli"] - x["dA_dP"]) / S, x["seconds"]])
+        r.add(f"### P = {fmt(st['depth_over_scale'])} {unit} ({fmt(st['depth_m'] * 1e3)} mm)", "",
+              f"Singular corners: {corners}.", "",
+              md_table(["h/d", "dofs", "Abar [mm]", "order", "Bbar", "order", "Bbar (surface G)", "order", "dA/dP / S",
+                        "order", "abs(B_bern - dA/dP)/S", "s"], tab), "")
+    fig = new_figure(7.5, 4.2)
+    axA, axB = fig.add_subplot(121), fig.add_subplot(122)
+    for st in study:
+        hs = np.array([x["h_over_d"] for x in st["rows"]])
+        for ax, k in ((axA, "A"), (axB, "B_body")):
+            ex = st["extrapolated"][k]["extrapolated"]
+            err = [max(abs(x[k] / ex - 1), 1e-16) for x in st["rows"]]
+            ax.loglog(hs[:-1], err[:-1], "o-", label=f"P = {fmt(st['depth_over_scale'])} {unit}")
+        err_s = [max(abs(x["B_surface"] / st["extrapolated"]["B_body"]["extrapolated"] - 1), 1e-16) for x in st["rows"]]
+        axB.loglog(hs, err_s, "x:", color="grey")
+    h = np.array([x["h_over_d"] for x in study[0]["rows"]])
+    for ax, qs, title in ((axA, (4,), "A"), (axB, (2, 4), "B (body); grey x: surface G")):
+        lo, hi = ax.get_ylim()
+        for q, style in zip(qs, ("k:", "k--") if len(qs) == 1 else ("k--", "k:")):
+            ax.loglog(h, hi * 0.5 * (h / h[0]) ** q, style, label=f"h^{q}")
+        _h_ticks(ax, sorted(h.tolist()))
+        ax.set_xlabel("h / d")
+        ax.set_title(f"{title}: abs(X_h / X_inf - 1)", fontsize=9)
+    axA.legend(fontsize=6)
+    r.figure("refinement", fig, "FEM error against the Richardson limit under refinement, graded meshes")

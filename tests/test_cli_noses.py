@@ -80,9 +80,7 @@ def test_coefficients_penetrate_run_sweep(name, env, capsys):
     assert len(rows) >= 3  # header + two velocities
 
 
-FEM = [pytest.param(n, marks=pytest.mark.xfail(strict=True, reason=(
-    "fem_check verify measures depths in nose lengths, L_h = 0 for a flat nose (fem_check: helper femcheck)")))
-    if n == "flat_nose" else n for n in NOSE_CASES]
+FEM = list(NOSE_CASES)  # fem_check verify measures a flat nose's depths in radii (its L_h = 0)
 
 
 @pytest.mark.parametrize("name", FEM)
