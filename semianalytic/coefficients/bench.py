@@ -236,7 +236,7 @@ def _append_certified(path: Path, certified) -> list[Path]:
     lines = ["", "## Certified tables (tolerance 1e-5)", "",
              "Best wall time of a certified table (adaptive knots, error estimates, deep limit) beside the legacy "
              "60-depth table in the same run (the machine is shared: the ratio is the comparable number). The "
-             "issue's targets are 1.0 s (ogive) and 0.7 s (sphere) on one core where the 60-depth table took 0.6 s "
+             "issue's targets are 1.0 s (ogive) and 0.7 s (sphere) on one core where the legacy 60-depth table took 0.6 s "
              "and 0.35 s; 'scaled' is the ratio times that reference.", "",
              "| nose | knots | certified [s] | 60 depths [s] | ratio | scaled to the reference [s] | target [s] |",
              "|---|---|---|---|---|---|---|"]
