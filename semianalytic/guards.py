@@ -110,6 +110,14 @@ def _estimated_nose_panels(nose, refinement: float, levels: int) -> float:
     return total
 
 
+def _arithmetic_unknowns(nose, order: int, refinement: float, max_depth_nose_lengths: float, levels: int = 12) -> float:
+    """Primary unknowns of the deepest half-space layout by arithmetic only (no layout built)."""
+    estimate = _estimated_nose_panels(nose, refinement, levels)
+    length = (max_depth_nose_lengths - 1) * max(nose.length, nose.radius)
+    shank = levels + max(0.0, math.log2(max(length / nose.radius, 1.0)) * refinement) + 2
+    return order * (estimate + shank)
+
+
 def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_depth_nose_lengths: float = 300.0,
                            levels: int = 12) -> float:
     """Primary unknowns N of the deepest half-space layout of ``nose`` (order x panels)."""
@@ -117,9 +125,7 @@ def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_de
 
     estimate = _estimated_nose_panels(nose, refinement, levels)
     if estimate > EXACT_PLAN_PANELS:
-        length = (max_depth_nose_lengths - 1) * max(nose.length, nose.radius)
-        shank = levels + max(0.0, math.log2(max(length / nose.radius, 1.0)) * refinement) + 2
-        return order * (estimate + shank)
+        return _arithmetic_unknowns(nose, order, refinement, max_depth_nose_lengths, levels)
     # the tables' depth unit: L_h, or the radius for a flat nose (L_h = 0)
     scale = nose.length if nose.length > 0.05 * nose.radius else nose.radius
     layout = halfspace_layout(nose, max_depth_nose_lengths * scale, LayoutOptions(order, refinement, levels))
@@ -198,6 +204,12 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     def need_for(n, o=order, r=ref) -> float:
         return bem_bytes(bem_halfspace_unknowns(n, o, r, depth))
 
+    # Fast path: the arithmetic count of panels (no layout), taken four times over (sixteen
+    # times the bytes) for the grading the arithmetic does not see, fits easily: no exact plan
+    # needed (building the deepest layout costs most of a second).
+    rough = _arithmetic_unknowns(nose, order, ref, depth)
+    if math.isfinite(rough) and bem_bytes(4.0 * rough) <= limit:
+        return bem_bytes(rough)
     need = need_for(nose)
     if need <= limit:
         return need
