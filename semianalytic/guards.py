@@ -93,16 +93,26 @@ def _budget_text(limit: float) -> str:
 # BEM unknowns from the panel plan
 
 
+def _arc_length(seg, ta: float, tb: float) -> float:
+    """Arc length of a meridian segment by 24-point Gauss-Legendre (as the BEM layout measures
+    it), without importing the BEM (its scipy imports cost half a second)."""
+    import numpy as np
+
+    u, w = np.polynomial.legendre.leggauss(24)
+    t = 0.5 * (ta + tb) + 0.5 * (tb - ta) * u
+    dx, dr = seg.derivative(t)
+    return float(0.5 * abs(tb - ta) * np.sum(w * np.hypot(dx, dr)))
+
+
 def _estimated_nose_panels(nose, refinement: float, levels: int) -> float:
     """Panels of the whole nose as :func:`semianalytic.bem.panels.halfspace_layout` would lay
     them at full submersion, by arithmetic only (a float: may be astronomically large)."""
-    from semianalytic.bem.panels import _segment_arc_length
     from semianalytic.geometry import SplineCurve
 
     R = nose.radius
     total = 0.0
     for seg in nose.segments:
-        arc = _segment_arc_length(seg, seg.t0, seg.t1)
+        arc = _arc_length(seg, seg.t0, seg.t1)
         n = max(2.0, math.ceil(refinement * 1.6 * arc / R)) if math.isfinite(arc) else math.inf
         if isinstance(seg, SplineCurve):
             n = max(n, len(seg.knots))
