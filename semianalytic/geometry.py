@@ -183,6 +183,15 @@ def _leggauss(n: int):
     return np.polynomial.legendre.leggauss(n)
 
 
+def segment_arc_length(seg: Segment, ta: float, tb: float) -> float:
+    """Arc length of a segment between parameters ``ta`` and ``tb`` (24-point Gauss-Legendre:
+    the measure the BEM layout and the memory guard count panels by)."""
+    u, w = _leggauss(24)
+    t = 0.5 * (ta + tb) + 0.5 * (tb - ta) * u
+    dx, dr = seg.derivative(t)
+    return float(0.5 * abs(tb - ta) * np.sum(w * np.hypot(dx, dr)))
+
+
 def _gauss_integrate(segment: Segment, f, n: int = 48) -> float:
     """Integrate ``f(x, r, dx, dr)`` dt over a segment with composite Gauss-Legendre."""
     u, w = _leggauss(n)

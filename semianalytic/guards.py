@@ -93,26 +93,15 @@ def _budget_text(limit: float) -> str:
 # BEM unknowns from the panel plan
 
 
-def _arc_length(seg, ta: float, tb: float) -> float:
-    """Arc length of a meridian segment by 24-point Gauss-Legendre (as the BEM layout measures
-    it), without importing the BEM (its scipy imports cost half a second)."""
-    import numpy as np
-
-    u, w = np.polynomial.legendre.leggauss(24)
-    t = 0.5 * (ta + tb) + 0.5 * (tb - ta) * u
-    dx, dr = seg.derivative(t)
-    return float(0.5 * abs(tb - ta) * np.sum(w * np.hypot(dx, dr)))
-
-
 def _estimated_nose_panels(nose, refinement: float, levels: int) -> float:
     """Panels of the whole nose as :func:`semianalytic.bem.panels.halfspace_layout` would lay
     them at full submersion, by arithmetic only (a float: may be astronomically large)."""
-    from semianalytic.geometry import SplineCurve
+    from semianalytic.geometry import SplineCurve, segment_arc_length
 
     R = nose.radius
     total = 0.0
     for seg in nose.segments:
-        arc = _arc_length(seg, seg.t0, seg.t1)
+        arc = segment_arc_length(seg, seg.t0, seg.t1)
         n = max(2.0, math.ceil(refinement * 1.6 * arc / R)) if math.isfinite(arc) else math.inf
         if isinstance(seg, SplineCurve):
             n = max(n, len(seg.knots))
@@ -144,14 +133,15 @@ def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_de
 
 def bem_body_unknowns(meridian, order: int = 8, refinement: float = 1.0, levels: int = 12) -> float:
     """Unknowns N of a closed body in unbounded fluid (order x panels of the body layout)."""
-    from semianalytic.bem.panels import LayoutOptions, _segment_arc_length, body_panels
+    from semianalytic.bem.panels import LayoutOptions, body_panels
+    from semianalytic.geometry import segment_arc_length
     from semianalytic.geometry import EllipseArc
 
     segs = meridian.segments
     scale = _max_radius(meridian)
     estimate = 0.0
     for seg in segs:
-        arc = _segment_arc_length(seg, seg.t0, seg.t1)
+        arc = segment_arc_length(seg, seg.t0, seg.t1)
         n = refinement * 1.6 * arc / scale
         if isinstance(seg, EllipseArc):
             n = max(n, refinement * 1.2 * max(seg.a, seg.b) / max(min(seg.a, seg.b), 1e-300))
@@ -330,9 +320,9 @@ def check_fem(case, h: float, depths_nose_lengths=(), far: float = 20.0) -> floa
 
 
 def _arc(seg) -> float:
-    from semianalytic.bem.panels import _segment_arc_length
+    from semianalytic.geometry import segment_arc_length
 
-    return _segment_arc_length(seg, seg.t0, seg.t1)
+    return segment_arc_length(seg, seg.t0, seg.t1)
 
 
 def check_case(case, *, order: int | None = None, refinement: float | None = None, max_depth: float | None = None,

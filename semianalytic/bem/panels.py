@@ -26,7 +26,7 @@ import numpy as np
 from scipy.optimize import brentq
 
 from semianalytic.bem.quadrature import gauss_legendre
-from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc
+from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc, segment_arc_length
 
 GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
 
@@ -423,11 +423,7 @@ def corner_power(turning: float) -> float:
     return float(min(max(k / lam, 1.0), MAX_POWER))
 
 
-def _segment_arc_length(seg: Segment, ta: float, tb: float) -> float:
-    u, w = gauss_legendre(24)
-    t = 0.5 * (ta + tb) + 0.5 * (tb - ta) * u
-    dx, dr = seg.derivative(t)
-    return float(0.5 * abs(tb - ta) * np.sum(w * np.hypot(dx, dr)))
+_segment_arc_length = segment_arc_length  # one measure of arc length (geometry), shared with the memory guard
 
 
 def _count(arc: float, scale: float, refinement: float, per_scale: float, minimum: int = 2) -> int:

@@ -147,7 +147,8 @@ def _peer_depths(inputs: DepthModelInputs, R, shots: ShotSet, model: str) -> np.
 
 
 def model_depths(inputs: DepthModelInputs, models, R, shots: ShotSet) -> dict[str, np.ndarray]:
-    """Depth [m] of each model in ``models`` at every R_t [Pa] for every shot: {model: (n_R, n_shots)}."""
+    """Depth [m] of each model in ``models`` at every R_t [Pa] for every shot: {model: (n_R, n_shots)}
+    (Part I, eq. (11), with eqs. (26), (29)/(30') for the elastic models; the peers' laws)."""
     out: dict[str, np.ndarray] = {}
     for model in models:
         if model == "rigid":

@@ -179,7 +179,8 @@ def eroding_depth(striking_velocity, *, length: float, nose_length: float, diame
 def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length: float, diameter: float,
                            density: float, target_density: float, target_resistance: float, rod_strength: float,
                            mass: float | None = None) -> float:
-    """U_e [m/s]: the lowest U_s >= U_y at which the eroding rod is consumed down to its nose
+    """U_e [m/s] (Alekseevskii-Tate rod equations, with U_y from Part I, eqs. (33)/(36)): the
+    lowest U_s >= U_y at which the eroding rod is consumed down to its nose
     length, or to its radius where the nose is shorter (module docstring).  NaN if U_y is NaN (no yielding predicted)."""
     _check_strengths(target_resistance, rod_strength, target_density, density)
     if not math.isfinite(yield_velocity):
@@ -212,7 +213,8 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
 
 
 def classify_regimes(striking_velocity, yield_velocity: float, erosion_velocity: float) -> list[str]:
-    """Regime per striking velocity: rigid below U_y, eroding from U_e, deforming between."""
+    """Regime per striking velocity: rigid below U_y (Part I, eqs. (33)/(36)), eroding from U_e
+    (Alekseevskii-Tate), deforming between."""
     U = np.atleast_1d(np.asarray(striking_velocity, float))
     out = []
     for v in U:
