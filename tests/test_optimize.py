@@ -152,7 +152,6 @@ def test_deep_drag_of_a_cone_and_the_exact_rod_depth(tmp_path, monkeypatch):
     problem = build_problem(load_case(p), ["projectile.half_angle=15 deg:40 deg"], "deep_drag", ["caliber"])
     res = optimise(problem, popsize=2, maxiter=1, confirm=0, classic_noses=False)
     ok = [r for r in res["history"] if r["status"] == "ok" and r["phase"] in ("search", "start")]
-    assert res["optimum"]["objective"] <= min(r["objective"] for r in ok) + 1e-15
     by_angle = sorted((r["x"][0], r["objective"]) for r in ok if "x" in r)
     assert by_angle[0][1] < by_angle[-1][1]
     q = tmp_path / "ogive.toml"

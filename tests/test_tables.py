@@ -248,7 +248,9 @@ def test_separated_contact_equals_full_without_separation_and_changes_little_wit
     full = penetration_curve(setup, U, elastic=False)
     sep = penetration_curve(dataclasses.replace(setup, contact="separated"), U, elastic=False)
     assert sep["depth_rigid_m"][0] == pytest.approx(full["depth_rigid_m"][0], rel=1e-8)
-    assert sep["depth_rigid_m"][1] == pytest.approx(full["depth_rigid_m"][1], rel=1e-4)
+    # the separated contact must act, and only slightly: measured -1.25e-6 (a band of a decade
+    # either side; a no-op 'separated' gives 0 and fails)
+    assert 1e-7 < abs(sep["depth_rigid_m"][1] / full["depth_rigid_m"][1] - 1) < 1e-5
 
 
 def test_contact_flag_bad_value_exits_2(capsys):
