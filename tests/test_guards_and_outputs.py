@@ -143,3 +143,19 @@ def test_run_and_penetrate_write_no_cache_into_the_cwd(tmp_path):
         assert proc.returncode == 0, proc.stderr[-1500:]
     assert sorted(p.name for p in work.iterdir()) == ["out"]
     assert any((tmp_path / "xdg" / "semianalytic").rglob("*.npz"))
+
+
+@pytest.mark.parametrize("out", ["", ".", ".."])
+def test_output_folder_never_the_working_folder(tmp_path, monkeypatch, capsys, out):
+    """The output folder is replaced as a whole; `--out .` (or '' or a parent) with --force must
+    be refused with exit 2 before anything is deleted: the user's file stays."""
+    from semianalytic.cli import main
+
+    work = tmp_path / "work"
+    work.mkdir()
+    (work / "sentinel.txt").write_text("keep me")
+    monkeypatch.chdir(work)
+    case = str(Path(__file__).resolve().parent.parent / "cases" / "fig5_ogive.toml")
+    assert main(["run", case, "--out", out, "--force"]) == 2
+    assert "--out" in capsys.readouterr().err
+    assert sorted(p.name for p in work.iterdir()) == ["sentinel.txt"]

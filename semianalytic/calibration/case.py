@@ -204,6 +204,8 @@ def read_posterior(path) -> dict:
         raise InputError(field, f"{path.name} is not a JSON file: {exc}") from None
     if not isinstance(obj, dict) or obj.get("format") != POSTERIOR_FORMAT:
         raise InputError(f"{field}.format", f"expected '{POSTERIOR_FORMAT}' (a posterior.json written by calibrate)")
+    if obj.get("version") != 1 or isinstance(obj.get("version"), bool):
+        raise InputError(f"{field}.version", f"expected 1 (the posterior format this version reads); got {obj.get('version')!r}")
     target = _need(obj, "target", dict, field)
     _need(target, "density_kg_m3", float, "target")
     _need(target, "resistance_model", str, "target")
@@ -225,12 +227,14 @@ def read_posterior(path) -> dict:
             raise InputError(f"models.{name}", f"unknown model; one of {', '.join(MODELS)}")
         samples = _need(mobj, "samples", dict, f"models.{name}")
         sigma = _samples(samples, "sigma", f"models.{name}.samples")
-        if np.any(sigma <= 0):
-            raise InputError(f"models.{name}.samples.sigma", "must be positive")
+        if not np.all(np.isfinite(sigma) & (sigma > 0) & (sigma < 10.0)):
+            # sigma is the log-normal scale of the depth error: beyond 10 (a factor e^10) it is no model
+            raise InputError(f"models.{name}.samples.sigma", "must be finite, positive and below 10")
         theta = np.column_stack([_samples(samples, k, f"models.{name}.samples", len(sigma)) for k in keys])
         models[name] = {"theta": theta, "sigma": sigma}
     cav = obj.get("cavity_shape")
-    if not (isinstance(cav, list) and len(cav) == 3 and all(isinstance(c, (int, float)) and c >= 0 for c in cav)
+    if not (isinstance(cav, list) and len(cav) == 3
+            and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) and c >= 0 for c in cav)
             and cav[0] > 0):
         raise InputError("cavity_shape", "expected [A, B, C] of the cavity law (A > 0)")
     return {"target": target, "parameters": keys, "models": models, "cavity_shape": tuple(map(float, cav)), "raw": obj}

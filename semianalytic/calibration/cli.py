@@ -67,6 +67,8 @@ def run(args) -> int:
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []
+    if args.transfer and not (args.cross_validate or args.diagnose):
+        raise InputError("--transfer", "is used only with --cross-validate or --diagnose")
     if args.cross_validate or args.diagnose:
         sec = case.section("calibration")
         paths = [Path(case.path).parent / p for p in (sec.transfer if sec else [])] + [Path(p) for p in args.transfer]

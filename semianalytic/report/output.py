@@ -20,9 +20,17 @@ from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_
 
 
 def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out") -> Path:
-    """Refuse an existing ``out`` without ``force``, and a path that is a file."""
+    """Refuse an existing ``out`` without ``force``, a path that is a file, and the working
+    folder or any folder above it: the output folder is replaced as a whole (``StagedDir``),
+    so ``--out .`` or ``--out ''`` with ``--force`` would delete the user's files."""
+    if not str(out).strip():
+        raise InputError(field, "expected a folder; got an empty path")
     out = Path(out)
     try:
+        resolved, cwd = out.resolve(), Path.cwd().resolve()
+        if resolved == cwd or resolved in cwd.parents:
+            raise InputError(field, f"{str(out)!r} is the working folder or contains it; the output folder is "
+                                    "replaced as a whole, so name a new folder (e.g. out/run1)")
         if out.exists() and not out.is_dir():
             raise InputError(field, f"{str(out)!r} exists and is not a folder")
         if out.exists() and not force and any(out.iterdir()):
