@@ -164,6 +164,9 @@ def test_cli_at_direct_and_interpolated(capsys, tmp_path, monkeypatch):
         (["--at", "-1 mm"], "--at"),
         (["--at", "1 mm,,2 mm"], "--at"),
         (["--at", "xLh"], "--at"),
+        (["--at", "1e-12Lh"], "--at"),  # 1e-14 m: below the physical range of a length (1 pm)
+        (["--at", "1e9Lh"], "--at"),  # 1e7 m: above it (10 km)
+        (["--at=-1Lh"], "--at"),
         (["--tolerance", "tight"], "--tolerance"),
         (["--tolerance", "0"], "--tolerance"),
         (["--tolerance=-1e-5"], "--tolerance"),

@@ -16,7 +16,7 @@ _LH = re.compile(r"^\s*([-+0-9.eE]+)\s*Lh\s*$")
 def parse_depths(text: str, nose_length: float, field: str = "--at") -> list[float]:
     """Depths [m] from a comma-separated list of lengths with units ("10 mm,59.0 mm") or of
     nose-length multiples with the suffix ``Lh`` ("0.5Lh,5Lh").  Each must be finite and > 0."""
-    from semianalytic.units import parse_quantity
+    from semianalytic.units import PHYSICAL_BOUNDS, parse_quantity
 
     items = [t.strip() for t in str(text).split(",")]
     if not items or any(not t for t in items):
@@ -32,6 +32,9 @@ def parse_depths(text: str, nose_length: float, field: str = "--at") -> list[flo
             if nose_length <= 0:
                 raise InputError(field, "this nose has no length L_h (flat); give depths with units, e.g. '2 mm'")
             P = k * nose_length
+            low, high, text = PHYSICAL_BOUNDS["length"]  # the same door as a length with units
+            if math.isfinite(P) and P > 0 and not low <= P <= high:
+                raise InputError(field, f"{item!r} is {P:g} m, outside the physical range of a length ({text})")
         else:
             P = parse_quantity(item, "length", field)
         if not (math.isfinite(P) and P > 0):
