@@ -209,6 +209,7 @@ def test_penetrate_refuses_eroding_posterior_of_another_projectile_or_target(ero
     (lambda t: t.replace('response_column = "regime"\n', ""), [], "data.response_column"),
     (None, ["--model", "eroding", "--model", "rigid"], "--model"),
     (None, ["--parameter", "target.resistance.yield_stress"], "--parameter"),
+    (None, ["--diagnose"], "--diagnose"),
     (lambda t: t.replace('"lognormal(1454 MPa, 1.0)"', '"lognormal(1454 m/s, 1.0)"'), [],
      "calibration.prior.target.resistance.eroding_resistance"),
     (lambda t: t.replace('select = { material = ["VAR4340"] }', 'select = { material = ["VAR4340"], regime = ["rigid"] }'),

@@ -69,6 +69,10 @@ def run(args) -> int:
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []
+    sec = case.section("calibration")
+    if args.diagnose and "eroding" in (args.model or (sec.models if sec else None) or []):
+        raise InputError("--diagnose", "studies the over-prediction of the Part I models on the rigid shots; "
+                                       "not with the eroding model")
     if args.transfer and not (args.cross_validate or args.diagnose):
         raise InputError("--transfer", "is used only with --cross-validate or --diagnose")
     if args.cross_validate or args.diagnose:
