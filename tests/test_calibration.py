@@ -219,7 +219,18 @@ striking_velocities = ["433 m/s", "917 m/s"]
         assert code == 0, err
         res = json.loads(stdout)
         q = res["depth_quantiles_m"]
-        assert set(q) == {"rigid", "quasi_rigid", "forrestal"}
+        assert set(q) == {"rigid", "quasi_rigid", "forrestal", "regime_aware"}
+        # below the erosion onset the regime-aware intervals are the rigid-projectile model's (--part1-model
+        # elastic_exact_rod is not in the file: the first Part I model present, said on stderr); eroding
+        # velocities get NaN without an eroding posterior, also said
+        assert res["posterior_regime_aware"]["rigid_model"] == "rigid"
+        assert "elastic_exact_rod is not in the posterior" in err
+        for i, reg in enumerate(res["regime"]):
+            for p in ("0.05", "0.5", "0.95"):
+                if reg == "eroding":
+                    assert math.isnan(q["regime_aware"][p][i]) and "no eroding model" in err
+                else:
+                    assert q["regime_aware"][p][i] == q["rigid"][p][i]
         for m, qq in q.items():
             assert len(qq["0.05"]) == len(qq["0.5"]) == len(qq["0.95"]) == 2
             assert all(a < b < c for a, b, c in zip(qq["0.05"], qq["0.5"], qq["0.95"])), m

@@ -79,3 +79,45 @@ def test_inverse_with_yield_dependent_buckling_and_unreachable_velocity():
     assert crit.critical_velocity(Y, APPENDIX, phi(Y)) == pytest.approx(900.0, rel=1e-10)
     with pytest.raises(InputError):
         crit.yield_stress_from_critical_velocity(1e6, APPENDIX, lambda Y: float(crit.johnson_euler_phi(200.0, 210e9, Y)))
+
+
+def test_no_real_root_when_the_velocity_term_vanishes():
+    """Issue 12 loose end: with the 'bernoulli' reading the deep B (= dA/dP) is round-off
+    (-2e-14 m^2 on the Piekutowski ogive), eq. (33) has no real root and used to raise a math
+    domain error.  By eq. (33) itself: with Bbar <= 0 the start stress rho B U^2/2 + C R_t never
+    grows with U, so for Ybar_p >= Rbar_t no velocity yields the rod: U_sC = inf, the reason is
+    stated, and the inverse problem is refused naming the option.  Eq. (34) is unaffected."""
+    import dataclasses
+
+    zero_b = dataclasses.replace(APPENDIX, B=-2.0e-14)
+    assert crit.critical_velocity(2146e6, zero_b) == math.inf
+    assert crit.critical_velocity(2146e6, dataclasses.replace(APPENDIX, B=0.0)) == math.inf
+    assert "no real root" in crit.no_real_root_reason(zero_b) and crit.no_real_root_reason(APPENDIX) is None
+    weak = 1.0e9  # Ybar_p < Rbar_t: eq. (34), the elastic limit, as with any B
+    assert crit.critical_velocity(weak, zero_b) == crit.critical_velocity(weak, APPENDIX)
+    with pytest.raises(InputError) as e:
+        crit.yield_stress_from_critical_velocity(1000.0, zero_b)
+    assert e.value.field == "coefficients.reading"
+
+
+def test_cli_bernoulli_reading_no_traceback(tmp_path, capsys):
+    """Through penetrate with [coefficients] reading = 'bernoulli' (the failing case): exit 0,
+    U_sC = inf in the JSON, the reason on stderr; the rigid depths are still the model's."""
+    import json
+    import shutil
+    from pathlib import Path
+
+    from semianalytic.cli import main
+
+    cases = Path(__file__).resolve().parents[1] / "cases"
+    text = (cases / "piekutowski1999_var4340.toml").read_text().replace(
+        "[target]\n", '[coefficients]\nreading = "bernoulli"\n\n[target]\n', 1)
+    (tmp_path / "bern.toml").write_text(text)
+    shutil.copy(cases / "piekutowski1999_ogive_6061T6511.csv", tmp_path)
+    code = main(["penetrate", str(tmp_path / "bern.toml"), "--json"])
+    out = capsys.readouterr()
+    assert code == 0, out.err
+    res = json.loads(out.out)
+    assert res["critical_velocity_m_s"][0] == math.inf and not any(res["yields"])
+    assert "eq. (33) has no real root" in out.err and "Traceback" not in out.err
+    assert all(d > 0 for d in res["depth_rigid_m"])

@@ -14,6 +14,12 @@ Example (``cases/piekutowski1999_var4340.toml``)::
     [calibration.prior]
     "target.resistance.yield_stress" = "lognormal(300 MPa, 0.5)"
 
+The eroding rod (``--model eroding``, Alekseevskii-Tate, issue 17) is calibrated on the shots whose
+recorded response (``[data] response_column``) is an eroding one (eroded, broken_eroding), its
+parameters ``target.resistance.eroding_resistance`` (R_t) and ``projectile.dynamic_yield_stress``
+(Y_p), both by default, with priors as above (``cases/piekutowski1999_var4340_eroding.toml``).  The
+other models use the shots recorded rigid (all selected shots when the data name no response).
+
 Priors: ``lognormal(MEDIAN, SIGMA_LN)``, ``normal(MEAN, SD)``, ``uniform(LOW, HIGH)``,
 ``halfnormal(SCALE)``, quantities with the parameter's unit (dimensionless parameters and
 SIGMA_LN plain numbers).  Default prior of a parameter: lognormal(the case's value, 0.5).
@@ -30,15 +36,18 @@ from pathlib import Path
 import numpy as np
 from pydantic import Field
 
-from semianalytic.calibration.names import MODELS
+from semianalytic.calibration.names import CALIBRATION_MODELS, ERODING, ERODING_KEYS
 from semianalytic.calibration.priors import HalfNormal, LogNormal, Normal, Uniform
 from semianalytic.errors import InputError
 from semianalytic.schema import Section
 
-__all__ = ["CalibrationSection", "parse_prior", "parameter_kind", "default_parameter", "load_shot_set",
+__all__ = ["CalibrationSection", "parse_prior", "parameter_kind", "default_parameter", "load_shot_set", "shots_in_regime",
            "read_posterior", "POSTERIOR_FORMAT"]
 
 POSTERIOR_FORMAT = "semianalytic-posterior"
+# version 2 adds the eroding model (per-model "parameters" and "eroding"); version 1 files are still read
+POSTERIOR_VERSION = 2
+POSTERIOR_VERSIONS_READ = (1, 2)
 MIN_SHOTS = 3
 
 # resistance field -> unit kind (pint) and display unit
@@ -70,8 +79,15 @@ class CalibrationSection(Section):
     prior: dict[str, str] = Field(default_factory=dict)
 
 
-def parameter_kind(key: str, resistance) -> tuple[str, str, float]:
-    """(unit kind, display unit, its SI scale) of a calibrated case key, or InputError."""
+def parameter_kind(key: str, resistance, *, eroding: bool = False) -> tuple[str, str, float]:
+    """(unit kind, display unit, its SI scale) of a calibrated case key, or InputError.  With
+    ``eroding`` the keys of the eroding rod (:data:`ERODING_KEYS`), else the resistance's."""
+    if eroding or key in ERODING_KEYS:
+        if key not in ERODING_KEYS:
+            raise InputError("--parameter", f"the eroding model calibrates {' and '.join(ERODING_KEYS)}; got {key!r}")
+        if not eroding:
+            raise InputError("--parameter", f"{key!r} is a parameter of the eroding rod: calibrate it with --model eroding")
+        return ("pressure", "MPa", 1e6)
     prefix = "target.resistance."
     if not key.startswith(prefix):
         raise InputError("--parameter", f"only target.resistance.* keys can be calibrated (the target's "
@@ -141,14 +157,40 @@ def parse_prior(text, kind: str, field: str):
 
 def check_models(models) -> tuple[str, ...]:
     for m in models:
-        if m not in MODELS:
-            raise InputError("--model", f"unknown model {m!r}; one of {', '.join(MODELS)}")
-    return tuple(dict.fromkeys(models))
+        if m not in CALIBRATION_MODELS:
+            raise InputError("--model", f"unknown model {m!r}; one of {', '.join(CALIBRATION_MODELS)}")
+    models = tuple(dict.fromkeys(models))
+    if ERODING in models and len(models) > 1:
+        raise InputError("--model", "the eroding model is calibrated on the eroded shots with its own parameters, the "
+                                    "others on the rigid shots: calibrate it in a run of its own (--model eroding), "
+                                    "then pass both posteriors to penetrate (--posterior A --posterior B)")
+    return models
 
 
-def load_shot_set(case, projectile_mass: float, *, minimum: int = MIN_SHOTS) -> ShotSet:
+def shots_in_regime(case, shots, regime: str):
+    """The shots whose recorded response (``[data] response_column``) maps to ``regime``
+    (penetration.regime_setup.RESPONSE_REGIME: rigid -> rigid; eroded, broken_eroding -> eroding).
+    Without a response column: every shot for ``rigid`` (the case's ``select`` says which are
+    rigid, as before), InputError for ``eroding`` (the eroded shots must be recorded as such)."""
+    from semianalytic.penetration.regime_setup import RESPONSE_REGIME
+
+    col = case.require("data").response_column
+    if not col:
+        if regime == "rigid":
+            return shots
+        raise InputError("data.response_column", f"the {regime} model is calibrated on the shots recorded {regime}: "
+                                                 "name the column of the recorded response (rigid, eroded, ...)")
+    for s in shots:
+        if s.row.get(col, "") not in RESPONSE_REGIME:
+            raise InputError("data.response_column", f"shot {s.id}: response {s.row.get(col, '')!r} is not one of "
+                                                     f"{', '.join(RESPONSE_REGIME)}")
+    return [s for s in shots if RESPONSE_REGIME[s.row[col]] == regime]
+
+
+def load_shot_set(case, projectile_mass: float, *, minimum: int = MIN_SHOTS, regime: str | None = None) -> ShotSet:
     """The case's ``[data]`` shots as a :class:`ShotSet` (SI), each with its own mass where the
-    data give one, else the projectile's.  Bad input (file missing or empty, a column absent,
+    data give one, else the projectile's; with ``regime``, only the shots recorded in it
+    (:func:`shots_in_regime`).  Bad input (file missing or empty, a column absent,
     a non-positive value, fewer than ``minimum`` shots): InputError naming the field."""
     from semianalytic.calibration.models import ShotSet  # the models load on use
     from semianalytic.penetration.validation import load_shots
@@ -157,8 +199,11 @@ def load_shot_set(case, projectile_mass: float, *, minimum: int = MIN_SHOTS) -> 
     if data is None or data.file is None:
         raise InputError("data.file", "calibration needs a [data] section with a CSV 'file' of shots")
     shots = load_shots(case)
+    if regime is not None:
+        shots = shots_in_regime(case, shots, regime)
     if len(shots) < minimum:
-        raise InputError("data.file", f"at least {minimum} shots with a depth are needed (after 'select'); "
+        which = f"recorded {regime} " if regime is not None and data.response_column else ""
+        raise InputError("data.file", f"at least {minimum} {which}shots with a depth are needed (after 'select'); "
                                       f"got {len(shots)}")
     mass = np.array([s.mass if s.mass is not None else projectile_mass for s in shots], float)
     if not np.all(mass > 0):
@@ -204,8 +249,10 @@ def read_posterior(path) -> dict:
         raise InputError(field, f"{path.name} is not a JSON file: {exc}") from None
     if not isinstance(obj, dict) or obj.get("format") != POSTERIOR_FORMAT:
         raise InputError(f"{field}.format", f"expected '{POSTERIOR_FORMAT}' (a posterior.json written by calibrate)")
-    if obj.get("version") != 1 or isinstance(obj.get("version"), bool):
-        raise InputError(f"{field}.version", f"expected 1 (the posterior format this version reads); got {obj.get('version')!r}")
+    version = obj.get("version")
+    if isinstance(version, bool) or version not in POSTERIOR_VERSIONS_READ:
+        raise InputError(f"{field}.version", f"expected one of {', '.join(map(str, POSTERIOR_VERSIONS_READ))} (the posterior "
+                                             f"formats this version reads); got {version!r}")
     target = _need(obj, "target", dict, field)
     _need(target, "density_kg_m3", float, "target")
     _need(target, "resistance_model", str, "target")
@@ -223,18 +270,43 @@ def read_posterior(path) -> dict:
         raise InputError("models", "empty: the posterior holds no model")
     models = {}
     for name, mobj in models_obj.items():
-        if name not in MODELS:
-            raise InputError(f"models.{name}", f"unknown model; one of {', '.join(MODELS)}")
+        if name not in CALIBRATION_MODELS or (name == ERODING and version < 2):
+            raise InputError(f"models.{name}", f"unknown model; one of {', '.join(CALIBRATION_MODELS)}")
         samples = _need(mobj, "samples", dict, f"models.{name}")
         sigma = _samples(samples, "sigma", f"models.{name}.samples")
         if not np.all(np.isfinite(sigma) & (sigma > 0) & (sigma < 10.0)):
             # sigma is the log-normal scale of the depth error: beyond 10 (a factor e^10) it is no model
             raise InputError(f"models.{name}.samples.sigma", "must be finite, positive and below 10")
-        theta = np.column_stack([_samples(samples, k, f"models.{name}.samples", len(sigma)) for k in keys])
-        models[name] = {"theta": theta, "sigma": sigma}
+        mkeys = keys
+        if "parameters" in mobj:  # version 2: the keys of this model (default: all of the file's)
+            mkeys = [_need({"k": k}, "k", str, f"models.{name}.parameters") for k in _need(mobj, "parameters", list, f"models.{name}")]
+            if not mkeys or any(k not in keys for k in mkeys):
+                raise InputError(f"models.{name}.parameters", "expected a non-empty list of the file's parameter keys")
+        theta = np.column_stack([_samples(samples, k, f"models.{name}.samples", len(sigma)) for k in mkeys])
+        models[name] = {"theta": theta, "sigma": sigma, "parameters": list(mkeys)}
+        if name == ERODING:
+            models[name]["eroding"] = _eroding_entry(mobj, mkeys, theta, f"models.{name}")
     cav = obj.get("cavity_shape")
     if not (isinstance(cav, list) and len(cav) == 3
             and all(isinstance(c, (int, float)) and not isinstance(c, bool) and math.isfinite(c) and c >= 0 for c in cav)
             and cav[0] > 0):
         raise InputError("cavity_shape", "expected [A, B, C] of the cavity law (A > 0)")
     return {"target": target, "parameters": keys, "models": models, "cavity_shape": tuple(map(float, cav)), "raw": obj}
+
+
+def _eroding_entry(mobj: dict, keys, theta, field: str) -> dict:
+    """The eroding model's own record: the projectile density it was calibrated for and the
+    value of each of its two parameters that was not calibrated (SI); every draw positive."""
+    ero = _need(mobj, "eroding", dict, field)
+    rho = _need(ero, "projectile_density_kg_m3", float, f"{field}.eroding")
+    fixed = _need(ero, "fixed", dict, f"{field}.eroding")
+    out = {"projectile_density_kg_m3": rho, "fixed": {}}
+    for k in ERODING_KEYS:
+        if k in keys:
+            continue
+        out["fixed"][k] = _need(fixed, k, float, f"{field}.eroding.fixed")
+        if not out["fixed"][k] > 0:
+            raise InputError(f"{field}.eroding.fixed.{k}", "must be positive")
+    if not rho > 0 or not np.all(theta > 0) or any(k not in ERODING_KEYS for k in keys):
+        raise InputError(f"{field}.samples", f"expected positive draws of {' and/or '.join(ERODING_KEYS)}")
+    return out

@@ -9,6 +9,22 @@
   the central 50% and 90% predictive intervals, mean log predictive density of ln P.
 * :func:`predict_with_posterior`: predictive depth quantiles of any case (nose, mass, length
   may differ) from a posterior file whose target matches the case's.
+
+The eroding rod (``--model eroding``, issue 17 item 3) is calibrated in a run of its own, on the
+shots recorded eroded, and ``penetrate`` takes ``--posterior`` twice (a rigid-shot posterior and
+an eroding one) rather than one file holding both.  Why: the two share no parameter and no shot
+(Part I's target strength on the rigid shots; the rod's R_t and Y_p on the eroded ones), so their
+joint posterior is the product of the two and nothing is lost by sampling them apart; each file
+keeps one data set, one shot selection, its diagnostics and its cross-validation; and a user can
+pair any rigid-shot posterior with any eroding one of the same target (each is checked against
+the case: target density and resistance model, and for the eroding rod the projectile's density
+and the value of a parameter held fixed).  ``depth_quantiles_m["regime_aware"]`` takes at each
+striking velocity the quantiles of the model of the regime ``penetrate`` predicts there (the same
+``regime`` labels, from the case's parameters): the ``--part1-model`` (else the first
+rigid-projectile model in the files) below the erosion onset U_e, in the deforming band as the
+upper bound like ``depth_m``, and the eroding rod from U_e; NaN where no file holds the model
+needed, with a warning.  Posterior files: format version 2 (per-model ``parameters``, the eroding
+record); version 1 files are still read.
 """
 
 from __future__ import annotations
@@ -21,6 +37,7 @@ import numpy as np
 
 from semianalytic.calibration.case import (
     POSTERIOR_FORMAT,
+    POSTERIOR_VERSION,
     CalibrationSection,
     check_models,
     default_parameter,
@@ -32,9 +49,12 @@ from semianalytic.calibration.case import (
 from semianalytic.calibration.models import (
     MODELS,
     DepthModelInputs,
+    ErodingDepths,
     ShotSet,
+    ThetaColumn,
     build_surrogate,
 )
+from semianalytic.calibration.names import ERODING, ERODING_KEYS
 from semianalytic.calibration.sampler import (
     Problem,
     ResistanceMap,
@@ -50,6 +70,7 @@ QUANTILES = (0.05, 0.25, 0.5, 0.75, 0.95)
 SURROGATE_NODES = 16  # Chebyshev nodes in ln R_t over the prior range (see the tests for its accuracy)
 PREDICTION_NODES = 6  # over the narrower posterior range
 STORED_DRAWS = 1000
+ERODING_PREDICTION_DRAWS = 500  # draws of the eroding rod per prediction (see _quantiles_at)
 LOO_STEPS = 500  # per refit, a quarter discarded: 32 walkers x 375 steps / tau ~ 20 -> ~600 effective draws
 
 
@@ -92,26 +113,40 @@ def _target(case, coefficients, keys, cavity_shape=None, models=MODELS) -> Targe
                   resistance.name, fixed)
 
 
-def _settings(case, models, parameters):
+def _eroding_defaults(case, coefficients) -> dict:
+    """The case's values of the eroding rod's parameters (with regime_setup's stated defaults)."""
+    from semianalytic.penetration.curve import PenetrationSetup
+    from semianalytic.penetration.regime_setup import eroding_inputs
+
+    ei = eroding_inputs(case, PenetrationSetup.from_case(case, coefficients, require_material=False))
+    return {ERODING_KEYS[0]: ei.target_resistance, ERODING_KEYS[1]: ei.rod_strength}
+
+
+def _settings(case, models, parameters, coefficients=None):
     sec = case.section("calibration") or CalibrationSection()
     from semianalytic.penetration.resistance import resistance_from_case
 
     resistance = resistance_from_case(case)
     models = check_models(models or sec.models or MODELS)
-    keys = list(dict.fromkeys(parameters or sec.parameters or [default_parameter(resistance)]))
+    eroding = models == (ERODING,)
+    # the case's [calibration] parameters of this kind of model (eroding rod or target resistance)
+    listed = [k for k in (sec.parameters or []) if (k in ERODING_KEYS) == eroding] or None
+    default = list(ERODING_KEYS) if eroding else [default_parameter(resistance)]
+    keys = list(dict.fromkeys(parameters or listed or default))
     for key in keys:
-        parameter_kind(key, resistance)
+        parameter_kind(key, resistance, eroding=eroding)
     for key in sec.prior:  # a prior of a parameter not calibrated now is unused, but must name a parameter
         try:
-            parameter_kind(key, resistance)
+            parameter_kind(key, resistance, eroding=key in ERODING_KEYS)
         except InputError as exc:
             raise InputError(f"calibration.prior.{key}", exc.message) from None
+    values = _eroding_defaults(case, coefficients) if eroding else {}
     priors, units = [], []
     for key in keys:
-        kind, unit, scale = parameter_kind(key, resistance)
+        kind, unit, scale = parameter_kind(key, resistance, eroding=eroding)
         text = sec.prior.get(key)
         if text is None:
-            value = float(getattr(resistance, key.rsplit(".", 1)[-1]))
+            value = values[key] if eroding else float(getattr(resistance, key.rsplit(".", 1)[-1]))
             text = f"lognormal({value / scale:.6g} {unit}, 0.5)" if kind != "dimensionless" else f"lognormal({value:.6g}, 0.5)"
         priors.append(parse_prior(text, kind, f"calibration.prior.{key}"))
         units.append((unit, scale, text))
@@ -165,7 +200,8 @@ def _predict(target: Target, models, shots: ShotSet, draws: dict, n_nodes: int =
     return out
 
 
-def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, posts: dict, fits: dict) -> dict:
+def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, posts: dict, fits: dict,
+                    eroding: dict | None = None) -> dict:
     data = case.require("data")
     models = {}
     for m, post in posts.items():
@@ -182,6 +218,7 @@ def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, 
                              "q95": qs[2]}
         q = fits[m]
         models[m] = {
+            "parameters": list(keys),
             "samples": samples,
             "summary": summary,
             "mode": dict(zip([*keys, "sigma"], post.mode)),
@@ -194,15 +231,18 @@ def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, 
             },
             "fit": {f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)},
         }
+        if m == ERODING:
+            models[m]["eroding"] = dict(eroding)
     return {
         "format": POSTERIOR_FORMAT,
-        "version": 1,
+        "version": POSTERIOR_VERSION,
         "case": str(case.path) if case.path else case.title,
         "title": case.title,
         "target": {"density_kg_m3": target.density, "resistance_model": target.resistance_model,
                    "resistance_fixed": target.fixed},
         "parameters": [{"key": k, "unit": "SI", "display_unit": u[0], "prior": u[2]} for k, u in zip(keys, units)],
         "discrepancy": {"model": "ln P_measured = ln P_model + eps, eps ~ N(0, sigma^2)", "prior": sigma_prior_text},
+        "shots_used": "recorded eroding" if eroding is not None else "recorded rigid (all selected without a response column)",
         "cavity_shape": list(target.inputs.cavity_shape),
         "data": {
             "file": data.file, "source": data.source, "select": data.select,
@@ -217,33 +257,82 @@ def _problem(keys, priors, sigma_prior, resistance, surrogate, depth):
     return Problem(keys, priors, sigma_prior, resistance, surrogate, depth)
 
 
+def _eroding_depths(case, coefficients, keys, shots: ShotSet, fixed: dict | None = None) -> tuple[ErodingDepths, dict]:
+    """The eroding rod of ``case`` for ``shots`` (L_0 per shot mass) with R_t and Y_p taken from
+    theta (columns of ``keys``) or fixed (``fixed``, else the case's values); and its record
+    for the posterior file."""
+    from semianalytic.penetration.curve import PenetrationSetup
+    from semianalytic.penetration.regime import eroding_rod_length
+    from semianalytic.penetration.regime_setup import eroding_inputs
+
+    ei = eroding_inputs(case, PenetrationSetup.from_case(case, coefficients, require_material=False))
+    values = {ERODING_KEYS[0]: ei.target_resistance, ERODING_KEYS[1]: ei.rod_strength}
+    values.update(fixed or {})
+    cols = [ThetaColumn(keys.index(k) if k in keys else None, float(values[k])) for k in ERODING_KEYS]
+    L0 = np.array([eroding_rod_length(ei.length, ei.nose_length, ei.diameter, ei.density, float(m)) for m in shots.mass])
+    depths = ErodingDepths(np.asarray(shots.velocity, float), L0, ei.density, ei.target_density, cols[0], cols[1])
+    record = {"projectile_density_kg_m3": ei.density,
+              "fixed": {k: float(values[k]) for k in ERODING_KEYS if k not in keys},
+              "rod": "Alekseevskii-Tate rod: the cylinder of the projectile's mass and diameter (penetration.regime)"}
+    return depths, record
+
+
+def _quantiles_at(depths, draws) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """(quantiles (len(QUANTILES), n), mu, sigma) of the posterior predictive of ``depths``
+    (an ErodingDepths) at draws (theta, sigma), vectorised over draws; at most
+    :data:`ERODING_PREDICTION_DRAWS` draws, evenly thinned: the Monte-Carlo error of a 5 %
+    quantile of a predictive of ln-sd ~0.1 from 500 independent draws is about 1 % (less here:
+    each draw enters as its exact log-normal), far inside the 90 % interval's width of ~30 %."""
+    theta, sigma = draws
+    if len(sigma) > ERODING_PREDICTION_DRAWS:
+        idx = np.linspace(0, len(sigma) - 1, ERODING_PREDICTION_DRAWS).astype(int)
+        theta, sigma = np.asarray(theta)[idx], np.asarray(sigma)[idx]
+    mu = depths.log_depth_theta(theta)
+    ok = np.all(np.isfinite(mu), axis=1)
+    return mixture_quantiles(mu[ok], sigma[ok], QUANTILES), mu[ok], sigma[ok]
+
+
 def calibrate_case(case, coefficients, *, models=None, parameters=None, progress: bool = False,
                    steps: int | None = None) -> dict:
     """Calibrate (see the module docstring).  Returns {"posterior": JSON dict, "shots": ShotSet,
-    "fits": {model: quantiles}, "curves": {...}, "histograms": {...}, "settings": {...}}."""
+    "fits": {model: quantiles}, "curves": {...}, "histograms": {...}, "settings": {...}}.
+    ``models`` all of the rigid-projectile family (calibrated on the shots recorded rigid) or
+    only ``eroding`` (on the shots recorded eroding)."""
     import time
 
     t0, c0 = time.perf_counter(), time.process_time()
-    sec, models, keys, priors, sigma_prior, units = _settings(case, models, parameters)
-    target = _target(case, coefficients, keys, models=models)
-    shots = load_shot_set(case, target.inputs.setup.mass)
-    lo, hi = _range(target.resistance, priors)
-    surrogates = build_surrogate(target.inputs, models, shots, lo, hi, SURROGATE_NODES)
-    fast = target.resistance
-    if len(priors) == 1 and priors[0].positive:
-        fast = fast.tabulated(float(priors[0].ppf(1e-4)), float(priors[0].ppf(1 - 1e-4)))
+    sec, models, keys, priors, sigma_prior, units = _settings(case, models, parameters, coefficients)
+    eroding = models == (ERODING,)
+    target = _target(case, coefficients, keys, models=() if eroding else models)
+    shots = load_shot_set(case, target.inputs.setup.mass, regime=ERODING if eroding else "rigid")
+    record = None
+    if eroding:
+        depths, record = _eroding_depths(case, coefficients, keys, shots)
+        depth_models = {ERODING: depths}
+        fast = depths.resistance
+        lo = hi = None
+    else:
+        lo, hi = _range(target.resistance, priors)
+        depth_models = build_surrogate(target.inputs, models, shots, lo, hi, SURROGATE_NODES)
+        fast = target.resistance
+        if len(priors) == 1 and priors[0].positive:
+            fast = fast.tabulated(float(priors[0].ppf(1e-4)), float(priors[0].ppf(1 - 1e-4)))
     posts, fits = {}, {}
     for m in models:
-        problem = _problem(keys, priors, sigma_prior, fast, surrogates[m], shots.depth)
+        problem = _problem(keys, priors, sigma_prior, fast, depth_models[m], shots.depth)
         posts[m] = sample_posterior(problem, walkers=sec.walkers, steps=steps or sec.steps, burn=min(sec.burn, (steps or sec.steps) // 2),
                                     seed=sec.seed, progress=progress)
-        mu = surrogates[m].log_depth(posts[m].resistance)
+        mu = depth_models[m].log_depth_theta(posts[m].theta, fast)
         fits[m] = mixture_quantiles(mu, posts[m].sigma, QUANTILES)
     # predictive curves on a velocity grid at the mean shot mass
     grid = np.linspace(0.85 * shots.velocity.min(), 1.1 * shots.velocity.max(), 21)
     grid_shots = ShotSet(grid, np.full(grid.shape, float(np.mean(shots.mass))), np.full(grid.shape, np.nan),
                          tuple(f"U{k}" for k in range(len(grid))))
-    pred = _predict(target, models, grid_shots, {m: (posts[m].theta, posts[m].sigma) for m in models})
+    draws = {m: (posts[m].theta, posts[m].sigma) for m in models}
+    if eroding:
+        pred = {ERODING: _quantiles_at(_eroding_depths(case, coefficients, keys, grid_shots)[0], draws[ERODING])}
+    else:
+        pred = _predict(target, models, grid_shots, draws)
     curves = {"velocity_m_s": grid.tolist(), "mass_kg": float(np.mean(shots.mass)),
               "models": {m: {f"{p:g}": pred[m][0][k].tolist() for k, p in enumerate(QUANTILES)} for m in models}}
     histograms = {}
@@ -255,7 +344,7 @@ def calibrate_case(case, coefficients, *, models=None, parameters=None, progress
         dens, edges = np.histogram(posts[m].sigma, bins=30, density=True)
         h["sigma"] = {"centres": (0.5 * (edges[1:] + edges[:-1])).tolist(), "density": dens.tolist()}
         histograms[m] = h
-    posterior = _posterior_json(case, target, keys, units, sec.discrepancy, shots, posts, fits)
+    posterior = _posterior_json(case, target, keys, units, sec.discrepancy, shots, posts, fits, record)
     return {
         "posterior": posterior,
         "shots": shots,
@@ -263,10 +352,10 @@ def calibrate_case(case, coefficients, *, models=None, parameters=None, progress
         "histograms": histograms,
         "timing_s": {"wall": time.perf_counter() - t0, "cpu": time.process_time() - c0},
         "settings": {"models": list(models), "parameters": list(keys), "units": units, "R_range_Pa": (lo, hi),
-                     "surrogate_nodes": SURROGATE_NODES, "discrepancy_prior": sec.discrepancy},
-        "_internal": {"target": target, "surrogates": surrogates, "posts": posts, "priors": priors,
+                     "surrogate_nodes": SURROGATE_NODES, "discrepancy_prior": sec.discrepancy, "eroding": eroding},
+        "_internal": {"target": target, "surrogates": depth_models, "posts": posts, "priors": priors,
                       "sigma_prior": sigma_prior, "section": sec,
-                      "resistance": fast},
+                      "resistance": fast, "coefficients": coefficients},
     }
 
 
@@ -285,7 +374,7 @@ def check_target(case, target_obj: dict, keys) -> None:
                                                     f"'{target_obj['resistance_model']}' resistance; the case has '{res.name}'")
     names = {f.name for f in dataclasses.fields(res)}
     for key in keys:
-        if key.rsplit(".", 1)[-1] not in names:
+        if key not in ERODING_KEYS and key.rsplit(".", 1)[-1] not in names:
             raise InputError(key, "the case's resistance model has no such parameter")
     for k, v in target_obj["resistance_fixed"].items():
         here = getattr(res, k, None)
@@ -319,11 +408,10 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
         lpd = np.empty(n)
         for i in range(n):
             keep = np.array([k for k in range(n) if k != i])
-            sub = dataclasses.replace(sur, coef=sur.coef[:, keep])
-            problem = _problem(keys, it["priors"], it["sigma_prior"], it["resistance"], sub, shots.depth[keep])
+            problem = _problem(keys, it["priors"], it["sigma_prior"], it["resistance"], sur.subset(keep), shots.depth[keep])
             post = sample_posterior(problem, walkers=sec.walkers, steps=steps, burn=steps // 4, seed=sec.seed + i + 1,
                                     start=posts[m].mode_u)
-            mu = sur.log_depth(post.resistance)[:, i : i + 1]
+            mu = sur.subset([i]).log_depth_theta(post.theta, it["resistance"])
             q[:, i] = mixture_quantiles(mu, post.sigma, QUANTILES)[:, 0]
             lpd[i] = log_predictive_density(mu, post.sigma, shots.depth[i : i + 1])[0]
             bar.update()
@@ -335,9 +423,16 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
     for tcase, tcoef in transfer:
         t1, c1 = time.perf_counter(), time.process_time()
         check_target(tcase, result["posterior"]["target"], keys)
-        ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape, models=models)
-        tshots = load_shot_set(tcase, ttarget.inputs.setup.mass, minimum=1)
-        pred = _predict(ttarget, models, tshots, {m: (posts[m].theta, posts[m].sigma) for m in models})
+        eroding = result["settings"].get("eroding", False)
+        ttarget = _target(tcase, tcoef, keys, cavity_shape=target.inputs.cavity_shape, models=() if eroding else models)
+        tshots = load_shot_set(tcase, ttarget.inputs.setup.mass, minimum=1, regime=ERODING if eroding else "rigid")
+        draws = {m: (posts[m].theta, posts[m].sigma) for m in models}
+        if eroding:
+            record = result["posterior"]["models"][ERODING]["eroding"]
+            check_eroding(tcase, tcoef, record, keys)
+            pred = {ERODING: _quantiles_at(_eroding_depths(tcase, tcoef, keys, tshots, record["fixed"])[0], draws[ERODING])}
+        else:
+            pred = _predict(ttarget, models, tshots, draws)
         entry = {"case": str(tcase.path) if tcase.path else tcase.title, "title": tcase.title, "models": {}}
         for m in models:
             q, mu, sigma = pred[m]
@@ -351,20 +446,113 @@ def cross_validate(case, coefficients, result: dict, transfer=(), *, progress: b
     return out
 
 
-def predict_with_posterior(case, coefficients, path, velocities=None) -> dict:
+def check_eroding(case, coefficients, record: dict, keys) -> None:
+    """Refuse (InputError, exit 2) a case whose projectile differs from the one an eroding
+    posterior was calibrated for: the rod's Y_p is a projectile property (its density stands for
+    the material), and a parameter held fixed in the calibration must have the same value here."""
+    from semianalytic.penetration.curve import PenetrationSetup
+    from semianalytic.penetration.regime_setup import eroding_inputs
+
+    ei = eroding_inputs(case, PenetrationSetup.from_case(case, coefficients, require_material=False))
+    rho = float(record["projectile_density_kg_m3"])
+    if not math.isclose(ei.density, rho, rel_tol=1e-9):
+        raise InputError("projectile.density", f"the eroding posterior was calibrated for a rod of {rho:g} kg/m^3 "
+                                               f"(its Y_p is that material's); the case's projectile has {ei.density:g} kg/m^3")
+    here = {ERODING_KEYS[0]: ei.target_resistance, ERODING_KEYS[1]: ei.rod_strength}
+    for k, v in record["fixed"].items():
+        if not math.isclose(here[k], float(v), rel_tol=1e-9):
+            raise InputError(k, f"the eroding posterior was calibrated with {k} = {v / 1e6:g} MPa held fixed; the case "
+                                f"has {here[k] / 1e6:g} MPa")
+
+
+def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | None) -> tuple[dict, dict, list[str]]:
+    """The regime-aware predictive quantiles at ``U``: per velocity the quantiles of the model
+    that holds in the case's predicted regime (penetration.regime_setup, the same labels as
+    ``penetrate``'s ``regime``): a rigid-projectile model below the erosion onset U_e (in the
+    deforming band as the upper bound, as ``depth_m``), the eroding rod from U_e.  Returns
+    ({quantile: list}, {"regime": [...], "rigid_model": name, "eroding_model": name}, warnings)."""
+    from semianalytic.penetration import regime as rg
+    from semianalytic.penetration.curve import PenetrationSetup
+    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, PART1_MODELS, eroding_inputs
+
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+    warnings = []
+    if setup.rod is None or setup.yield_stress is None:
+        return {}, {}, ["warning: posterior: no regime-aware intervals: the regimes need the projectile's youngs_modulus and "
+                        "yield_stress (U_sC of Part I, eqs. (33)/(36))"]
+    ei = eroding_inputs(case, setup)
+    U_y = setup.critical_velocity()
+    U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
+    regimes = rg.classify_regimes(U, U_y, U_e)
+    order = [part1_model or DEFAULT_PART1_MODEL, *PART1_MODELS, *MODELS]
+    rigid = next((m for m in order if m in quantiles and m != ERODING), None)
+    ero = ERODING if ERODING in quantiles else None
+    nan = [math.nan] * len(U)
+    out = {}
+    for p in QUANTILES:
+        key = f"{p:g}"
+        r_q = quantiles[rigid][key] if rigid else nan
+        e_q = quantiles[ero][key] if ero else nan
+        out[key] = [e if reg == "eroding" else r for reg, r, e in zip(regimes, r_q, e_q)]
+    for label, model, mask in (("rigid or deforming", rigid, [r != "eroding" for r in regimes]),
+                               ("eroding", ero, [r == "eroding" for r in regimes])):
+        if model is None and any(mask):
+            at = ", ".join(f"{u:.0f}" for u, k in zip(U, mask) if k)
+            how = "calibrate --model eroding" if label == "eroding" else "calibrate on the rigid shots"
+            warnings.append(f"posterior: no {label} model in the posterior file(s): the regime-aware intervals at U_s = "
+                            f"{at} m/s are NaN; add --posterior with a file of {how}")
+    if rigid is not None and part1_model is not None and rigid != part1_model:
+        warnings.append(f"posterior: {part1_model} is not in the posterior file(s); the regime-aware intervals below "
+                        f"the erosion onset use {rigid}")
+    return out, {"regime": regimes, "rigid_model": rigid, "eroding_model": ero}, [f"warning: {w}" for w in warnings]
+
+
+def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_model: str | None = None) -> dict:
     """{"depth_quantiles_m": {model: {"0.05": [...], "0.5": [...], "0.95": [...], ...}}} at the
     case's striking velocities (or ``velocities``), with the case's projectile (mass from its
-    geometry and density) and the posterior's target parameters."""
-    post = read_posterior(path)
-    keys = post["parameters"]
-    check_target(case, post["target"], keys)
-    target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"], models=tuple(post["models"]))
+    geometry and density) and the posterior's target parameters.
+
+    ``path``: one posterior file or several (e.g. one of the rigid-shot models and one of the
+    eroding rod; a model may appear in one file only).  ``depth_quantiles_m`` also holds
+    ``"regime_aware"``: per velocity the quantiles of the model of its predicted regime
+    (:func:`_regime_aware`; the model names in ``posterior_regime_aware``).  ``warnings``:
+    lines for stderr."""
+    paths = [path] if isinstance(path, (str, bytes)) or not hasattr(path, "__iter__") else list(path)
     U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
-    shots = ShotSet(U, np.full(U.shape, target.inputs.setup.mass), np.full(U.shape, np.nan),
-                    tuple(str(k) for k in range(len(U))))
-    models = tuple(post["models"])
-    pred = _predict(target, models, shots, {m: (post["models"][m]["theta"], post["models"][m]["sigma"]) for m in models})
+    quantiles, seen = {}, {}
+    for one in paths:
+        post = read_posterior(one)
+        keys = post["parameters"]
+        check_target(case, post["target"], keys)
+        models = tuple(post["models"])
+        for m in models:
+            if m in seen:
+                raise InputError("--posterior", f"model {m!r} is in two posterior files ({seen[m]} and {one})")
+            seen[m] = str(one)
+        draws = {m: (post["models"][m]["theta"], post["models"][m]["sigma"]) for m in models}
+        rigid = tuple(m for m in models if m != ERODING)
+        if rigid:
+            target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"], models=rigid)
+            shots = ShotSet(U, np.full(U.shape, target.inputs.setup.mass), np.full(U.shape, np.nan),
+                            tuple(str(k) for k in range(len(U))))
+            pred = _predict(target, rigid, shots, draws)
+            quantiles.update({m: {f"{p:g}": pred[m][0][k].tolist() for k, p in enumerate(QUANTILES)} for m in rigid})
+        if ERODING in models:
+            record = post["models"][ERODING]["eroding"]
+            mkeys = post["models"][ERODING]["parameters"]
+            check_eroding(case, coefficients, record, mkeys)
+            from semianalytic.penetration.curve import PenetrationSetup
+
+            mass = PenetrationSetup.from_case(case, coefficients, require_material=False).mass
+            shots = ShotSet(U, np.full(U.shape, mass), np.full(U.shape, np.nan), tuple(str(k) for k in range(len(U))))
+            q = _quantiles_at(_eroding_depths(case, coefficients, mkeys, shots, record["fixed"])[0], draws[ERODING])[0]
+            quantiles[ERODING] = {f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}
+    aware, info, warnings = _regime_aware(case, coefficients, U, quantiles, part1_model)
+    if aware:
+        quantiles["regime_aware"] = aware
     return {
-        "depth_quantiles_m": {m: {f"{p:g}": pred[m][0][k].tolist() for k, p in enumerate(QUANTILES)} for m in models},
-        "posterior_file": str(path),
+        "depth_quantiles_m": quantiles,
+        "posterior_file": ", ".join(map(str, paths)),
+        "posterior_regime_aware": info,
+        "warnings": warnings,
     }

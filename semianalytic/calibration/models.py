@@ -19,6 +19,10 @@ Models (the names of :data:`MODELS`):
   errata item 5): :func:`semianalytic.penetration.curve.penetration_curve` at the surrogate's
   nodes (the energy depends on the stop time, so no scaling holds); per-shot masses by
   polynomial interpolation between Chebyshev nodes in m.
+* ``eroding``: the Alekseevskii-Tate eroding rod (:mod:`semianalytic.penetration.regime`) as a
+  function of its two strengths theta = (R_t, Y_p) (either may be fixed): no surrogate, the
+  closed-form I(v) and a fixed Gauss rule evaluate every draw and shot at once
+  (:class:`ErodingDepths`; the depth is proportional to the rod length L_0 of each shot's mass).
 * ``forrestal``: Forrestal's cavity-expansion formula with the cavity law's shape (A, B, C)
   and its yield stress set so that its static term A Y equals R_t; ``chen_li``: Chen & Li
   (2002) with the static resistance R_t and B = 3/2 (as in :mod:`.penetration.validation`).
@@ -41,7 +45,7 @@ from semianalytic.penetration.elastic import quasi_rigid_start, start_force_coef
 from semianalytic.penetration.motion import depth_profile
 
 __all__ = ["MODELS", "PHYSICALLY_CONSISTENT", "ShotSet", "DepthModelInputs", "model_depths",
-           "rigid_depths", "DepthSurrogate", "build_surrogate"]
+           "rigid_depths", "DepthSurrogate", "build_surrogate", "ThetaColumn", "ErodingDepths"]
 
 # the keys of semianalytic.penetration.validation.MODEL_LABELS (its labels are used by the report;
 # that module reads CSV files, so a pure model does not import it)
@@ -190,6 +194,19 @@ class DepthSurrogate:
         out[~inside] = np.nan
         return out
 
+    def log_depth_theta(self, theta, resistance) -> np.ndarray:
+        """ln D (n, n_shots) at parameter draws theta (n, p) through R_t = resistance(theta)
+        (NaN where R_t is not finite or outside the surrogate's range)."""
+        R = np.asarray(resistance(theta), float)
+        ok = np.isfinite(R)
+        out = self.log_depth(np.where(ok, R, self.R_lo))
+        out[~ok] = np.nan
+        return out
+
+    def subset(self, keep) -> "DepthSurrogate":
+        """The surrogate of the shots ``keep`` (column indices)."""
+        return dataclasses.replace(self, coef=self.coef[:, keep])
+
 
 def chebyshev_nodes(lo: float, hi: float, n: int) -> np.ndarray:
     """n Chebyshev points of the first kind, log-spaced on [lo, hi] (ascending)."""
@@ -215,3 +232,49 @@ def build_surrogate(inputs: DepthModelInputs, models, shots: ShotSet, R_lo: floa
         coef = cheb.chebfit(x, y, n_nodes - 1)
         out[model] = DepthSurrogate(model, float(R_lo), float(R_hi), np.atleast_2d(coef.reshape(n_nodes, -1)))
     return out
+
+
+@dataclass(frozen=True)
+class ThetaColumn:
+    """theta -> one calibrated parameter (column ``index``) or, when it is not calibrated
+    (index None), its fixed value: the R_t or Y_p of the eroding rod per draw."""
+
+    index: int | None
+    fixed: float
+
+    def __call__(self, theta) -> np.ndarray:
+        theta = np.atleast_2d(np.asarray(theta, float))
+        return theta[:, self.index].copy() if self.index is not None else np.full(len(theta), self.fixed)
+
+
+@dataclass(frozen=True)
+class ErodingDepths:
+    """ln depth of the Alekseevskii-Tate eroding rod (penetration.regime, eq. of the module
+    docstring there) for a shot set, at parameter draws theta: R_t = ``resistance(theta)``,
+    Y_p = ``strength(theta)`` (each a :class:`ThetaColumn`); ``rod_length`` L_0 per shot (the
+    cylinder of the shot's mass).  Depth 0 (the target does not yield, Y_p < R_t and U_s <= v_e)
+    is floored at 1e-12 m, so its ln is finite and far below any measured depth."""
+
+    velocity: np.ndarray
+    rod_length: np.ndarray
+    density: float
+    target_density: float
+    resistance: ThetaColumn
+    strength: ThetaColumn
+    model: str = "eroding"
+
+    def log_depth_theta(self, theta, resistance=None) -> np.ndarray:
+        from semianalytic.penetration.regime import eroding_depth_per_length
+
+        R = self.resistance(theta)[:, None]
+        Y = self.strength(theta)[:, None]
+        ok = np.isfinite(R) & np.isfinite(Y) & (R > 0) & (Y > 0)
+        d, _, _ = eroding_depth_per_length(self.velocity[None, :], density=self.density,
+                                           target_density=self.target_density,
+                                           target_resistance=np.where(ok, R, 1e9), rod_strength=np.where(ok, Y, 1e9))
+        out = np.log(np.maximum(d * self.rod_length[None, :], 1e-12))
+        return np.where(ok, out, np.nan)
+
+    def subset(self, keep) -> "ErodingDepths":
+        keep = np.atleast_1d(keep)
+        return dataclasses.replace(self, velocity=self.velocity[keep], rod_length=self.rod_length[keep])

@@ -84,7 +84,9 @@ class ResistanceMap:
 @dataclass(frozen=True)
 class Problem:
     """One calibration: priors of theta (SI), the discrepancy prior, R_t(theta), one model's
-    surrogate over the shots and the measured depths [m] (same order as the surrogate's columns)."""
+    depth over the shots (``surrogate``: anything with ``log_depth_theta(theta, resistance)``
+    and ``model``, a :class:`DepthSurrogate` or an :class:`ErodingDepths`) and the measured
+    depths [m] (same order as the surrogate's columns)."""
 
     names: tuple[str, ...]
     priors: tuple
@@ -125,12 +127,11 @@ class Problem:
         out = np.full(len(lp), -np.inf)
         if not ok.any():
             return out
-        R = self.resistance(theta[ok])
-        mu = self.surrogate.log_depth(np.where(np.isfinite(R), R, 1.0))  # (n_ok, n_shots)
+        mu = self.surrogate.log_depth_theta(theta[ok], self.resistance)  # (n_ok, n_shots), NaN: no valid depth
         s = sigma[ok][:, None]
         z = (np.log(self.depth)[None, :] - mu) / s
         ll = np.sum(-0.5 * z * z - np.log(s) - 0.5 * math.log(2 * math.pi), axis=1)
-        ll = np.where(np.isfinite(R) & np.isfinite(ll), ll, -np.inf)
+        ll = np.where(np.isfinite(ll), ll, -np.inf)
         out[ok] = lp[ok] + ll
         return out
 

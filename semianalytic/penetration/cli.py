@@ -61,8 +61,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
                         "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
-    parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None,
-                        help="add predictive depth quantiles (depth_quantiles_m) from a posterior written by calibrate")
+    parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None, action="append",
+                        help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
+                             "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding)")
 
 
 def _load(paths):
@@ -183,8 +184,10 @@ def run(args) -> int:
         if args.posterior is not None:  # first: a bad posterior stops before anything is computed
             from semianalytic.calibration.evaluate import predict_with_posterior
 
-            quantiles = predict_with_posterior(case, coefficients, args.posterior)
+            quantiles = predict_with_posterior(case, coefficients, args.posterior, part1_model=args.part1_model)
+        notes = quantiles.pop("warnings", [])
         results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model), **quantiles))
+        results[-1]["warnings"] = [*results[-1]["warnings"], *notes]
         descs.append(desc)
         _warn_separation(results[-1])
         for line in results[-1]["warnings"]:

@@ -7,6 +7,7 @@ velocity U_s - Y_p c_0/E_p at the start (eq. (26)):
 
     U_sC = Y_p c_0/E_p + sqrt( (2/(rho Bbar)) (Ybar_p - Rbar_t) )   if Ybar_p >= Rbar_t   (33)/(36)
     U_sC = Y_p c_0/E_p                                              otherwise             (34)
+    U_sC = inf (no real root)                     if Ybar_p >= Rbar_t and Bbar <= 0
     Ybar_p = (1 + rho A/m) Y_p,  Rbar_t = Cbar R_t,  Bbar = 4B/(pi d^2)                   (35)
 
 With loss of stability, Y_p is replaced everywhere by Y_c = phi(lambda) Y_p, lambda = 4L/d
@@ -20,6 +21,14 @@ so lambda = 4L/d):
     phi = 1 - Y_p lambda^2 / (4 pi^2 E_p)      for lambda <= lambda_e = pi sqrt(2 E_p / Y_p)
     phi = pi^2 E_p / (lambda^2 Y_p)            for lambda >  lambda_e  (Euler)
 phi = 1/2 at lambda_e, where both branches and their slopes meet.
+
+No real root.  Eq. (33) needs Bbar > 0: the axial stress grows with the velocity only through
+the velocity term rho B u^2 of eq. (11).  The ``bernoulli`` reading of B (B = dA/dP) vanishes
+at depth (the table's deep B is round-off, |Bbar| ~ 1e-9, of either sign): then the stress at
+the start never exceeds Rbar_t, and with Ybar_p >= Rbar_t the projectile yields at no striking
+velocity.  :func:`critical_velocity` returns ``math.inf`` (stated by
+:func:`no_real_root_reason`, which ``penetrate`` prints on stderr); the inverse problem has no
+solution and raises InputError naming ``coefficients.reading``.
 """
 
 from __future__ import annotations
@@ -41,6 +50,7 @@ __all__ = [
     "critical_velocity",
     "yield_stress_from_critical_velocity",
     "CriticalInputs",
+    "no_real_root_reason",
 ]
 
 
@@ -124,7 +134,20 @@ def critical_velocity(Y_p: float, inputs: CriticalInputs, phi: float = 1.0) -> f
     if Ybar < Rbar:  # eq. (34): the target is as strong as the projectile or stronger
         return elastic
     Bbar = c.B / area
+    if not Bbar > 0:  # no velocity term: the stress never reaches Ybar_p (module docstring, "No real root")
+        return math.inf
     return elastic + math.sqrt(2.0 / (c.target_density * Bbar) * (Ybar - Rbar))
+
+
+def no_real_root_reason(inputs: CriticalInputs) -> str | None:
+    """Why eq. (33) has no real root for these inputs (deep Bbar <= 0), or None when it has one."""
+    Bbar = inputs.B / (math.pi * inputs.diameter**2 / 4.0)
+    if Bbar > 0:
+        return None
+    return (f"eq. (33) has no real root: the deep drag coefficient Bbar = {Bbar:.2g} is not positive (the "
+            "'bernoulli' reading B = dA/dP vanishes at depth), so the axial stress never grows with the velocity and "
+            "no yielding is predicted at any striking velocity (U_sC = inf); use [coefficients] reading = 'body' "
+            "or 'literal' for U_sC")
 
 
 def yield_stress_from_critical_velocity(U_sC: float, inputs: CriticalInputs, phi=1.0) -> float:
@@ -133,6 +156,9 @@ def yield_stress_from_critical_velocity(U_sC: float, inputs: CriticalInputs, phi
     Johnson-Euler factor depends on Y_p).  U_sC increases with Y_p wherever phi Y_p does."""
     if not (np.isfinite(U_sC) and U_sC > 0):
         raise InputError("critical_velocity", f"must be positive; got {U_sC!r}")
+    reason = no_real_root_reason(inputs)
+    if reason is not None:
+        raise InputError("coefficients.reading", f"the dynamic yield stress cannot be found from U_sC: {reason}")
     phif = phi if callable(phi) else (lambda Y: phi)
     f = lambda Y: critical_velocity(Y, inputs, phif(Y)) - U_sC
     lo, hi = 1e3, 1e8

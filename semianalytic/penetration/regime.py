@@ -29,7 +29,7 @@ depth drop between the last deep shot (1493 m/s, 277 mm) and the first shallow o
 Alekseevskii-Tate (Alekseevskii 1966, Tate 1967; Part IV, eq. (1) for the rigid phase):
 rho_p L dv/dt = -Y_p, dL/dt = -(v - u), dP/dt = u,
 (1/2) rho_p (v - u)^2 + Y_p = (1/2) rho_t u^2 + R_t.  With v as the independent variable
-(dt = -rho_p L dv / Y_p) it is a quadrature, used here for all striking velocities at once:
+(dt = -rho_p L dv / Y_p) it is a quadrature, used here for all striking velocities and strengths at once:
 
     ln(L_0 / L(v)) = k [I(U_s) - I(v)],    I(v) = int (w - u(w)) dw,   k = rho_p / Y_p
     P_erosion(U_s) = k L_0 int_{v_e}^{U_s} u(w) exp(-k [I(U_s) - I(w)]) dw
@@ -37,7 +37,9 @@ rho_p L dv/dt = -Y_p, dL/dt = -(v - u), dP/dt = u,
 where v_e ends erosion: u = v at v_e = sqrt(2 (Y_p - R_t)/rho_t) if Y_p > R_t (the residual
 rod then penetrates rigidly, P += rho_p L_r / rho_t ln(1 + rho_t v_e^2 / (2 R_t)), Part IV
 eq. (3)), or u = 0 at v_e = sqrt(2 (R_t - Y_p)/rho_p) if Y_p < R_t (the rest erodes on the
-crater floor).  The rod is the cylinder of the projectile's mass and diameter (mass is what
+crater floor).  I(v) has a closed form (:func:`tate_integral`); the depth integral is Gauss-Legendre
+in s, w = v_e + (U_s - v_e) s^2 (8 panels of 16 points; u(w) ~ sqrt(w - v_e) near v_e becomes smooth
+in s).  The rod is the cylinder of the projectile's mass and diameter (mass is what
 erodes; for the Piekutowski ogive this is 65.6 mm against the 71.1 mm overall length).
 :func:`semianalytic.penetration.peers.tate_penetration` (time integration) is the check.
 """
@@ -48,8 +50,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.integrate import cumulative_simpson
-from scipy.interpolate import CubicSpline
 
 from semianalytic.errors import InputError
 from semianalytic.penetration.peers import tate_interface_velocity
@@ -59,6 +59,8 @@ __all__ = [
     "ErodingDepth",
     "eroding_rod_length",
     "eroding_depth",
+    "eroding_depth_per_length",
+    "tate_integral",
     "erosion_onset_velocity",
     "classify_regimes",
     "regime_depth",
@@ -111,22 +113,80 @@ def _check_strengths(target_resistance: float, rod_strength: float, target_densi
             raise InputError(key, f"must be positive; got {val!r}")
 
 
-class _Quadrature:
-    """I(v) = int_{v_e}^v (w - u(w)) dw on one grid up to the largest velocity (cubic spline)."""
+def tate_integral(v, v_e, rho_p, Y_p, rho_t, R_t):
+    """I(v) = int_{v_e}^{v} (w - u(w)) dw of the Alekseevskii-Tate rod in closed form (module
+    docstring; u(w) from (1/2) rho_p (w - u)^2 + Y_p = (1/2) rho_t u^2 + R_t).  With
+    a = rho_p rho_t, c = 2 (rho_p - rho_t)(R_t - Y_p), S(w) = sqrt(a w^2 + c):
+    w - u = (S - rho_t w)/(rho_p - rho_t) and int S dw = w S/2 + c/(2 sqrt a) ln(sqrt a w + S);
+    for rho_p = rho_t, w - u = w/2 - (Y_p - R_t)/(rho_p w).  Arrays broadcast (v, v_e, Y_p, R_t)."""
+    v, v_e, Y_p, R_t = (np.asarray(x, float) for x in (v, v_e, Y_p, R_t))
+    dr = rho_p - rho_t
+    if abs(dr) <= 1e-12 * rho_p:
+        with np.errstate(divide="ignore", invalid="ignore"):
+            log = np.where(v_e > 0, np.log(np.maximum(v, v_e) / v_e), 0.0)
+        return 0.25 * (v**2 - v_e**2) - (Y_p - R_t) / rho_p * log
+    a = rho_p * rho_t
+    sa = math.sqrt(a)
+    c = 2.0 * dr * (R_t - Y_p)
+    S = np.sqrt(np.maximum(a * v**2 + c, 0.0))
+    S_e = np.sqrt(np.maximum(a * v_e**2 + c, 0.0))
+    with np.errstate(divide="ignore", invalid="ignore"):
+        log = np.where(c != 0.0, np.log((sa * v + S) / (sa * v_e + S_e)), 0.0)
+    return (0.5 * (v * S - v_e * S_e) + c / (2.0 * sa) * log - 0.5 * rho_t * (v**2 - v_e**2)) / dr
 
-    def __init__(self, v_e, v_max, rho_p, Y_p, rho_t, R_t, n_grid=2048):
-        self.v_e = v_e
-        self.args = (rho_p, Y_p, rho_t, R_t)
-        # grid clustered at v_e, where u(w) has a square-root behaviour for Y_p < R_t
-        s = np.linspace(0.0, 1.0, n_grid + 1)
-        w = v_e + (v_max - v_e) * s**2
-        f = w - tate_interface_velocity(np.maximum(w, 1e-9 * v_max), *self.args)
-        I = cumulative_simpson(f * 2.0 * (v_max - v_e) * s, x=s, initial=0.0)
-        self.spline = CubicSpline(s, I)
-        self.span = v_max - v_e
 
-    def I(self, v):
-        return self.spline(np.sqrt(np.clip((np.asarray(v, float) - self.v_e) / self.span, 0.0, 1.0)))
+def _erosion_end_array(rho_p, Y_p, rho_t, R_t):
+    """v_e of :func:`_erosion_end` for arrays of Y_p and R_t."""
+    return np.where(Y_p > R_t, np.sqrt(2.0 * np.abs(Y_p - R_t) / rho_t), np.sqrt(2.0 * np.abs(R_t - Y_p) / rho_p))
+
+
+# Gauss-Legendre in s on [0, 1] (w = v_e + (U - v_e) s^2), 8 panels of 16 points
+_EDGES = np.linspace(0.0, 1.0, 9)
+_S = (_EDGES[:-1, None] + 0.5 * (_EDGES[1:] - _EDGES[:-1])[:, None] * (_GX + 1.0)[None, :]).ravel()
+_WS = (0.5 * (_EDGES[1:] - _EDGES[:-1])[:, None] * _GW[None, :]).ravel()
+_CHUNK = 1 << 20  # quadrature values per block: bounds the memory of a vectorised call (~50 MB)
+
+
+def eroding_depth_per_length(striking_velocity, *, density: float, target_density: float, target_resistance,
+                             rod_strength) -> tuple[np.ndarray, np.ndarray, np.ndarray]:
+    """Alekseevskii-Tate depth and residual length per unit rod length L_0 (module docstring),
+    vectorised over striking velocities U_s AND strengths: ``striking_velocity``,
+    ``target_resistance`` (R_t) and ``rod_strength`` (Y_p) broadcast against each other (the
+    depth is proportional to L_0).  Returns (P / L_0, L_r / L_0, eroded) of the broadcast shape.
+    The calibration evaluates thousands of (R_t, Y_p) draws at once with it; no check of the
+    inputs (see :func:`eroding_depth`)."""
+    rho_p, rho_t = float(density), float(target_density)
+    U, R, Y = np.broadcast_arrays(*(np.asarray(x, float) for x in (striking_velocity, target_resistance, rod_strength)))
+    shape = U.shape
+    U, R, Y = U.ravel(), R.ravel(), Y.ravel()
+    k = rho_p / Y
+    v_e = _erosion_end_array(rho_p, Y, rho_t, R)
+    depth = np.zeros(U.shape)
+    residual = np.ones(U.shape)
+    eroded = U > v_e
+    stronger = Y > R
+    low = ~eroded & stronger  # rigid rod below v_e, Part IV eq. (3)
+    depth[low] = rho_p / rho_t * np.log1p(rho_t * U[low] ** 2 / (2.0 * R[low]))
+    low = ~eroded & ~stronger  # u = 0: the rod erodes on the surface without penetrating, L = L0 exp(-k U^2/2)
+    residual[low] = np.exp(-0.5 * k[low] * U[low] ** 2)
+    idx = np.flatnonzero(eroded)
+    step = max(1, _CHUNK // len(_S))
+    for b in range(0, len(idx), step):
+        j = idx[b : b + step]
+        Uj, Rj, Yj, kj, vj = U[j], R[j], Y[j], k[j], v_e[j]
+        IU = tate_integral(Uj, vj, rho_p, Yj, rho_t, Rj)
+        # P/L0 = k int_{v_e}^{U} u(w) exp(-k (I(U) - I(w))) dw, w = v_e + (U - v_e) s^2
+        span = (Uj - vj)[:, None]
+        w = vj[:, None] + span * _S[None, :] ** 2
+        u = tate_interface_velocity(np.maximum(w, 1e-9 * Uj[:, None]), rho_p, Yj[:, None], rho_t, Rj[:, None])
+        Iw = tate_integral(w, vj[:, None], rho_p, Yj[:, None], rho_t, Rj[:, None])
+        integrand = u * np.exp(-kj[:, None] * (IU[:, None] - Iw)) * 2.0 * span * _S[None, :]
+        d = kj * (integrand @ _WS)
+        lr = np.exp(-kj * IU)
+        s_ = Yj > Rj  # the residual rod penetrates rigidly from v_e (Part IV eqs. (2)-(3))
+        d[s_] += rho_p * lr[s_] / rho_t * np.log1p(rho_t * vj[s_] ** 2 / (2.0 * Rj[s_]))
+        depth[j], residual[j] = d, lr
+    return depth.reshape(shape), residual.reshape(shape), eroded.reshape(shape)
 
 
 def eroding_depth(striking_velocity, *, length: float, nose_length: float, diameter: float, density: float,
@@ -144,36 +204,9 @@ def eroding_depth(striking_velocity, *, length: float, nose_length: float, diame
     if U.size == 0 or np.any(~np.isfinite(U)) or np.any(U <= 0):
         raise InputError("impact.striking_velocities", "must be positive (m/s)")
     L0 = eroding_rod_length(length, nose_length, diameter, density, mass)
-    rho_p, Y_p, rho_t, R_t = density, rod_strength, target_density, target_resistance
-    k = rho_p / Y_p
-    v_e = _erosion_end(rho_p, Y_p, rho_t, R_t)
-    depth = np.zeros(U.shape)
-    residual = np.full(U.shape, L0)
-    eroded = U > v_e
-    if Y_p > R_t:  # rigid rod below v_e, Part IV eq. (3)
-        low = ~eroded
-        depth[low] = rho_p * L0 / rho_t * np.log1p(rho_t * U[low] ** 2 / (2.0 * R_t))
-    else:  # u = 0 below v_e: the rod erodes on the surface without penetrating, L = L0 exp(-k U^2/2)
-        low = ~eroded
-        residual[low] = L0 * np.exp(-0.5 * k * U[low] ** 2)
-    if np.any(eroded):
-        Ue = U[eroded]
-        q = _Quadrature(v_e, float(Ue.max()), rho_p, Y_p, rho_t, R_t)
-        IU = q.I(Ue)
-        # P = k L0 int_{v_e}^{U} u(w) exp(-k (I(U) - I(w))) dw; w = v_e + (U - v_e) s^2 (Gauss on 8 panels)
-        edges = np.linspace(0.0, 1.0, 9)
-        s = (edges[:-1, None] + 0.5 * (edges[1:] - edges[:-1])[:, None] * (_GX + 1.0)[None, :]).ravel()
-        ws = (0.5 * (edges[1:] - edges[:-1])[:, None] * _GW[None, :]).ravel()
-        span = (Ue - v_e)[:, None]
-        w = v_e + span * s[None, :] ** 2
-        u = tate_interface_velocity(np.maximum(w, 1e-9 * Ue.max()), rho_p, Y_p, rho_t, R_t)
-        integrand = u * np.exp(-k * (IU[:, None] - q.I(w))) * 2.0 * span * s[None, :]
-        depth[eroded] = k * L0 * np.sum(ws[None, :] * integrand, axis=1)
-        Lr = L0 * np.exp(-k * IU)
-        residual[eroded] = Lr
-        if Y_p > R_t:  # the residual rod penetrates rigidly from v_e (Part IV eqs. (2)-(3))
-            depth[eroded] += rho_p * Lr / rho_t * math.log1p(rho_t * v_e**2 / (2.0 * R_t))
-    return ErodingDepth(depth, residual, v_e, eroded)
+    d, r, eroded = eroding_depth_per_length(U, density=density, target_density=target_density,
+                                            target_resistance=target_resistance, rod_strength=rod_strength)
+    return ErodingDepth(L0 * d, L0 * r, _erosion_end(density, rod_strength, target_density, target_resistance), eroded)
 
 
 def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length: float, diameter: float,
@@ -181,7 +214,10 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
                            mass: float | None = None) -> float:
     """U_e [m/s] (Alekseevskii-Tate rod equations, with U_y from Part I, eqs. (33)/(36)): the
     lowest U_s >= U_y at which the eroding rod is consumed down to its nose
-    length, or to its radius where the nose is shorter (module docstring).  NaN if U_y is NaN (no yielding predicted)."""
+    length, or to its radius where the nose is shorter (module docstring).  NaN if U_y is not
+    finite (no yielding predicted)."""
+    from scipy.optimize import brentq
+
     _check_strengths(target_resistance, rod_strength, target_density, density)
     if not math.isfinite(yield_velocity):
         return math.nan
@@ -195,20 +231,16 @@ def erosion_onset_velocity(yield_velocity: float, *, length: float, nose_length:
     if not l_n < L0:
         return math.inf
     target = math.log(L0 / l_n) * Y_p / rho_p
+
+    def gap(v):
+        return float(tate_integral(v, v_e, rho_p, Y_p, rho_t, R_t)) - target
+
     v_hi = max(2.0 * v_e, 4000.0)
-    while True:
-        q = _Quadrature(v_e, v_hi, rho_p, Y_p, rho_t, R_t, n_grid=512)
-        if float(q.I(v_hi)) >= target:
-            break
+    while gap(v_hi) < 0:
         v_hi *= 2.0
         if v_hi > 1e6:
             return math.inf
-    # I is increasing: invert on the grid, then Newton on the spline
-    x = q.spline.x
-    s = float(np.interp(target, q.spline(x), x))
-    for _ in range(4):
-        s -= (float(q.spline(s)) - target) / float(q.spline(s, 1))
-    onset = v_e + q.span * s**2
+    onset = brentq(gap, v_e, v_hi, xtol=1e-10, rtol=1e-14)
     return float(max(onset, yield_velocity))
 
 

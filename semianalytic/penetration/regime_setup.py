@@ -142,6 +142,13 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     valid["eroding"] = (reg == "eroding").tolist()
     valid["regime_aware"] = (reg != "deforming").tolist()  # depth_m: no model holds in the deforming band
     warnings = []
+    if U_y == math.inf and setup.rod is not None:  # eq. (33) without a real root (critical.no_real_root_reason)
+        from semianalytic.penetration.critical import no_real_root_reason
+
+        reason = no_real_root_reason(setup.critical_inputs())
+        if reason is not None:
+            warnings.append(f"U_sC: {reason}; every striking velocity is labelled rigid, which only reflects this "
+                            "reading, not the projectile")
     if np.any(~rigid_ok):
         why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))")
         for k in valid:
