@@ -193,8 +193,10 @@ def run(args) -> int:
         for line in results[-1]["warnings"]:
             print(f"{line} [{case.path or case.title}]", file=sys.stderr)
     if args.json:
+        from semianalytic.report.output import json_safe  # strict JSON: a non-finite number is null
+
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
-        print(json.dumps(objs[0] if len(objs) == 1 else {"cases": objs}, indent=1, allow_nan=True))
+        print(json.dumps(json_safe(objs[0] if len(objs) == 1 else {"cases": objs}), indent=1, allow_nan=False))
     else:
         for r, d in zip(results, descs):
             _print_text(r, d)
