@@ -551,8 +551,24 @@ class DomainMesh:
 
     def with_doflocs(self, doflocs: np.ndarray) -> "DomainMesh":
         """Same topology and tags, moved nodes (for shape finite differences)."""
-        mesh = dataclasses.replace(self.mesh, doflocs=np.ascontiguousarray(doflocs))
-        return dataclasses.replace(self, mesh=mesh)
+        return dataclasses.replace(self, mesh=moved_mesh(self.mesh, np.ascontiguousarray(doflocs)))
+
+
+# the connectivity scikit-fem derives from the elements alone (t), not from the node positions
+_TOPOLOGY = ("_facets", "_t2f", "_f2t", "_edges", "_t2e", "_f2e")
+
+
+def moved_mesh(mesh, doflocs: np.ndarray):
+    """``mesh`` with its nodes at ``doflocs`` (same elements), sharing the facet and edge arrays
+    scikit-fem derives from the elements: a new Mesh would sort them out again (a sort of all
+    facets) for every moved or shifted copy.  The arrays are the same ones, so the results are."""
+    mesh.t2f  # noqa: B018 - derive the facets once, on the original
+    moved = dataclasses.replace(mesh, doflocs=doflocs)
+    if moved.t is mesh.t or np.array_equal(moved.t, mesh.t):
+        for name in _TOPOLOGY:
+            if name in vars(mesh):
+                setattr(moved, name, getattr(mesh, name))
+    return moved
 
 
 def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):

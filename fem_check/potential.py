@@ -29,7 +29,7 @@ import scipy.sparse.linalg as spla
 from skfem import Basis, BilinearForm, ElementTriP1, ElementTriP2, FacetBasis, Functional, LinearForm
 from skfem.helpers import dot, grad
 
-from fem_check.meshing import DomainMesh
+from fem_check.meshing import DomainMesh, moved_mesh
 from semianalytic.errors import InputError
 
 FAR_FIELD_EXPONENT = {"dipole": 2.0, "monopole": 1.0, "neumann": 0.0}
@@ -157,7 +157,8 @@ class PotentialSolution:
         """
         facets = self.dm.boundaries[tag]
         order = intorder or 2 * self.basis.elem.maxdeg + 2
-        fb = FacetBasis(self.basis.mesh, self.basis.elem, facets=facets, intorder=order, mapping=self.basis.mapping)
+        fb = FacetBasis(self.basis.mesh, self.basis.elem, facets=facets, intorder=order, mapping=self.basis.mapping,
+                        dofs=self.basis.dofs, disable_doflocs=True)
         ph = fb.interpolate(self.phi)
         x, r = np.asarray(fb.global_coordinates())
         x = x + self.shift
@@ -187,15 +188,19 @@ def solve_potential(dm: DomainMesh, far_field: str, order: int | None = None) ->
     # with an absolute tolerance, which round-off defeats on the tiny tip elements when |x| is
     # thousands of element sizes (deep penetration).  Only x is shifted: the weight r is unchanged.
     shift = float(dm.domain.info.get("depth", 0.0)) if dm.domain.kind == "halfspace" else 0.0
-    mesh = dataclasses.replace(dm.mesh, doflocs=dm.mesh.doflocs - np.array([[shift], [0.0]])) if shift else dm.mesh
+    mesh = moved_mesh(dm.mesh, dm.mesh.doflocs - np.array([[shift], [0.0]])) if shift else dm.mesh
     mapping = mapping_for(mesh)
     basis = Basis(mesh, elem, intorder=q, mapping=mapping)
     K = _laplace_r.assemble(basis)
-    body = FacetBasis(mesh, elem, facets=dm.boundaries["body"], intorder=q, mapping=mapping)
+    # the facet bases reuse the cell basis' dof numbering (Dofs(mesh, elem) again, otherwise) and skip the
+    # global dof locations they never read
+    body = FacetBasis(mesh, elem, facets=dm.boundaries["body"], intorder=q, mapping=mapping, dofs=basis.dofs,
+                      disable_doflocs=True)
     f = _body_load.assemble(body)
     k = FAR_FIELD_EXPONENT[far_field]
     if k > 0:
-        far = FacetBasis(mesh, elem, facets=dm.boundaries["far"], intorder=q, mapping=mapping)
+        far = FacetBasis(mesh, elem, facets=dm.boundaries["far"], intorder=q, mapping=mapping, dofs=basis.dofs,
+                         disable_doflocs=True)
         xc, rc = dm.domain.far_center
         K = K + _robin_r.assemble(far, xc=xc - shift, rc=rc, k=k)
     if k == 0:
