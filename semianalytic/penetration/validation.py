@@ -18,7 +18,6 @@ import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.penetration import peers
-from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
 __all__ = ["MODEL_LABELS", "Shot", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
 
@@ -181,6 +180,8 @@ def predict_shots(case, coefficients, shots: list[Shot], *, w1: str = "neglect")
     """Per shot: measured and predicted depths [m] of every model in :data:`MODEL_LABELS`,
     plus U_sC [m/s] and the yield flag (U_s >= U_sC: outside the model's validity)."""
     rows = []
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve  # the models: not for load_shots
+
     base = PenetrationSetup.from_case(case, coefficients)
     for shot in shots:
         setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
