@@ -1,7 +1,9 @@
 """Physical quantities at the edges: unit strings in, SI floats out.
 
 Case files write quantities as strings with units (``"7.11 mm"``, ``"400 MPa"``,
-``"1.0 km/s"``).  They are parsed with pint, checked for dimension and converted to SI.
+``"1.0 km/s"``).  They are parsed with pint, checked for dimension and converted to SI; the
+most common unit strings are converted with pint's own factors without loading pint (start-up
+time; the same floats, see ``_COMMON_UNITS``).
 Inside the code every quantity is a plain float in SI units.
 
 The pydantic types at the bottom (``Length``, ``Pressure``, ...) are what case-file section
