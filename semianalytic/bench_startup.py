@@ -45,6 +45,7 @@ from semianalytic.case import load_case; mark("import semianalytic.case (pydanti
 case = load_case(case_path); mark("load_case")
 from semianalytic.cache import coefficients_for_case
 coefficients, _, _ = coefficients_for_case(case); mark("cached coefficient table (read)")
+import semianalytic.penetration.curve, semianalytic.penetration.critical
 from semianalytic.penetration.evaluate import evaluate_case; mark("import the models (scipy.integrate, interpolate, optimize)")
 if posterior:
     from semianalytic.calibration.evaluate import predict_with_posterior; mark("import the calibration")
@@ -197,7 +198,8 @@ def main(argv=None) -> int:
     doc.table(header, rows)
     doc.para("Issue 17's target (one `penetrate` call for 50 velocities in at most 0.5 s) cannot be met end to end: the "
              "interpreter, numpy, scipy's solvers and the case schemas alone cost more. The in-process times below give "
-             "what the call itself costs once the process runs (the row 'the depths again, same process').")
+             "what the call itself costs once the process runs (the row 'the depths again, same process'; the first call "
+             "also imports what the models load on use).")
     for key, title in (("posterior", f"`penetrate {CALIBRATED} --posterior ... --json`, in-process parts (CPU s)"),
                        ("fifty", f"`penetrate` at {N_VELOCITIES} velocities, in-process parts (CPU s)")):
         labels = [n for n, _ in phases["this tree"][key]]

@@ -19,7 +19,7 @@ import numpy as np
 from semianalytic.errors import InputError
 from semianalytic.penetration import peers
 
-__all__ = ["MODEL_LABELS", "Shot", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
+__all__ = ["MODEL_LABELS", "Shot", "read_csv_rows", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
 
 # column key -> label (the Part I models first, then the peers)
 MODEL_LABELS = {
