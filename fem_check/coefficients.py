@@ -36,7 +36,7 @@ from skfem import Basis, BilinearForm
 from skfem.helpers import dot, grad
 
 from fem_check.meshing import DomainMesh, MeshOptions, Piece, body_domain, build_mesh, halfspace_domain
-from fem_check.potential import PotentialSolution, element_for, solve_potential
+from fem_check.potential import PotentialSolution, element_for, solve_potential, symmetric_lu
 from semianalytic.geometry import Meridian, Nose
 
 
@@ -115,7 +115,7 @@ def moved_meshes(dm: DomainMesh, steps) -> list[DomainMesh]:
         nodes, new = _boundary_motion(dm, eps)
         if lu is None:
             interior = np.setdiff1d(np.arange(basis.N), nodes)
-            lu = spla.splu(K[interior][:, interior].tocsc())
+            lu = symmetric_lu(K[interior][:, interior])  # the Laplacian's interior block: symmetric positive definite
             Kib = K[interior][:, nodes]
             first_nodes = nodes
         elif not np.array_equal(nodes, first_nodes):

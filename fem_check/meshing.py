@@ -551,8 +551,24 @@ class DomainMesh:
 
     def with_doflocs(self, doflocs: np.ndarray) -> "DomainMesh":
         """Same topology and tags, moved nodes (for shape finite differences)."""
-        mesh = dataclasses.replace(self.mesh, doflocs=np.ascontiguousarray(doflocs))
-        return dataclasses.replace(self, mesh=mesh)
+        return dataclasses.replace(self, mesh=moved_mesh(self.mesh, np.ascontiguousarray(doflocs)))
+
+
+# the connectivity scikit-fem derives from the elements alone (t), not from the node positions
+_TOPOLOGY = ("_facets", "_t2f", "_f2t", "_edges", "_t2e", "_f2e")
+
+
+def moved_mesh(mesh, doflocs: np.ndarray):
+    """``mesh`` with its nodes at ``doflocs`` (same elements), sharing the facet and edge arrays
+    scikit-fem derives from the elements: a new Mesh would sort them out again (a sort of all
+    facets) for every moved or shifted copy.  The arrays are the same ones, so the results are."""
+    mesh.t2f  # noqa: B018 - derive the facets once, on the original
+    moved = dataclasses.replace(mesh, doflocs=doflocs)
+    if moved.t is mesh.t or np.array_equal(moved.t, mesh.t):
+        for name in _TOPOLOGY:
+            if name in vars(mesh):
+                setattr(moved, name, getattr(mesh, name))
+    return moved
 
 
 def _to_skfem(msh: meshio.Mesh, domain: Domain, order: int):
@@ -612,7 +628,52 @@ def build_mesh(domain: Domain, options: MeshOptions, use_cache: bool = True) -> 
     path = cache_dir() / f"{domain.kind}_{domain.key(options)}.msh"
     if not (use_cache and path.exists()):
         _generate(domain, options, path)
-    with contextlib.redirect_stdout(io.StringIO()):  # meshio prints an empty line for msh 4.1
-        msh = meshio.read(path)
-    mesh, boundaries, pieces = _to_skfem(msh, domain, options.order)
+    arrays = _read_arrays(path) if use_cache else None
+    if arrays is None:
+        with contextlib.redirect_stdout(io.StringIO()):  # meshio prints an empty line for msh 4.1
+            msh = meshio.read(path)
+        mesh, boundaries, pieces = _to_skfem(msh, domain, options.order)
+        if use_cache:
+            _write_arrays(path, mesh, boundaries, pieces)
+    else:
+        mesh, boundaries, pieces = arrays
     return _snap_curved(DomainMesh(domain, options, mesh, boundaries, pieces, path))
+
+
+# The scikit-fem arrays of a cached .msh file (nodes in scikit-fem's order, elements, tagged facets),
+# stored beside it: reading them back is several times faster than parsing the .msh with meshio and
+# matching its tagged lines to facets again, and gives the same arrays.  Bumped when _to_skfem changes.
+ARRAYS_VERSION = 1
+
+
+def _arrays_path(path: Path) -> Path:
+    return path.with_name(f"{path.stem}.skfem{ARRAYS_VERSION}.npz")
+
+
+def _write_arrays(path: Path, mesh, boundaries: dict, pieces: dict) -> None:
+    from semianalytic.io import atomic_write_bytes
+
+    buf = io.BytesIO()
+    np.savez(buf, order=np.array(2 if isinstance(mesh, MeshTri2) else 1), doflocs=mesh.doflocs, t=mesh.t,
+             **{f"boundary:{k}": v for k, v in boundaries.items()}, **{f"piece:{k}": v for k, v in pieces.items()})
+    try:
+        atomic_write_bytes(_arrays_path(path), buf.getvalue())
+    except OSError:
+        pass  # a read-only cache: the .msh is read each time, as before
+
+
+def _read_arrays(path: Path):
+    """(mesh, boundaries, pieces) from the arrays beside ``path``, or None (absent, older than the
+    .msh or unreadable: the .msh is read instead)."""
+    sidecar = _arrays_path(path)
+    try:
+        if sidecar.stat().st_mtime < path.stat().st_mtime:
+            return None
+        with np.load(sidecar) as z:
+            cls = MeshTri2 if int(z["order"]) == 2 else MeshTri1
+            mesh = cls(np.ascontiguousarray(z["doflocs"]), np.ascontiguousarray(z["t"]))
+            boundaries = {k.split(":", 1)[1]: z[k] for k in z.files if k.startswith("boundary:")}
+            pieces = {int(k.split(":", 1)[1]): z[k] for k in z.files if k.startswith("piece:")}
+    except (OSError, ValueError, KeyError):
+        return None
+    return mesh, boundaries, pieces

@@ -129,9 +129,21 @@ def body_far_field_study(meridian, exact: float, fars=(1.5, 3.0, 6.0, 12.0), h: 
 # projectile in the half-space
 
 
+def _solved(memo: dict | None, nose, depth: float, options: MeshOptions):
+    """:func:`halfspace_coefficients` of (nose, depth, options), computed once per ``memo`` (one
+    command: the refinement study repeats some of the comparison's solves)."""
+    if memo is None:
+        return halfspace_coefficients(nose, depth, options)
+    key = (id(nose), depth, options)
+    if key not in memo:
+        memo[key] = (nose, halfspace_coefficients(nose, depth, options))  # the nose kept: its id stays its own
+    return memo[key][1]
+
+
 def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_refinement: float = 1.0,
-                   grading: float | None = None) -> list[dict]:
-    """FEM and BEM coefficients at the given depths (in nose lengths); one dict per depth (SI)."""
+                   grading: float | None = None, memo: dict | None = None) -> list[dict]:
+    """FEM and BEM coefficients at the given depths (in nose lengths); one dict per depth (SI).
+    ``memo``: a dict shared with :func:`convergence_study` so a solve both need runs once."""
     from semianalytic.coefficients.table import coefficients_at
 
     scale = depth_scale(nose)  # L_h, or the radius of a flat nose
@@ -142,7 +154,7 @@ def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_re
     rows = []
     for i, P in enumerate(Ps):
         opts = MeshOptions(h=h, order=order) if grading is None else MeshOptions(h=h, order=order, grading=grading)
-        f = halfspace_coefficients(nose, float(P), opts)
+        f = _solved(memo, nose, float(P), opts)
         row = {"depth_m": float(P), "depth_over_Lh": float(P / scale)}
         for key, fk in (("A", "A"), ("B", "B_body"), ("C", "C")):
             row[f"{key}_bem"] = float(bem[fk if key != "B" else "B_body"][i])
@@ -165,7 +177,8 @@ def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_re
     return rows
 
 
-def convergence_study(nose, depths_over_Lh=(0.5, 2.0, 8.0), h_list=(0.16, 0.08, 0.04, 0.02), orders=(1, 2)) -> list[dict]:
+def convergence_study(nose, depths_over_Lh=(0.5, 2.0, 8.0), h_list=(0.16, 0.08, 0.04, 0.02), orders=(1, 2),
+                      memo: dict | None = None) -> list[dict]:
     """|FEM - BEM| / BEM for A and B_body under uniform refinement (BEM at refinement 2 as reference)."""
     from semianalytic.coefficients.table import coefficients_at
 
@@ -175,7 +188,7 @@ def convergence_study(nose, depths_over_Lh=(0.5, 2.0, 8.0), h_list=(0.16, 0.08, 
     for i, P in enumerate(Ps):
         for order in orders:
             for h in h_list:
-                f = halfspace_coefficients(nose, float(P), MeshOptions(h=h, order=order))
+                f = _solved(memo, nose, float(P), MeshOptions(h=h, order=order))
                 rows.append({"depth_over_Lh": float(P / nose.length), "order": order, "h_over_d": h, "n_dofs": f.n_dofs,
                              "A": abs(f.A / ref["A"][i] - 1), "B": abs(f.B_body / ref["B_body"][i] - 1),
                              "seconds": f.seconds})
@@ -291,7 +304,8 @@ def run(args) -> int:
         from fem_check.refinement import has_singular_corners, refinement_study
 
         nose = nose_from_section(case.projectile)
-        rows = compare_depths(nose, depths, h=args.h, grading=args.grading)
+        memo: dict = {}  # solves shared by the comparison and the convergence study
+        rows = compare_depths(nose, depths, h=args.h, grading=args.grading, memo=memo)
         scale = depth_scale(nose)
         payload = {"case": case.title, "kind": "halfspace", "nose": nose.kind, "diameter_m": nose.diameter,
                    "nose_length_m": nose.length, "depth_scale": "L_h" if scale == nose.length else "radius",
@@ -301,7 +315,7 @@ def run(args) -> int:
         if not args.quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
             payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading)
         elif not args.quick:
-            payload["convergence"] = convergence_study(nose)
+            payload["convergence"] = convergence_study(nose, memo=memo)
             if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
                 payload["far_field"] = halfspace_far_field_study()
                 payload["hemisphere_exact"] = hemisphere_check()

@@ -92,16 +92,19 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
     module is not available (then the paper's constants are used).
     """
     from semianalytic.errors import InputError
-    from semianalytic.penetration.curve import paper_coefficients
 
     psec = case.require("projectile")
     if source == "paper":
+        from semianalytic.penetration.curve import paper_coefficients  # the models: only for the paper's constants
+
         return paper_coefficients(psec), "the paper's quoted deep-penetration Abar, Bbar, Cbar (constant in P)", False
     if source != "bem":
         raise InputError("coefficients", f"must be 'bem' or 'paper'; got {source!r}")
     try:
         import semianalytic.coefficients.table  # noqa: F401
     except ImportError:
+        from semianalytic.penetration.curve import paper_coefficients
+
         return (
             paper_coefficients(psec),
             "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",

@@ -1,7 +1,9 @@
 """Physical quantities at the edges: unit strings in, SI floats out.
 
 Case files write quantities as strings with units (``"7.11 mm"``, ``"400 MPa"``,
-``"1.0 km/s"``).  They are parsed with pint, checked for dimension and converted to SI.
+``"1.0 km/s"``).  They are parsed with pint, checked for dimension and converted to SI; the
+most common unit strings are converted with pint's own factors without loading pint (start-up
+time; the same floats, see ``_COMMON_UNITS``).
 Inside the code every quantity is a plain float in SI units.
 
 The pydantic types at the bottom (``Length``, ``Pressure``, ...) are what case-file section
@@ -95,7 +97,7 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
     """
     from semianalytic.errors import InputError
 
-    dim, si, example = KINDS[kind]
+    _, si, example = KINDS[kind]
     if isinstance(value, bool) or not isinstance(value, (str, int, float)):
         raise InputError(field, f"expected a {kind} with a unit, e.g. '{example}'; got {value!r}")
     if isinstance(value, (int, float)):
@@ -104,6 +106,22 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
         )
     if not _NUMBER_FIRST.match(value):  # pint reads a bare "mm" as 1 mm
         raise InputError(field, f"expected a {kind} as a number and a unit, e.g. '{example}'; got {value!r}")
+    out = _common_unit_si(value, kind)
+    if out is None:  # anything but a plain number and one of the common units: pint decides
+        out = _pint_si(value, kind, field, example, si)
+    if not math.isfinite(out):
+        raise InputError(field, f"{value!r} is not a finite {kind}")
+    low, high, text = PHYSICAL_BOUNDS[kind]
+    if out != 0 and not low <= abs(out) <= high:
+        raise InputError(field, f"{value!r} lies outside the physical range of a {kind} ({text})")
+    return out
+
+
+def _pint_si(value: str, kind: str, field: str, example: str, si: str) -> float:
+    """``value`` parsed by pint, checked for the dimension of ``kind``, in SI."""
+    from semianalytic.errors import InputError
+
+    dim = KINDS[kind][0]
     ureg = registry()
     try:
         q = ureg.Quantity(value.strip())
@@ -123,12 +141,51 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
                 field, f"expected a {kind} (SI unit {si}), e.g. '{example}'; got {value!r}"
             )
         out = float(q.to(si.replace("^", "**")).magnitude)
-    if not math.isfinite(out):
-        raise InputError(field, f"{value!r} is not a finite {kind}")
-    low, high, text = PHYSICAL_BOUNDS[kind]
-    if out != 0 and not low <= abs(out) <= high:
-        raise InputError(field, f"{value!r} lies outside the physical range of a {kind} ({text})")
     return out
+
+
+# The unit strings case files and flags use most, with pint's own factor to SI (the magnitude
+# pint's ``Quantity(value).to(SI)`` returns is the number times this factor, bit for bit:
+# tests/test_units_fast_path.py checks every entry against pint on many numbers and spellings).
+# Parsing these without pint spares a command pint's import and its unit registry (~0.4 s);
+# every other string, and every string whose unit is not of the kind asked for, goes to pint.
+_COMMON_UNITS: dict[str, tuple[str, float]] = {
+    "m": ("length", 1.0), "mm": ("length", 0.001), "cm": ("length", 0.01), "um": ("length", 1e-06),
+    "µm": ("length", 1e-06), "km": ("length", 1000.0), "nm": ("length", 1e-09),
+    "kg": ("mass", 1.0), "g": ("mass", 0.001), "mg": ("mass", 1e-06),
+    "s": ("time", 1.0), "ms": ("time", 0.001), "us": ("time", 1e-06), "µs": ("time", 1e-06), "ns": ("time", 1e-09),
+    "m/s": ("velocity", 1.0), "km/s": ("velocity", 1000.0), "mm/us": ("velocity", 1000.0),
+    "mm/s": ("velocity", 0.001),
+    "Pa": ("pressure", 1.0), "kPa": ("pressure", 1000.0), "MPa": ("pressure", 1000000.0),
+    "GPa": ("pressure", 1000000000.0), "TPa": ("pressure", 1000000000000.0),
+    "kg/m^3": ("density", 1.0), "kg/m**3": ("density", 1.0),
+    "g/cm^3": ("density", 999.9999999999999), "g/cm**3": ("density", 999.9999999999999),  # pint's factor
+    "kg/m^2": ("areal_density", 1.0), "g/cm^2": ("areal_density", 10.0),
+    "J": ("energy", 1.0), "kJ": ("energy", 1000.0), "MJ": ("energy", 1000000.0),
+    "J/m^2": ("surface_energy", 1.0),
+    "deg": ("angle", 0.017453292519943295), "degree": ("angle", 0.017453292519943295),
+    "degrees": ("angle", 0.017453292519943295), "rad": ("angle", 1.0), "radian": ("angle", 1.0),
+    "m^2": ("area", 1.0), "mm^2": ("area", 1e-06), "cm^2": ("area", 0.0001),
+    "m^3": ("volume", 1.0), "mm^3": ("volume", 1e-09), "cm^3": ("volume", 1.0000000000000002e-06),
+}
+_COMMON_QUANTITY = re.compile(r"\s*([-+]?(?:\d+\.?\d*|\.\d+)(?:[eE][-+]?\d+)?) ([^\s]+)\s*")
+
+
+def _common_unit_si(value: str, kind: str) -> float | None:
+    """``value`` in SI when it is a decimal number, one space and a unit of ``kind`` from
+    :data:`_COMMON_UNITS` (the same float pint gives); else None."""
+    match = _COMMON_QUANTITY.fullmatch(value)
+    if match is None:
+        return None
+    number, unit = match.groups()
+    unit_kind, factor = _COMMON_UNITS.get(unit, ("", 0.0))
+    digits = number.lstrip("+-")
+    if unit_kind != kind or (digits[:1] == "0" and digits[1:2].isdigit()):
+        return None  # another kind (pint words the error), or a leading zero as in "07" (pint's tokenizer decides)
+    try:  # as pint's evaluator: an integer stays an int ("-0" is 0), anything else a float ("-0.0")
+        return float((int(number) if digits.isdigit() else float(number)) * factor)
+    except OverflowError:
+        return None
 
 
 _NUMBER_FIRST = re.compile(r"\s*[-+]?(\d|\.\d|inf|nan)", re.IGNORECASE)

@@ -23,7 +23,6 @@ from dataclasses import dataclass
 from functools import cached_property
 
 import numpy as np
-from scipy.optimize import brentq
 
 from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc, segment_arc_length
@@ -524,6 +523,8 @@ def param_at_x(seg: Segment, x: float) -> float:
     if isinstance(seg, Arc):
         c = np.clip((x - seg.center[0]) / seg.radius, -1.0, 1.0)
         return float(np.arccos(c))
+    from scipy.optimize import brentq  # here, not at start-up (scipy.optimize: ~0.5 s to import)
+
     f = lambda t: float(seg.point(t)[0]) - x  # noqa: E731
     if isinstance(seg, SplineCurve):
         # a table nose is cut at its knots into segments; the free surface of a nearby

@@ -27,7 +27,6 @@ import warnings
 from dataclasses import asdict, dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from semianalytic.cavity.material import BrittleMaterial
 from semianalytic.cavity.zones import crack_front_ratio, front_strains
@@ -174,6 +173,8 @@ def solve_front_stress_bracket(material: BrittleMaterial, xtol_rel: float = 1e-1
         hi *= 2.0
     else:  # pragma: no cover - F -> +inf as x -> inf, so this cannot happen for valid input
         raise RuntimeError("could not bracket the root of Part II eq. (21)")
+    from scipy.optimize import brentq  # on use: loading a case stays light
+
     x, info = brentq(front_equation, lo, hi, args=(m,), xtol=xtol_rel * lo, rtol=4 * np.finfo(float).eps,
                      full_output=True, maxiter=200)
     if not info.converged:  # pragma: no cover

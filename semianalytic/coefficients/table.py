@@ -38,11 +38,8 @@ import math
 from dataclasses import dataclass, field, replace
 
 import numpy as np
-from scipy.interpolate import BPoly, PPoly, make_interp_spline
 
-from semianalytic.bem.panels import LayoutOptions
 from semianalytic.coefficients import READINGS
-from semianalytic.coefficients.depth import DepthCoefficients, coefficients_at_depth
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose
 
@@ -165,6 +162,8 @@ def depth_pieces(nose: Nose) -> tuple[list[Piece], list[float]]:
 def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) -> DepthCoefficients:
     """One direct BEM solve at depth P (Part I, eqs. (12)-(14)); beside a breakpoint the
     difference in P is of fourth order with a step of a hundredth of the distance to it."""
+    from semianalytic.coefficients.depth import coefficients_at_depth  # the BEM: not on a cached table's path
+
     kinks = breakpoints(nose) if kinks is None else kinks
     scale = max(nose.length, nose.radius)
     dist = min((abs(depth - b) for b in kinks), default=math.inf)
@@ -184,6 +183,8 @@ def direct_coefficients(nose: Nose, depths, order: int = 8, refinement: float = 
     A, B_body, B_literal, B_bernoulli, C, phi_tip, dA_dP, unknowns (SI).  Within BREAK_OFFSET
     of a breakpoint (no layout exists there) the value is the linear interpolation between
     the solves at b (1 -+ BREAK_OFFSET), as in the table."""
+    from semianalytic.bem.panels import LayoutOptions
+
     opts = LayoutOptions(order, refinement, levels)
     kinks = breakpoints(nose)
     out = []
@@ -238,6 +239,8 @@ def _spline(v: np.ndarray, y: np.ndarray, derivs=None):
     """Interpolant as a PPoly in v: quintic Hermite through values and the given first and
     second derivatives (``derivs`` = (dy, d2y)), else an interpolating spline of degree 5
     (3 or 1 when there are too few knots)."""
+    from scipy.interpolate import BPoly, PPoly, make_interp_spline  # building only: not on a cached table's path
+
     n = len(v)
     if n == 1:
         return None
@@ -714,6 +717,8 @@ class _Builder:
         """BEM discretisation error per coefficient: two depths solved again at a lower order
         (the difference bounds the error of the table's order), and the residual of the
         identity B_bernoulli = dA/dP at every knot (errata item 2a)."""
+        from semianalytic.bem.panels import LayoutOptions
+
         lower = LayoutOptions(max(self.opts.order - 2, 2), self.opts.refinement, self.opts.levels)
         probes = []
         root = self.knots[0]
@@ -841,6 +846,8 @@ def coefficient_table(
     tol = check_tolerance(DEFAULT_TOLERANCE if tolerance is None else tolerance)
     scale = nose.length if nose.length > 0.05 * nose.radius else nose.radius
     P_max = max_depth_nose_lengths * scale
+    from semianalytic.bem.panels import LayoutOptions  # the BEM: imported when a table is built
+
     opts = LayoutOptions(order, refinement, levels)
     bar = None
     if progress:

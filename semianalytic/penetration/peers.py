@@ -23,6 +23,7 @@ Part I:
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass
 
@@ -44,9 +45,19 @@ def ogive_nose_factor(psi: float) -> float:
     return (8.0 * psi - 1.0) / (24.0 * psi**2)
 
 
+@functools.cache
+def _gauss_legendre_64() -> tuple[np.ndarray, np.ndarray]:
+    """The 64-point Gauss-Legendre rule on [-1, 1], computed once (an eigenvalue problem each time
+    otherwise: nose_factors runs once per model and shot set)."""
+    u, w = np.polynomial.legendre.leggauss(64)
+    u.setflags(write=False)
+    w.setflags(write=False)
+    return u, w
+
+
 def nose_factors(nose) -> tuple[float, float]:
     """(N_1, N_2) = (int n_x^2 dS, int n_x^3 dS) / (pi a^2) over a geometry.Nose (quadrature)."""
-    u, w = np.polynomial.legendre.leggauss(64)
+    u, w = _gauss_legendre_64()
     n1 = n2 = 0.0
     for seg in nose.segments:
         edges = np.asarray(seg.knots) if hasattr(seg, "knots") else np.linspace(seg.t0, seg.t1, 9)

@@ -18,9 +18,8 @@ import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.penetration import peers
-from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
-__all__ = ["MODEL_LABELS", "Shot", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
+__all__ = ["MODEL_LABELS", "Shot", "read_csv_rows", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
 
 # column key -> label (the Part I models first, then the peers)
 MODEL_LABELS = {
@@ -50,11 +49,56 @@ def _unit_scale(unit: str, kind: str, field: str) -> float:
     return parse_quantity(f"1 {unit}", kind, field)
 
 
+def _strip_comment(line: str) -> str:
+    """The line up to a ``#`` outside double quotes (the rest is a comment)."""
+    quoted = False
+    for k, ch in enumerate(line):
+        if ch == '"':
+            quoted = not quoted
+        elif ch == "#" and not quoted:
+            return line[:k]
+    return line
+
+
+def read_csv_rows(path: Path, field: str = "data.file") -> tuple[list[str], list[dict]]:
+    """(columns, rows as {column: text}) of a small CSV file, read as ``pandas.read_csv(path,
+    comment="#", dtype=str, keep_default_na=False)`` reads it: ``#`` starts a comment, blank
+    lines are skipped, the first line left is the header, every value stays text (missing ones
+    ""), a repeated column name gets ".1", ".2", ...  The csv module, not pandas: the shot
+    tables are small and pandas costs a command about 0.4 s to import.  Bad input raises
+    ``InputError`` naming ``field``."""
+    import csv
+
+    def bad(why: str) -> InputError:
+        return InputError(field, f"cannot read {path.name} as CSV: {why}")
+
+    try:
+        text = path.read_text(encoding="utf-8-sig")
+    except (OSError, UnicodeDecodeError) as exc:
+        raise bad(str(exc)) from None
+    lines = [ln for ln in (_strip_comment(ln) for ln in text.splitlines(keepends=True)) if ln.strip()]
+    try:
+        records = list(csv.reader(lines, strict=True))
+    except csv.Error as exc:
+        raise bad(str(exc)) from None
+    if not records:
+        raise bad("no columns to parse from file")
+    columns, seen = [], {}
+    for name in records[0]:
+        n = seen.get(name, 0)
+        seen[name] = n + 1
+        columns.append(name if n == 0 else f"{name}.{n}")
+    rows = []
+    for k, rec in enumerate(records[1:]):
+        if len(rec) > len(columns):
+            raise bad(f"expected {len(columns)} fields in line {k + 2}, saw {len(rec)}")
+        rows.append(dict(zip(columns, rec + [""] * (len(columns) - len(rec)))))
+    return columns, rows
+
+
 def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     """The shots of the case's ``[data]`` CSV in SI units (rows with a depth, kept by ``select``;
     with ``require_depth=False`` also the rows without one, depth NaN)."""
-    import pandas as pd
-
     data = case.require("data")
     if data.file is None:
         return []
@@ -62,22 +106,19 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     path = (base / data.file).resolve()
     if not path.is_file():
         raise InputError("data.file", f"{str(path)!r} does not exist")
-    try:
-        df = pd.read_csv(path, comment="#", dtype=str, keep_default_na=False)
-    except Exception as exc:  # noqa: BLE001 - any parse failure is bad input
-        raise InputError("data.file", f"cannot read {path.name} as CSV: {exc}") from None
+    names, table = read_csv_rows(path)
     columns = {k: getattr(data, k) for k in ("velocity_column", "depth_column", "mass_column", "id_column")}
     columns.update({f"select.{c}": c for c in data.select})
     for key, col in columns.items():
-        if col is not None and col not in df.columns:
-            raise InputError(f"data.{key}", f"column {col!r} is not in {path.name} (columns: {', '.join(df.columns)})")
-    for col, allowed in data.select.items():
-        df = df[df[col].isin(allowed)]
+        if col is not None and col not in names:
+            raise InputError(f"data.{key}", f"column {col!r} is not in {path.name} (columns: {', '.join(names)})")
     v_scale = _unit_scale(data.velocity_unit, "velocity", "data.velocity_unit")
     d_scale = _unit_scale(data.depth_unit, "length", "data.depth_unit")
     m_scale = _unit_scale(data.mass_unit, "mass", "data.mass_unit")
     shots = []
-    for i, row in df.iterrows():
+    for i, row in enumerate(table):
+        if any(row[col] not in allowed for col, allowed in data.select.items()):
+            continue
         no_depth = row[data.depth_column].strip() == ""
         if no_depth and require_depth:
             continue  # no depth printed (e.g. only a channel length)
@@ -90,7 +131,7 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
         if not (V > 0 and (P > 0 or no_depth) and (m is None or m > 0)):
             raise InputError("data.file", f"row {i + 1} of {path.name}: velocity, depth and mass must be positive")
         shot_id = str(row[data.id_column]) if data.id_column else str(i + 1)
-        shots.append(Shot(shot_id, V, P, m, dict(row)))
+        shots.append(Shot(shot_id, V, P, m, row))
     return shots
 
 
@@ -139,6 +180,8 @@ def predict_shots(case, coefficients, shots: list[Shot], *, w1: str = "neglect")
     """Per shot: measured and predicted depths [m] of every model in :data:`MODEL_LABELS`,
     plus U_sC [m/s] and the yield flag (U_s >= U_sC: outside the model's validity)."""
     rows = []
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve  # the models: not for load_shots
+
     base = PenetrationSetup.from_case(case, coefficients)
     for shot in shots:
         setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
