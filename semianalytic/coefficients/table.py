@@ -8,7 +8,13 @@ segment junctions.  Each smooth piece is interpolated in its own variable:
   powers of P (A ~ P^3/2, B ~ P^1/2, C ~ P on a rounded tip, A ~ P^3 on a pointed one), which
   are polynomials in sqrt(P);
 - between breakpoints in v = P/l;
-- beyond the last breakpoint in v = l/P, down to v = 0: the deep-penetration limit, which
+- past a breakpoint b where a corner of the meridian enters the target (a cone's shoulder at
+  P = L_h) or where two of the nose's segments join, in v = ((P - b)/l)^(1/3) (``graded``; up
+  to 2 b past the last breakpoint): there the coefficients change like non-integer powers of
+  P - b over many decades (B jumps at a shoulder corner; the corner and its mirror image, or
+  the joint and the free-surface edge, are P - b apart and interact), which are smooth in
+  that v (the knots crowd b like P - b ~ v^3); in l/P they took about 100 knots;
+- beyond the last breakpoint (or the graded piece) in v = l/P, down to v = 0: the deep-penetration limit, which
   the free-surface image approaches like 1/P (errata item 2b), so the coefficients are
   smooth in 1/P there.  The limit is extrapolated from the deepest solves by polynomials in
   1/P, with the difference of two orders as its error estimate; the table is extended
@@ -24,7 +30,7 @@ as that interval's interpolation-error estimate.  The BEM discretisation error i
 by solving two depths again at a lower order (the difference bounds the error of the table's
 order, which converges spectrally) and by the residual of the identity B_bernoulli = dA/dP.
 
-Breakpoints: the knots nearest a breakpoint b are at b (1 -+ BREAK_OFFSET) (the BEM layout
+Breakpoints (also a table spline's knots where its third derivative jumps): the knots nearest a breakpoint b are at b (1 -+ BREAK_OFFSET) (the BEM layout
 changes topology at b itself), solved with a fourth-order difference in P whose step is a
 hundredth of the distance to b; across the gap the table is linear.
 """
@@ -414,8 +420,9 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.where(kind == 0, np.sqrt(P / sc), np.where(kind == 1, P / sc, np.where(np.isinf(P), 0.0, sc / P)))
-            graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / self._power[j])
-            v = np.where(kind == 3, graded, v)
+            if np.any(kind == 3):
+                graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / self._power[j])
+                v = np.where(kind == 3, graded, v)
         return v - np.asarray(self.intervals["v0"])[j]
 
     def _eval(self, name: str, P):
@@ -472,9 +479,10 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             dv_dP = np.where(kind == 0, 0.5 / np.sqrt(P * sc), np.where(kind == 1, 1.0 / sc, -sc / P**2))
-            m = self._power[j]
-            graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / m - 1.0) / (m * sc)
-            dv_dP = np.where(kind == 3, graded, dv_dP)
+            if np.any(kind == 3):
+                m = self._power[j]
+                graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / m - 1.0) / (m * sc)
+                dv_dP = np.where(kind == 3, graded, dv_dP)
             out = np.where(np.isfinite(dv_dP), dA_dv * dv_dP, 0.0)
         return np.where(np.isinf(P), 0.0, out)[()]
 
