@@ -408,6 +408,7 @@ class CoefficientTable:
         n = len(iv["P_lo"])  # graded intervals: v = ((P - origin)/scale)^(1/power)
         object.__setattr__(self, "_origin", np.asarray(iv.get("origin", np.zeros(n)), float))
         object.__setattr__(self, "_power", np.asarray(iv.get("power", np.ones(n)), float))
+        object.__setattr__(self, "_graded", bool(np.any(np.asarray(iv["kind"]) == _KINDS["graded"])))
         object.__setattr__(self, "_coef", {k: np.asarray(iv[f"coef_{k}"]).tolist() for k in INTERPOLATED})
 
     # --- evaluation -----------------------------------------------------------------
@@ -420,7 +421,7 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.where(kind == 0, np.sqrt(P / sc), np.where(kind == 1, P / sc, np.where(np.isinf(P), 0.0, sc / P)))
-            if np.any(kind == 3):
+            if self._graded:
                 graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / self._power[j])
                 v = np.where(kind == 3, graded, v)
         return v - np.asarray(self.intervals["v0"])[j]
@@ -479,7 +480,7 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             dv_dP = np.where(kind == 0, 0.5 / np.sqrt(P * sc), np.where(kind == 1, 1.0 / sc, -sc / P**2))
-            if np.any(kind == 3):
+            if self._graded:
                 m = self._power[j]
                 graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / m - 1.0) / (m * sc)
                 dv_dP = np.where(kind == 3, graded, dv_dP)
