@@ -28,8 +28,8 @@ from semianalytic.coefficients.table import (
 from semianalytic.errors import InputError
 
 TOL = 1e-5  # the default tolerance: relative to each coefficient's largest magnitude over the table
-# cornered noses cost 2-3 times the knots of smooth ones at 1e-5; CI checks them looser (the
-# slow study below and reports/bem_coefficients.md at 1e-5)
+# cornered noses are checked looser here to keep CI short; at the default 1e-5, beside every
+# breakpoint, in tests/test_table_corners.py, the slow study below and reports/bem_corners.md
 CI_TOL = {"ogive": TOL, "sphere": TOL, "cone": 1e-3, "flat": 1e-4, "table": 1e-3}
 FIG5 = "cases/fig5_ogive.toml"
 

@@ -8,7 +8,13 @@ segment junctions.  Each smooth piece is interpolated in its own variable:
   powers of P (A ~ P^3/2, B ~ P^1/2, C ~ P on a rounded tip, A ~ P^3 on a pointed one), which
   are polynomials in sqrt(P);
 - between breakpoints in v = P/l;
-- beyond the last breakpoint in v = l/P, down to v = 0: the deep-penetration limit, which
+- past a breakpoint b where a corner of the meridian enters the target (a cone's shoulder at
+  P = L_h) or where two of the nose's segments join, in v = ((P - b)/l)^(1/3) (``graded``; up
+  to 2 b past the last breakpoint): there the coefficients change like non-integer powers of
+  P - b over many decades (B jumps at a shoulder corner; the corner and its mirror image, or
+  the joint and the free-surface edge, are P - b apart and interact), which are smooth in
+  that v (the knots crowd b like P - b ~ v^3); in l/P they took about 100 knots;
+- beyond the last breakpoint (or the graded piece) in v = l/P, down to v = 0: the deep-penetration limit, which
   the free-surface image approaches like 1/P (errata item 2b), so the coefficients are
   smooth in 1/P there.  The limit is extrapolated from the deepest solves by polynomials in
   1/P, with the difference of two orders as its error estimate; the table is extended
@@ -24,7 +30,7 @@ as that interval's interpolation-error estimate.  The BEM discretisation error i
 by solving two depths again at a lower order (the difference bounds the error of the table's
 order, which converges spectrally) and by the residual of the identity B_bernoulli = dA/dP.
 
-Breakpoints: the knots nearest a breakpoint b are at b (1 -+ BREAK_OFFSET) (the BEM layout
+Breakpoints (also a table spline's knots where its third derivative jumps): the knots nearest a breakpoint b are at b (1 -+ BREAK_OFFSET) (the BEM layout
 changes topology at b itself), solved with a fourth-order difference in P whose step is a
 hundredth of the distance to b; across the gap the table is linear.
 """
@@ -41,9 +47,9 @@ import numpy as np
 
 from semianalytic.coefficients import READINGS
 from semianalytic.errors import InputError
-from semianalytic.geometry import Nose
+from semianalytic.geometry import Nose, SplineCurve
 
-TABLE_VERSION = 7  # (5: certified tables; 6-7: with the corner-aware BEM) bump when the numerics change, to invalidate caches
+TABLE_VERSION = 8  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners) bump when the numerics change, to invalidate caches
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")  # error-controlled coefficients
@@ -57,7 +63,12 @@ NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is n
 # floor of every error estimate, relative to the coefficient's largest magnitude: phi at P is the
 # mean of the difference stencil's solves (error O(h^2), about 1e-8; coefficients/depth.py)
 ROUND_OFF = 1e-8
-_KINDS = {"root": 0, "mid": 1, "deep": 2}
+# past a corner breakpoint b the coefficients go like non-integer powers of P - b (B jumps at b,
+# then changes over many decades of P - b: the corner and its mirror image, 2 (P - b) apart,
+# interact); interpolated in v = ((P - b)/l)^(1/GRADED_POWER) up to b (1 + GRADED_SPAN)
+GRADED_POWER = 3.0
+GRADED_SPAN = 1.0
+_KINDS = {"root": 0, "mid": 1, "deep": 2, "graded": 3}
 
 
 # --------------------------------------------------------------------------------------
@@ -72,6 +83,8 @@ def breakpoints(nose: Nose) -> list[float]:
     for seg in nose.segments[:-1]:
         x, _ = seg.point(seg.t1)
         out.append(-float(x))
+    for seg in nose.segments:
+        out.extend(_spline_jumps(seg))
     for name in ("corner_depths", "corner_positions"):  # exposed by cornered-nose geometries
         extra = getattr(nose, name, None)
         if extra is not None:
@@ -84,6 +97,23 @@ def breakpoints(nose: Nose) -> list[float]:
         if P > tol and P <= L + tol and (not pts or P - pts[-1] > tol):
             pts.append(P)
     return pts
+
+
+def _spline_jumps(seg) -> list[float]:
+    """Axial distances from the tip of a table spline's knots where its third derivative
+    jumps (the not-a-knot spline's other interior knots are C^3): the coefficients have a
+    weak singularity there, which a spline across it spreads over the whole piece."""
+    if not isinstance(seg, SplineCurve) or seg.lo is not None:
+        return []
+    knots, xs, rs = seg._splines
+    out = []
+    for spl in (xs, rs):
+        c3 = np.asarray(spl.c[0], float)  # cubic coefficient per interval
+        big = float(np.max(np.abs(c3))) or 1.0
+        for i in range(1, len(knots) - 1):
+            if abs(c3[i] - c3[i - 1]) > 1e-8 * big:
+                out.append(-float(xs(knots[i])))  # the knot's axial position
+    return sorted(set(out))
 
 
 def flat_tip(nose: Nose) -> bool:
@@ -99,12 +129,15 @@ def flat_tip(nose: Nose) -> bool:
 @dataclass(frozen=True)
 class Piece:
     """A smooth piece of the depth axis, [P_lo, P_hi] (P_hi = inf for the deep piece), with
-    its interpolation variable v: ``root`` v = sqrt(P/l), ``mid`` v = P/l, ``deep`` v = l/P."""
+    its interpolation variable v: ``root`` v = sqrt(P/l), ``mid`` v = P/l, ``deep`` v = l/P,
+    ``graded`` v = ((P - b)/l)^(1/m) past a corner breakpoint b (``origin``; m = ``power``)."""
 
     kind: str
     P_lo: float
     P_hi: float
     scale: float
+    origin: float = 0.0
+    power: float = 1.0
 
     def v(self, P):
         P = np.asarray(P, float)
@@ -112,6 +145,8 @@ class Piece:
             return np.sqrt(P / self.scale)
         if self.kind == "mid":
             return P / self.scale
+        if self.kind == "graded":
+            return np.maximum((P - self.origin) / self.scale, 0.0) ** (1.0 / self.power)
         with np.errstate(divide="ignore"):
             return np.where(np.isinf(P), 0.0, self.scale / P)
 
@@ -121,6 +156,8 @@ class Piece:
             return self.scale * v * v
         if self.kind == "mid":
             return self.scale * v
+        if self.kind == "graded":
+            return self.origin + self.scale * v**self.power
         with np.errstate(divide="ignore"):
             return np.where(v == 0, np.inf, self.scale / np.where(v == 0, 1.0, v))
 
@@ -130,6 +167,8 @@ class Piece:
             return 2.0 * self.scale * v
         if self.kind == "mid":
             return np.full_like(v, self.scale)
+        if self.kind == "graded":
+            return self.power * self.scale * v ** (self.power - 1.0)
         with np.errstate(divide="ignore"):
             return -self.scale / (v * v)
 
@@ -139,6 +178,8 @@ class Piece:
             return np.full_like(v, 2.0 * self.scale)
         if self.kind == "mid":
             return np.zeros_like(v)
+        if self.kind == "graded":
+            return self.power * (self.power - 1.0) * self.scale * v ** (self.power - 2.0)
         with np.errstate(divide="ignore"):
             return 2.0 * self.scale / (v * v * v)
 
@@ -154,9 +195,28 @@ def depth_pieces(nose: Nose) -> tuple[list[Piece], list[float]]:
     # pointed one (A ~ P^3, B ~ P^2: polynomial in P; exactly so on a cone)
     pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-9 and not flat_tip(nose)
     pieces = [Piece("mid" if pointed else "root", 0.0, ends[1], ends[1])]
-    pieces += [Piece("mid", a, b, a) for a, b in zip(ends[1:-1], ends[2:])]
-    pieces.append(Piece("deep", ends[-1], math.inf, ends[-1]))
+    corners = graded_breakpoints(nose, kinks)
+    for a, b in zip(ends[1:-1], ends[2:]):
+        pieces.append(Piece("graded", a, b, b - a, a, GRADED_POWER) if a in corners else Piece("mid", a, b, a))
+    last = ends[-1]
+    if last in corners:  # past a corner: graded up to GRADED_SPAN times the depth, then 1/P
+        pieces.append(Piece("graded", last, last * (1 + GRADED_SPAN), last * GRADED_SPAN, last, GRADED_POWER))
+        last *= 1 + GRADED_SPAN
+    pieces.append(Piece("deep", last, math.inf, last))
     return pieces, kinks
+
+
+def graded_breakpoints(nose: Nose, kinks) -> set:
+    """The breakpoints past which the table is graded: where a corner of the meridian (off
+    the axis) enters the target, and the joints between the nose's segments (a tangent joint
+    with a curvature jump: past it the free-surface edge, itself a corner of the mirrored
+    surface, lies P - b from the joint).  Not P = L_h of a tangent shoulder (the shank meets
+    its mirror image smoothly) nor a table spline's C^2 knots (measured: grading there costs
+    knots)."""
+    tol = 1e-9 * max(nose.length, nose.radius)
+    at = [-x for x, r, _ in nose.corners() if r > tol]
+    at += [-float(seg.point(seg.t1)[0]) for seg in nose.segments[:-1]]
+    return {b for b in kinks if any(abs(b - c) <= tol for c in at)}
 
 
 def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) -> DepthCoefficients:
@@ -348,6 +408,10 @@ class CoefficientTable:
         object.__setattr__(self, "_kind", list(map(int, iv["kind"])))
         object.__setattr__(self, "_scale", list(map(float, iv["scale"])))
         object.__setattr__(self, "_v0", list(map(float, iv["v0"])))
+        n = len(iv["P_lo"])  # graded intervals: v = ((P - origin)/scale)^(1/power)
+        object.__setattr__(self, "_origin", np.asarray(iv.get("origin", np.zeros(n)), float))
+        object.__setattr__(self, "_power", np.asarray(iv.get("power", np.ones(n)), float))
+        object.__setattr__(self, "_graded", bool(np.any(np.asarray(iv["kind"]) == _KINDS["graded"])))
         object.__setattr__(self, "_coef", {k: np.asarray(iv[f"coef_{k}"]).tolist() for k in INTERPOLATED})
 
     # --- evaluation -----------------------------------------------------------------
@@ -360,13 +424,19 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             v = np.where(kind == 0, np.sqrt(P / sc), np.where(kind == 1, P / sc, np.where(np.isinf(P), 0.0, sc / P)))
+            if self._graded:
+                graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / self._power[j])
+                v = np.where(kind == 3, graded, v)
         return v - np.asarray(self.intervals["v0"])[j]
 
     def _eval(self, name: str, P):
         if isinstance(P, float) and P >= 0.0:
             j = max(bisect.bisect_right(self._breaks, P) - 1, 0)
             kind, sc = self._kind[j], self._scale[j]
-            v = math.sqrt(P / sc) if kind == 0 else (P / sc if kind == 1 else sc / P)
+            if kind == 3:
+                v = max((P - float(self._origin[j])) / sc, 0.0) ** (1.0 / float(self._power[j]))
+            else:
+                v = math.sqrt(P / sc) if kind == 0 else (P / sc if kind == 1 else sc / P)
             h = v - self._v0[j]
             c5, c4, c3, c2, c1, c0 = self._coef[name][j]
             return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
@@ -413,6 +483,10 @@ class CoefficientTable:
         sc = np.asarray(self.intervals["scale"])[j]
         with np.errstate(divide="ignore", invalid="ignore"):
             dv_dP = np.where(kind == 0, 0.5 / np.sqrt(P * sc), np.where(kind == 1, 1.0 / sc, -sc / P**2))
+            if self._graded:
+                m = self._power[j]
+                graded = np.maximum((P - self._origin[j]) / sc, 0.0) ** (1.0 / m - 1.0) / (m * sc)
+                dv_dP = np.where(kind == 3, graded, dv_dP)
             out = np.where(np.isfinite(dv_dP), dA_dv * dv_dP, 0.0)
         return np.where(np.isinf(P), 0.0, out)[()]
 
@@ -557,14 +631,19 @@ class _Builder:
         self.solves = 0
         self.noise_limited = 0
         self.limit_err: dict = {}
+        self.solved: dict = {}  # depth -> (row, nodes, unknowns)
 
     # one solve
     def solve(self, P: float):
+        if P in self.solved:  # a knot shared by two pieces
+            row, nodes, n = self.solved[P]
+            return dict(row), nodes, n
         r = solve_depth(self.nose, P, self.opts, self.kinks)
         self.solves += 1
         if self.progress is not None:
             self.progress.update(1)
-        return _row(r), r.nodes, r.unknowns
+        self.solved[P] = (_row(r), r.nodes, r.unknowns)
+        return self.solved[P]
 
     def _add_solved(self, pk: _PieceKnots, vs):
         for v, (row, nodes, n) in zip(vs, [self.solve(float(pk.piece.P(v))) for v in vs]):
@@ -757,11 +836,12 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
             a, b = v[k], v[k + 1]
             P_lo = float(p.P(b)) if deep else float(p.P(a))
             if not deep and k == 0 and a > 0 and p.kind == "root":  # flat tip: constant below the first solve
-                rows.append({"P_lo": 0.0, "kind": 1, "scale": 1.0, "v0": 0.0,
+                rows.append({"P_lo": 0.0, "kind": 1, "scale": 1.0, "v0": 0.0, "origin": 0.0, "power": 1.0,
                              **{f"coef_{q}": [0.0] * 5 + [pk.rows[0][q]] for q in INTERPOLATED}})
                 for q in INTERPOLATED:  # twice the change over the next interval (X0 + c P^alpha, alpha >= 0.3)
                     errs[q].append(2.0 * abs(pk.rows[1][q] - pk.rows[0][q]) + pk.err.get((a, b), {}).get(q, math.inf))
             rows.append({"P_lo": P_lo, "kind": _KINDS[p.kind], "scale": p.scale, "v0": float(a),
+                         "origin": p.origin, "power": p.power,
                          **{f"coef_{q}": _coef6(sp[q], float(a), pk.rows[0][q]) for q in INTERPOLATED}})
             e = pk.err.get((float(a), float(b)), {})
             for q in INTERPOLATED:
@@ -774,7 +854,7 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
             if P1 > P0:
                 r0 = pk.rows[-1]
                 r1 = nxt.rows[-1] if nxt.piece.kind == "deep" else nxt.rows[0]
-                rows.append({"P_lo": P0, "kind": 1, "scale": 1.0, "v0": P0,
+                rows.append({"P_lo": P0, "kind": 1, "scale": 1.0, "v0": P0, "origin": 0.0, "power": 1.0,
                              **{f"coef_{q}": [0.0] * 4 + [(r1[q] - r0[q]) / (P1 - P0), r0[q]] for q in INTERPOLATED}})
                 for q in INTERPOLATED:  # slope of the neighbouring intervals times the gap
                     slope = max(abs(r0[q] - pk.rows[-2][q]) / abs(P0 - float(p.P(v[-2]))) if len(v) > 1 else 0.0, 0.0)
@@ -782,7 +862,7 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
     # deep piece rows were appended in increasing v = decreasing P: sort by P_lo
     order = np.argsort([r["P_lo"] for r in rows], kind="stable")
     rows = [rows[i] for i in order]
-    intervals = {k: np.array([r[k] for r in rows]) for k in ("P_lo", "kind", "scale", "v0")}
+    intervals = {k: np.array([r[k] for r in rows]) for k in ("P_lo", "kind", "scale", "v0", "origin", "power")}
     for q in INTERPOLATED:
         intervals[f"coef_{q}"] = np.array([r[f"coef_{q}"] for r in rows], float)
         intervals[f"err_{q}"] = np.array(errs[q], float)[order]
