@@ -148,6 +148,7 @@ class _Stops:
     s: np.ndarray
     t: np.ndarray  # (n, J+1)
     spline: CubicSpline
+    u2: np.ndarray  # (n, J+1) rigid u^2 on the grid (the elastic models start from it)
 
     @property
     def stop_time(self) -> np.ndarray:
@@ -168,7 +169,7 @@ def _stops(prof: DepthProfile, U0: np.ndarray, n_grid: int) -> _Stops:
         dt[:, -1] = 2.0 * np.sqrt(P_f * np.exp(F_end) / prof.dG(P_f))
     dt[P_f == 0] = 0.0
     t = cumulative_simpson(dt, x=s, axis=1, initial=0.0)
-    return _Stops(U0, P_f, s, t, CubicSpline(s, t, axis=1))
+    return _Stops(U0, P_f, s, t, CubicSpline(s, t, axis=1), u2)
 
 
 def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2: str, w1: str):
@@ -178,16 +179,16 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     sig = np.asarray(sigma0, float)[:, None]
     Pf = st.P_f[:, None]
 
-    def g(S, T=None):  # (ubar^2 - 2W/m, ubar^2) at mapped coordinate S (rows)
+    def g(S, T=None, ub2=None):  # (ubar^2 - 2W/m, ubar^2) at mapped coordinate S (rows)
         P = Pf * S * (2.0 - S)
         T = _rows_eval(st.spline, S) if T is None else T
         W = oscillation_energy(w2, rod, sig, T) + lateral_energy(
             w1, P, sigma0=sig, resistance_pa=setup.resistance_pa, rod=rod, poisson_ratio=nu
         )
-        ub2 = prof.speed2(st.U0[:, None], P)
+        ub2 = prof.speed2(st.U0[:, None], P) if ub2 is None else ub2
         return ub2 - 2.0 * W / m, ub2
 
-    vals, _ = g(np.broadcast_to(st.s, st.t.shape), st.t)
+    vals, _ = g(np.broadcast_to(st.s, st.t.shape), st.t, st.u2)  # on the time grid: u^2 known already
     vals[:, -1] = np.minimum(vals[:, -1], 0.0)
     n = len(st.U0)
     j = np.argmax(vals[:, 1:] <= 0.0, axis=1) + 1

@@ -571,27 +571,41 @@ def separated_profile(table, mass: float, target_density: float, resistance_pa: 
 
 def separation_onset(table, mass: float, target_density: float, resistance_pa: float, profile, U0) -> list:
     """Per start velocity: the first knot depth [m] at which the full-contact pressure of
-    eq. (9) would turn negative somewhere on the nose (eq. (15)), or None."""
+    eq. (9) would turn negative somewhere on the nose (eq. (15)), or None.
+
+    All knots and velocities at once: the nodes' pressure terms do not depend on the velocity,
+    so they are gathered once and p_c is evaluated on a (velocities x nodes) array."""
     from semianalytic.coefficients.contact import pressure_terms
 
     reading = getattr(table, "reading", "body")
     rho, R, m = float(target_density), float(resistance_pa), float(mass)
     P_k = np.asarray(table.depth, float)
+    U = np.atleast_1d(np.asarray(U0, float))
+    P_f = np.asarray(profile.final_depth(U), float).reshape(U.shape)
+    inside = np.nonzero(P_k < P_f.max())[0] if U.size else np.empty(0, int)
+    if inside.size == 0:
+        return [None] * U.size
+    phis, qs, owner = [], [], []
+    for j, k in enumerate(inside):  # the nodes where separation counts (n_x > 0), knot by knot
+        nodes = table.nodes[k]
+        phi, q = pressure_terms(nodes, reading)
+        keep = nodes["nx"] > 1e-12
+        phis.append(phi[keep])
+        qs.append(q[keep])
+        owner.append(np.full(int(keep.sum()), j))
+    phi, q, owner = np.concatenate(phis), np.concatenate(qs), np.concatenate(owner)
+    starts = np.searchsorted(owner, np.arange(len(inside)))
+    A = np.asarray(table.A(P_k[inside]), float)[owner]
+    B = np.asarray(table.B(P_k[inside]), float)[owner]
+    C = np.asarray(table.C(P_k[inside]), float)[owner]
     out = []
-    for U in np.atleast_1d(np.asarray(U0, float)):
-        P_f = float(profile.final_depth(U))
-        hit = None
-        inside = np.nonzero(P_k < P_f)[0]
-        if inside.size:
-            u2 = np.maximum(profile.speed2(U, P_k[inside]), 0.0)
-            for k, w in zip(inside, u2):
-                nodes = table.nodes[k]
-                phi, q = pressure_terms(nodes, reading)
-                A, B, C = float(table.A(P_k[k])), float(table.B(P_k[k])), float(table.C(P_k[k]))
-                a = -(0.5 * rho * B * w + C * R) / (m + rho * A)
-                p = rho * phi * a + q * rho * w / 2 + R
-                if np.any((p <= 0) & (nodes["nx"] > 1e-12)):
-                    hit = float(P_k[k])
-                    break
-        out.append(hit)
+    for lo in range(0, U.size, 64):  # blocks of velocities bound the (velocities x nodes) arrays
+        u2 = np.maximum(profile.speed2(U[lo:lo + 64, None], P_k[None, inside]), 0.0)
+        w = u2[:, owner]
+        a = -(0.5 * rho * B * w + C * R) / (m + rho * A)  # du/dt of eq. (11), full contact
+        p = rho * phi * a + q * rho * w / 2 + R  # p_c of eq. (9) at every node
+        sep = np.logical_or.reduceat(p <= 0, starts, axis=1) & (P_k[None, inside] < P_f[lo:lo + 64, None])
+        sep &= np.diff(np.append(starts, len(owner)))[None, :] > 0  # a knot without such nodes never separates
+        first = np.argmax(sep, axis=1)
+        out.extend(float(P_k[inside[f]]) if sep[i, f] else None for i, f in enumerate(first))
     return out
