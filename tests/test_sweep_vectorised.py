@@ -143,7 +143,7 @@ def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkey
     sizes = []
     monkeypatch.setattr(kernels, "_pressures", lambda b, cols, d: sizes.append(len(next(iter(cols.values())))) or _pressures(b, cols, d))
     R, msg = resistance_per_sample(base, samples, D)
-    assert max(sizes) < 2000  # the grid and the three probes, not every sample
+    assert max(sizes, default=0) < 2000  # closed form on arrays, or the grid and three probes: not every sample
     exact, _ = _pressures(base, {f: v.tolist() for f, v in samples.items()}, D)
     assert (msg == "").all()
     np.testing.assert_allclose(R, exact, rtol=1e-10)
