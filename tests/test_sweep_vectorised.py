@@ -147,3 +147,70 @@ def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkey
     exact, _ = _pressures(base, {f: v.tolist() for f, v in samples.items()}, D)
     assert (msg == "").all()
     np.testing.assert_allclose(R, exact, rtol=1e-10)
+
+
+def test_geometry_batches_hold_one_table_each():
+    # a geometry sweep on workers: every batch holds the cases of one nose (its task builds that table)
+    from semianalytic.sweep.engine import _geometry_batches
+
+    spec = build_spec(["projectile.crh=1,2,3,4", "impact.striking_velocity=400:1600:100 m/s"])
+    k = PenetrationKernel()
+    ids = np.arange(spec.n_cases, dtype=np.int64)
+    batches = _geometry_batches(spec, k, ids, {}, size=5)
+    crh = spec.values(ids)["projectile.crh"]
+    assert sorted(np.concatenate(batches).tolist()) == ids.tolist()  # every case once
+    assert all(len(set(crh[b].tolist())) == 1 and len(b) <= 5 for b in batches)
+    assert len(batches) == 4 * 3  # 13 velocities per nose in batches of at most 5
+
+
+def test_worker_moves_into_its_own_session():
+    # own_session (run in every LocalCluster worker): setsid, so the kernel's autogroup scheduler
+    # gives the worker its own CPU share; a child of this process starts in this process's session
+    import os
+    import subprocess
+    import sys
+
+    code = "import os; from semianalytic.sweep.engine import own_session; print(os.getsid(0), own_session(), os.getpid())"
+    before, after, pid = map(int, subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                                 check=True).stdout.split())
+    assert before == os.getsid(0) and after == pid != before
+
+
+GEOMETRY_CASE = """
+[projectile]
+nose = "ogive"
+crh = 3.0
+diameter = "7.11 mm"
+shank_length = "59.3 mm"
+density = "7830 kg/m^3"
+[target]
+density = "2710 kg/m^3"
+[target.resistance]
+model = "elastic-plastic"
+yield_stress = "400 MPa"
+youngs_modulus = "68.9 GPa"
+poisson_ratio = 0.33
+[impact]
+striking_velocities = ["0.8 km/s", "1.4 km/s"]
+[bem]
+order = 4
+refinement = 0.2
+[coefficients]
+depths = 16
+max_depth_nose_lengths = 30.0
+"""
+
+
+def test_geometry_sweep_on_a_local_cluster_equals_inline(tmp_path):
+    # coarse BEM tables (the check is of the engine: same tables, same rows); the inline run builds
+    # the tables, the cluster's tasks load them from the same disk cache (one table per task)
+    p = tmp_path / "case.toml"
+    p.write_text(GEOMETRY_CASE)
+    spec = build_spec(["projectile.crh=1.5,2.5,3.5"])
+    cache = str(tmp_path / "cache")
+    s_in = run_sweep(p, spec, tmp_path / "in", scheduler="inline", progress=False, kernel=PenetrationKernel(cache_dir=cache))
+    s_lc = run_sweep(p, spec, tmp_path / "lc", scheduler="local", workers=2, progress=False,
+                     kernel=PenetrationKernel(cache_dir=cache))
+    assert s_lc.scheduler == "local" and s_lc.workers == 2 and s_in.n_ok == s_lc.n_ok == 6
+    a, b = (pd.read_csv(tmp_path / d / "results.csv").sort_values("case_id").reset_index(drop=True) for d in ("in", "lc"))
+    pd.testing.assert_frame_equal(a, b)  # same tables and the same arithmetic: identical rows

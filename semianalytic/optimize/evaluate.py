@@ -5,16 +5,27 @@ One design: the case with the design's overrides and the constrained shank
 per-user cache, keyed by the geometry hash (:func:`semianalytic.cache.coefficients_for_case`;
 built by the BEM when absent) -> the objective (:mod:`~semianalytic.optimize.model`).
 
-The optimiser is scipy's ``differential_evolution``, bounded, ``vectorized=True`` with
-deferred updating: each generation's whole population is handed to :meth:`Evaluator.map`,
-which evaluates the designs in parallel on the dask workers (the same connection as
-``sweep``, :func:`semianalytic.sweep.engine.connect`).  Why differential evolution: it needs
-no gradients (the BEM's panel layout changes with the geometry, so the objective has small
-discretisation steps that spoil finite differences and mislead a local simplex), it keeps to
-the bounds, and a generation is a batch of independent designs that fills the workers;
-``polish`` is off for the same reason as the gradients.  Designs are rounded to
-``resolution`` of each range, so the converging population re-uses designs (memo here) and
-their tables (disk cache).  The optimum is then checked on a finer grid around it.
+Optimisers (``method``):
+
+- ``grid-nm`` (default): a coarse grid over the bounds (``coarse`` points per variable, all
+  designs evaluated in parallel on the dask workers), then scipy's Nelder-Mead with bounds
+  from the grid's best point (initial simplex half a grid step wide, in coordinates scaled
+  to [0, 1] per variable; stops when the simplex is within ``resolution`` of each range and
+  the objectives within ``tol`` relative).  Why: the nose problems have one or two smooth
+  parameters, where a grid of a few designs per variable finds the basin (and every corner of
+  the bounds, where the optimum of a monotone objective lies) and a simplex converges in a few
+  tens of designs; it needs no gradients (the BEM's panel layout changes with the geometry, so
+  the objective has small discretisation steps that spoil finite differences) and keeps to
+  the bounds.  The simplex is sequential (one design at a time), the grid is not.
+- ``de``: scipy's ``differential_evolution``, bounded, ``vectorized=True`` with deferred
+  updating: each generation's population is evaluated in parallel; no polish (same reason
+  as the gradients).  More designs (popsize x variables per generation) for problems with
+  several basins.
+
+Designs are rounded to ``resolution`` of each range, so the search re-uses designs (memo
+here) and their tables (disk cache).  The optimum is then checked on a finer grid around it,
+and, when the design tables are lighter than the case's (``table_overrides``), re-evaluated
+on the case's own tables (the objective's table error, reported).
 """
 
 from __future__ import annotations
@@ -143,11 +154,35 @@ def _start_x(problem: Problem) -> list[float] | None:
     return x
 
 
+def _grid_nelder_mead(batch, k: int, coarse: int, resolution: float, tol: float, maxfev: int):
+    """Coarse grid, then Nelder-Mead with bounds (module docstring); ``batch(U, phase)`` evaluates
+    designs given in [0, 1]^k coordinates and returns their objectives.  Returns a summary dict."""
+    from scipy.optimize import minimize
+
+    axes = [np.linspace(0.0, 1.0, coarse)] * k
+    U = np.column_stack([m.ravel() for m in np.meshgrid(*axes, indexing="ij")])
+    f = batch(U, "grid")
+    i = int(np.argmin(f))
+    u0 = U[i]
+    h = 0.5 / (coarse - 1)  # half a grid step: the simplex starts inside the grid cell of the best point
+    simplex = [u0] + [u0 + np.where(np.arange(k) == j, h if u0[j] + h <= 1.0 else -h, 0.0) for j in range(k)]
+    res = minimize(lambda u: float(batch(np.atleast_2d(u), "search")[0]), u0, method="Nelder-Mead",
+                   bounds=[(0.0, 1.0)] * k,
+                   options={"initial_simplex": np.array(simplex), "xatol": resolution,
+                            "fatol": tol * max(abs(float(f[i])), 1e-300), "maxfev": maxfev})
+    return {"method": "coarse grid + scipy.optimize.minimize(Nelder-Mead, bounds)", "coarse": coarse,
+            "maxfev": maxfev, "nfev": int(res.nfev) + len(U), "nit": int(res.nit), "message": str(res.message),
+            "success": bool(res.success)}
+
+
 def optimise(
     problem: Problem,
     *,
     client=None,
     cache_dir: str | None = None,
+    method: str = "grid-nm",
+    coarse: int = 5,
+    maxfev: int = 60,
     popsize: int = 5,
     maxiter: int = 12,
     tol: float = 1e-5,
@@ -158,11 +193,9 @@ def optimise(
     classic_noses: bool = True,
     on_done: Callable[[int], None] | None = None,
 ) -> dict:
-    """Differential evolution over the problem's bounds, then the confirmation grid and the
-    classic noses.  Returns a plain dict (the optimum, the start, the grid, the classics, the
-    history); see the module docstring for the method."""
-    from scipy.optimize import differential_evolution
-
+    """Search the problem's bounds (``method``: see the module docstring), then the confirmation
+    grid, the optimum on the case's own tables (with lighter design tables) and the classic noses.
+    Returns a plain dict (the optimum, the start, the grid, the classics, the history)."""
     t0 = time.perf_counter()
     low, high = np.array(problem.low), np.array(problem.high)
     ev = Evaluator(problem, client, cache_dir, on_done)
@@ -179,12 +212,33 @@ def optimise(
         gen["n"] += 1
         return np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
 
-    x0 = None if start is None else np.clip(start, low, high)
-    res = differential_evolution(
-        objective, list(zip(low, high)), popsize=popsize, maxiter=maxiter, tol=tol, seed=seed, polish=False,
-        vectorized=True, updating="deferred", init="latinhypercube", x0=x0,
-    )
-    best_x = quantise(res.x, low, high, resolution)
+    if method == "de":
+        from scipy.optimize import differential_evolution
+
+        x0 = None if start is None else np.clip(start, low, high)
+        res = differential_evolution(
+            objective, list(zip(low, high)), popsize=popsize, maxiter=maxiter, tol=tol, seed=seed, polish=False,
+            vectorized=True, updating="deferred", init="latinhypercube", x0=x0,
+        )
+        info = {"method": "scipy.optimize.differential_evolution (vectorized, deferred, no polish)",
+                "popsize": popsize, "maxiter": maxiter, "nfev": int(res.nfev), "message": str(res.message),
+                "success": bool(res.success)}
+    elif method == "grid-nm":
+        def batch(U, phase):
+            pts = quantise(low + np.atleast_2d(U) * (high - low), low, high, resolution)
+            recs = ev.map([problem.overrides(p) for p in pts], phase, gen["n"], pts)
+            gen["n"] += 1
+            return np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
+
+        info = _grid_nelder_mead(batch, len(low), coarse, resolution, tol, maxfev)
+    else:
+        raise InputError("--method", f"must be grid-nm or de; got {method!r}")
+    info.update(tol=tol, seed=seed, resolution=resolution, generations=gen["n"])
+    # the optimum: the best design the search evaluated (the optimiser's own answer is one of them)
+    searched = [r for r in ev.history if r["phase"] in ("search", "grid") and r["status"] == "ok"]
+    if not searched:
+        raise InputError("--vary", "no design within the bounds could be evaluated (see history: all invalid)")
+    best_x = np.asarray(min(searched, key=lambda r: r["objective"])["x"])
     best = ev.map([problem.overrides(best_x)], "optimum", gen["n"], [best_x])[0]
     search_seconds = time.perf_counter() - t0
     n_search = len({json.dumps(r["overrides"], sort_keys=True) for r in ev.history})
@@ -210,6 +264,15 @@ def optimise(
             "confirmed": bool(f[k] >= best["objective"] - 1e-6 * abs(best["objective"]) or np.all(steps <= 1.0 + 1e-9)),
             "points": [{"x": p.tolist(), "objective": float(fi), "status": r["status"]} for p, fi, r in zip(pts, f, recs)],
         }
+    own_tables = None
+    if problem.table_overrides:  # the optimum again on the case's own tables: the design tables' error
+        import dataclasses
+
+        own = evaluate_design(dataclasses.replace(problem, table_overrides=()), problem.overrides(best_x), cache_dir)
+        if own["status"] == "ok":
+            own_tables = {"objective": own["objective"], "design_tables_objective": best["objective"],
+                          "relative_difference": abs(best["objective"] - own["objective"]) / abs(own["objective"]),
+                          "seconds": own["seconds"], "table_overrides": dict(problem.table_overrides)}
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -222,10 +285,8 @@ def optimise(
         "fixed_mass_kg": problem.fixed_mass,
         "fixed_length_m": problem.fixed_length,
         "striking_velocities_m_s": list(problem.velocities),
-        "optimizer": {"method": "scipy.optimize.differential_evolution (vectorized, deferred, no polish)",
-                      "popsize": popsize, "maxiter": maxiter, "tol": tol, "seed": seed, "resolution": resolution,
-                      "generations": gen["n"], "nfev": int(res.nfev), "message": str(res.message),
-                      "success": bool(res.success)},
+        "optimizer": info,
+        "own_tables_check": own_tables,
         "optimum": {**best, "x": best_x.tolist()},
         "start": start_rec,
         "confirmation": grid,

@@ -97,10 +97,20 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
              + ". Bounds: " + ", ".join(f"{v['key']} in [{_shown(v, v['low'])}, {_shown(v, v['high'])}]"
                                         for v in result["variables"]) + ".")
     o = result["optimizer"]
-    doc.para(f"Optimiser: {o['method']}, popsize {o['popsize']}, maxiter {o['maxiter']}, tol {o['tol']}, seed "
-             f"{o['seed']}, designs rounded to {o['resolution']:g} of each range: {o['generations']} generations, "
-             f"{result['n_designs_search']} distinct designs (BEM tables) in {result['seconds_search']:.1f} s "
-             f"({result['scheduler']}, {result['workers']} worker(s)); scipy says: {o['message']}.")
+    settings = (f"popsize {o['popsize']}, maxiter {o['maxiter']}" if "popsize" in o
+                else f"coarse grid {o['coarse']} points per variable, at most {o['maxfev']} simplex evaluations")
+    doc.para(f"Optimiser: {o['method']}, {settings}, tol {o['tol']}, seed "
+             f"{o['seed']}, designs rounded to {o['resolution']:g} of each range: {o['generations']} batches, "
+             f"{o['nfev']} evaluations, {result['n_designs_search']} distinct designs (BEM tables) in "
+             f"{result['seconds_search']:.1f} s ({result['scheduler']}, {result['workers']} worker(s)); "
+             f"scipy says: {o['message']}.")
+    chk = result.get("own_tables_check")
+    if chk:
+        tabs = ", ".join(f"{k.split('.', 1)[1]} = {v:g}" for k, v in chk["table_overrides"].items())
+        doc.para(f"Design tables: every design's coefficient table with {tabs} (lighter than the case's). The optimum "
+                 f"on the case's own tables: objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
+                 f"on the design tables, relative difference **{chk['relative_difference']:.1e}** (the design tables' "
+                 "error in the objective; compare it with the change of the objective over one resolution step).")
     rows = [["optimum", _design_text(result, result["optimum"]), _value_text(result, result["optimum"])]]
     if result.get("start"):
         rows.append(["start", _design_text(result, result["start"]), _value_text(result, result["start"])])

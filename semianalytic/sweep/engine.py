@@ -299,6 +299,16 @@ def _batches(ids: np.ndarray, size: int) -> list[np.ndarray]:
     return [ids[i : i + size] for i in range(0, len(ids), size)]
 
 
+def _geometry_batches(spec: SweepSpec, kernel: Kernel, pending: np.ndarray, draws, size: int) -> list[np.ndarray]:
+    """Batches that each hold the cases of one geometry (one coefficient table), at most ``size``."""
+    geo = [k for k in spec.keys if kernel.affects_resource(k)]
+    vals = spec.values(pending, draws)
+    groups: dict[tuple, list[int]] = defaultdict(list)
+    for j, cid in enumerate(pending.tolist()):
+        groups[tuple(float(vals[k][j]) for k in geo)].append(cid)
+    return [b for ids in groups.values() for b in _batches(np.asarray(ids, np.int64), size)]
+
+
 def check_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict) -> bool:
     """Check the output folder (nothing is changed); returns True for a fresh start."""
     res = results_path(out, fmt)
@@ -354,6 +364,25 @@ def choose_engine(scheduler: str | None, n_cases: int, n_geometries: int, second
     return "local" if work > 2.0 * LOCAL_START_SECONDS else "inline"
 
 
+def own_session() -> int:
+    """Move this (worker) process into a session of its own (``setsid``); returns its session id.
+
+    Linux's autogroup scheduling (``/proc/sys/kernel/sched_autogroup_enabled``) shares the CPU
+    fairly between sessions, not processes: a LocalCluster's workers, started by the sweep's
+    process, would share its session's one share, so on a machine where other sessions keep the
+    cores busy two local workers run no faster than one inline process (measured: two workers at
+    about 50 % of a core each beside another session's process at 95 %; reports/bench_sweep.md).
+    In their own sessions they get a share each, as workers started by a dask scheduler service
+    or a batch system do.  Harmless otherwise: the nanny still supervises and stops the worker
+    (it exits with its nanny's pipe, not with the terminal), and no CPU is taken that another
+    session of the same size would not get."""
+    try:
+        os.setsid()
+    except OSError:  # already a session or group leader (e.g. an external worker): nothing to do
+        pass
+    return os.getsid(0)
+
+
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address (InputError if it cannot be used)."""
@@ -367,7 +396,9 @@ def connect(scheduler: str | None, workers: int):
             n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
             silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
         )
-        return Client(cluster), cluster, "local"
+        client = Client(cluster)
+        client.run(own_session)
+        return client, cluster, "local"
     client = None
     try:
         client = Client(sched, timeout="10s")
@@ -443,9 +474,17 @@ def run_sweep(
         if len(rcases) > 20:
             print(f"warning: {len(rcases)} distinct nose geometries: each needs its own BEM coefficient table "
                   "(seconds each, cached on disk)", file=sys.stderr)
+        per_geometry = client is not None and len(rcases) > 1
         if client is None:
             resources = {k: kernel.prepare(c) for k, c in rcases.items()}
             summary.workers = 1
+        elif per_geometry:
+            # a geometry sweep on workers: each task builds (or loads from the disk cache) the table of its
+            # own geometry and evaluates that geometry's cases, so no table travels to the client and back
+            # to every worker, and no worker waits for all tables before the cases start
+            summary.workers = len(client.scheduler_info().get("workers", {})) or workers
+            client.run(warm_up)
+            resources = {}
         else:
             summary.workers = len(client.scheduler_info().get("workers", {})) or workers
             client.run(warm_up)
@@ -457,7 +496,7 @@ def run_sweep(
         payload = _check_arrays_once(payload, pending)
         nw = max(1, summary.workers)
         size = batch_size or int(min(2000, max(20, math.ceil(len(pending) / (8 * nw)))))
-        batches = _batches(pending, size)
+        batches = _geometry_batches(spec, kernel, pending, draws, size) if per_geometry else _batches(pending, size)
         t_cases = time.perf_counter()
         bar = _progress(len(pending), progress)
         try:

@@ -89,6 +89,7 @@ class PenetrationKernel:
     # per-process cache of unit-resistance depth profiles (see _rigid); not part of the identity
     _profiles: dict = field(default_factory=dict, compare=False, repr=False)
     _derived: dict = field(default_factory=dict, compare=False, repr=False)  # per-case constants (evaluate_arrays)
+    _tables: dict = field(default_factory=dict, compare=False, repr=False)  # geometry key -> table (prepare)
 
     @property
     def seconds_per_case(self) -> float:
@@ -230,7 +231,13 @@ class PenetrationKernel:
     def prepare(self, case: Case):
         if self.coefficients is not None:
             return self.coefficients
-        return coefficient_table_for(case, self.cache_dir)
+        key = geometry_key(case)
+        table = self._tables.get(key)
+        if table is None:  # kept per worker: the batches of a geometry sweep ask again for their table
+            if len(self._tables) >= 8:
+                self._tables.pop(next(iter(self._tables)))
+            table = self._tables[key] = coefficient_table_for(case, self.cache_dir)
+        return table
 
     def evaluate(self, case: Case, coefficients, fast: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         U = np.asarray(fast[VELOCITY_KEY], float)
