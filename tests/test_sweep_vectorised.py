@@ -47,6 +47,10 @@ MODELS = {
     "part4": ('model = "part4"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"',
               "target.resistance.youngs_modulus=uniform(60 GPa, 75 GPa)"),
     "constant": ('model = "constant"\nvalue = "1.2 GPa"', "target.resistance.value=lognormal(1.2 GPa, 0.1)"),
+    # Part II (no closed form): R_t on a Chebyshev grid of the strength, checked against direct solves
+    "cavity": ('model = "cavity"\nyoungs_modulus = "373.14 GPa"\npoisson_ratio = 0.232\ntensile_strength = "0.262 GPa"\n'
+               'compressive_strength = "2.62 GPa"',
+               "target.resistance.compressive_strength=uniform(2.5 GPa, 2.75 GPa)"),
 }
 
 
@@ -121,10 +125,11 @@ def test_cheap_sweep_runs_inline_without_a_scheduler(tmp_path):
     assert s.scheduler == "inline" and s.n_ok == 11
 
 
-@pytest.mark.parametrize("model", ["elastic-plastic", "brittle", "hardening", "limestone", "part4", "constant"])
+@pytest.mark.parametrize("model", ["elastic-plastic", "brittle", "hardening", "limestone", "part4", "constant", "cavity"])
 def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkeypatch):
     # R_t on a Chebyshev grid over the samples' box, interpolated, against the model's closed form
     # evaluated sample by sample (smooth in the fields: interpolation error ~1e-13, checked to 1e-10)
+    from semianalytic.cavity import BrittleMaterial
     from semianalytic.penetration import resistance as res
     from semianalytic.sweep.kernels import _pressures, resistance_per_sample
 
@@ -135,15 +140,17 @@ def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkey
         "limestone": (res.Limestone(), {"psi": (500e6, 700e6)}),
         "part4": (res.Part4(400e6, 68.9e9), {"youngs_modulus": (60e9, 75e9)}),
         "constant": (res.Constant(1.2e9), {"value": (1.0e9, 1.4e9)}),
+        "cavity": (res.Cavity(BrittleMaterial(373.14e9, 0.232, 0.262e9, 2.62e9)), {"compressive_strength": (2.5e9, 2.75e9)}),
     }[model]
     rng = np.random.default_rng(4)
-    samples = {f: rng.uniform(lo, hi, 2000) for f, (lo, hi) in fields.items()}
+    n = 200 if model == "cavity" else 2000  # a Part II solve per sample for the reference
+    samples = {f: rng.uniform(lo, hi, n) for f, (lo, hi) in fields.items()}
     import semianalytic.sweep.kernels as kernels
 
     sizes = []
     monkeypatch.setattr(kernels, "_pressures", lambda b, cols, d: sizes.append(len(next(iter(cols.values())))) or _pressures(b, cols, d))
     R, msg = resistance_per_sample(base, samples, D)
-    assert max(sizes, default=0) < 2000  # closed form on arrays, or the grid and three probes: not every sample
+    assert max(sizes, default=0) < n  # closed form on arrays, or the grid and three probes: not every sample
     exact, _ = _pressures(base, {f: v.tolist() for f, v in samples.items()}, D)
     assert (msg == "").all()
     np.testing.assert_allclose(R, exact, rtol=1e-10)

@@ -7,7 +7,16 @@ built by the BEM when absent) -> the objective (:mod:`~semianalytic.optimize.mod
 
 Optimisers (``method``):
 
-- ``grid-nm`` (default): a coarse grid over the bounds (``coarse`` points per variable, all
+- ``grid-pattern`` (default): the coarse grid below, then a compass search (a generalised
+  pattern search: Torczon 1997; with bounds Lewis & Torczon 1999; review: Kolda, Lewis &
+  Torczon, SIAM Review 45, 2003) from its best point: each poll evaluates the 2k points
+  u +- h e_j of the current point together (in parallel on the workers), moves to the best if
+  it improves, else halves h, from half a grid step down to ``resolution``.  Derivative-free
+  and bounded like the simplex, but a poll's designs are independent, so both workers stay
+  busy (Nelder-Mead evaluates one design at a time); converges to a point where no
+  coordinate step of the finest size improves the objective (on a smooth objective, a
+  stationary point, or a bound for a monotone one).  scipy has no parallel-poll pattern search.
+- ``grid-nm``: a coarse grid over the bounds (``coarse`` points per variable, all
   designs evaluated in parallel on the dask workers), then scipy's Nelder-Mead with bounds
   from the grid's best point (initial simplex half a grid step wide, in coordinates scaled
   to [0, 1] per variable; stops when the simplex is within ``resolution`` of each range and
@@ -159,20 +168,50 @@ def _grid_nelder_mead(batch, k: int, coarse: int, resolution: float, tol: float,
     designs given in [0, 1]^k coordinates and returns their objectives.  Returns a summary dict."""
     from scipy.optimize import minimize
 
-    axes = [np.linspace(0.0, 1.0, coarse)] * k
-    U = np.column_stack([m.ravel() for m in np.meshgrid(*axes, indexing="ij")])
-    f = batch(U, "grid")
-    i = int(np.argmin(f))
-    u0 = U[i]
+    U, u0, f0 = _coarse_grid(batch, k, coarse)
     h = 0.5 / (coarse - 1)  # half a grid step: the simplex starts inside the grid cell of the best point
     simplex = [u0] + [u0 + np.where(np.arange(k) == j, h if u0[j] + h <= 1.0 else -h, 0.0) for j in range(k)]
     res = minimize(lambda u: float(batch(np.atleast_2d(u), "search")[0]), u0, method="Nelder-Mead",
                    bounds=[(0.0, 1.0)] * k,
                    options={"initial_simplex": np.array(simplex), "xatol": resolution,
-                            "fatol": tol * max(abs(float(f[i])), 1e-300), "maxfev": maxfev})
+                            "fatol": tol * max(abs(f0), 1e-300), "maxfev": maxfev})
     return {"method": "coarse grid + scipy.optimize.minimize(Nelder-Mead, bounds)", "coarse": coarse,
             "maxfev": maxfev, "nfev": int(res.nfev) + len(U), "nit": int(res.nit), "message": str(res.message),
             "success": bool(res.success)}
+
+
+def _coarse_grid(batch, k: int, coarse: int):
+    axes = [np.linspace(0.0, 1.0, coarse)] * k
+    U = np.column_stack([m.ravel() for m in np.meshgrid(*axes, indexing="ij")])
+    f = batch(U, "grid")
+    i = int(np.argmin(f))
+    return U, U[i], float(f[i])
+
+
+def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int):
+    """Coarse grid, then a compass (pattern) search from its best point (module docstring): each poll
+    evaluates the 2k points u +- h e_j (clipped to the bounds) together; the best one that improves
+    becomes u, else h is halved; from half a grid step down to ``resolution`` of each range."""
+    U, u, f = _coarse_grid(batch, k, coarse)
+    h = 0.5 / (coarse - 1)
+    polls = moves = 0
+    while h >= resolution and polls < max_polls:
+        pts = np.clip(np.vstack([u + s * h * np.eye(k)[j] for j in range(k) for s in (1.0, -1.0)]), 0.0, 1.0)
+        pts = np.unique(pts[np.any(np.abs(pts - u) > 0.5 * resolution, axis=1)], axis=0)
+        polls += 1
+        if len(pts):
+            fs = batch(pts, "search")
+            j = int(np.argmin(fs))
+            if fs[j] < f:
+                u, f = pts[j], float(fs[j])
+                moves += 1
+                continue
+        h *= 0.5
+    done = h < resolution
+    return {"method": "coarse grid + compass search (polls of 2 x variables designs in parallel)", "coarse": coarse,
+            "max_polls": max_polls, "polls": polls, "moves": moves, "final_step": h,
+            "message": "step below the resolution" if done else
+            "stopped at --maxfev polls", "success": bool(done)}
 
 
 def optimise(
@@ -180,7 +219,7 @@ def optimise(
     *,
     client=None,
     cache_dir: str | None = None,
-    method: str = "grid-nm",
+    method: str = "grid-pattern",
     coarse: int = 5,
     maxfev: int = 60,
     popsize: int = 5,
@@ -223,17 +262,21 @@ def optimise(
         info = {"method": "scipy.optimize.differential_evolution (vectorized, deferred, no polish)",
                 "popsize": popsize, "maxiter": maxiter, "nfev": int(res.nfev), "message": str(res.message),
                 "success": bool(res.success)}
-    elif method == "grid-nm":
+    elif method in ("grid-pattern", "grid-nm"):
         def batch(U, phase):
             pts = quantise(low + np.atleast_2d(U) * (high - low), low, high, resolution)
             recs = ev.map([problem.overrides(p) for p in pts], phase, gen["n"], pts)
             gen["n"] += 1
             return np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
 
-        info = _grid_nelder_mead(batch, len(low), coarse, resolution, tol, maxfev)
+        if method == "grid-nm":
+            info = _grid_nelder_mead(batch, len(low), coarse, resolution, tol, maxfev)
+        else:
+            info = _grid_pattern(batch, len(low), coarse, resolution, maxfev)
     else:
-        raise InputError("--method", f"must be grid-nm or de; got {method!r}")
+        raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {method!r}")
     info.update(tol=tol, seed=seed, resolution=resolution, generations=gen["n"])
+    info.setdefault("nfev", sum(1 for r in ev.history if r["phase"] in ("grid", "search")))
     # the optimum: the best design the search evaluated (the optimiser's own answer is one of them)
     searched = [r for r in ev.history if r["phase"] in ("search", "grid") and r["status"] == "ok"]
     if not searched:

@@ -32,8 +32,8 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     if args.confirm < 0 or args.confirm == 1:
         raise InputError("--confirm", "must be 0 (no grid) or at least 2")
     case = load_case(args.case)
-    if args.method not in ("grid-nm", "de"):
-        raise InputError("--method", f"must be grid-nm or de; got {args.method!r}")
+    if args.method not in ("grid-pattern", "grid-nm", "de"):
+        raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {args.method!r}")
     problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model,
                             args.table_depths, args.table_nose_lengths)
     out = Path(args.out) if args.out else None
@@ -52,7 +52,7 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
             from tqdm import tqdm
 
             search = (args.popsize * n_var * (args.maxiter + 1) if args.method == "de"
-                      else args.coarse**n_var + min(args.maxfev, 20 * n_var))
+                      else args.coarse**n_var + min(args.maxfev, 15) * (2 * n_var if args.method == "grid-pattern" else 1))
             total = search + args.confirm**n_var + 4
             bar = tqdm(total=total, unit="design", file=sys.stderr, dynamic_ncols=True, mininterval=0.5,
                        desc="optimize")

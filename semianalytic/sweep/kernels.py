@@ -137,7 +137,7 @@ class PenetrationKernel:
             model = resistance_from_case(case)
         except InputError:
             return False
-        names = {f.name for f in dataclasses.fields(model)}
+        names = {f.name for f in dataclasses.fields(_fields_owner(model))}
         return all(f in names for f in res)
 
     def _per_case(self, case: Case, coefficients):
@@ -292,19 +292,32 @@ class PenetrationKernel:
         }
 
 
-def _pressures(base, cols: Mapping[str, list], diameter) -> tuple[np.ndarray, np.ndarray]:
-    """R_t of the model ``base`` with the fields in ``cols`` replaced, sample by sample."""
+def _fields_owner(model):
+    """The dataclass holding a resistance model's case fields: the model, or the Part II cavity
+    model's material (``[target.resistance]`` of model "cavity" gives the material's fields)."""
+    material = getattr(model, "material", None)
+    return material if material is not None else model
+
+
+def _with_fields(base, values: Mapping[str, Any]):
+    """The resistance model ``base`` with the case fields in ``values`` replaced."""
     import dataclasses
 
+    owner = _fields_owner(base)
+    kw = {f.name: getattr(owner, f.name) for f in dataclasses.fields(owner)}
+    kw.update(values)
+    new = type(owner)(**kw)
+    return type(base)(new) if owner is not base else new
+
+
+def _pressures(base, cols: Mapping[str, list], diameter) -> tuple[np.ndarray, np.ndarray]:
+    """R_t of the model ``base`` with the fields in ``cols`` replaced, sample by sample."""
     n = len(next(iter(cols.values())))
     R = np.empty(n)
     msg = np.full(n, "", dtype=object)
-    model, kw = type(base), {f.name: getattr(base, f.name) for f in dataclasses.fields(base)}
     for i in range(n):
         try:
-            for f, v in cols.items():
-                kw[f] = v[i]
-            R[i] = model(**kw).pressure(diameter)
+            R[i] = _with_fields(base, {f: v[i] for f, v in cols.items()}).pressure(diameter)
         except (ValueError, ArithmeticError, InputError) as exc:
             R[i], msg[i] = np.nan, f"target.resistance: {exc}"
     return R, msg
@@ -314,14 +327,10 @@ def _pressures_on_arrays(base, fields: Mapping[str, np.ndarray], diameter):
     """R_t of the model's closed form evaluated on the sample arrays at once (eqs. (16), (17), (19),
     Part IV eq. (6), constant), or None where the model has no array form (eq. (18)'s integral
     and the Part II cavity model) or a sample is out of its range (then per sample, with messages)."""
-    import dataclasses
-
     n = len(next(iter(fields.values())))
-    kw = {f.name: getattr(base, f.name) for f in dataclasses.fields(base)}
-    kw.update({f: np.asarray(v, float) for f, v in fields.items()})
     try:
         with np.errstate(all="ignore"):
-            R = np.asarray(type(base)(**kw).pressure(diameter), float)
+            R = np.asarray(_with_fields(base, {f: np.asarray(v, float) for f, v in fields.items()}).pressure(diameter), float)
     except (TypeError, ValueError, ArithmeticError, InputError):
         return None
     if R.ndim > 1 or R.size not in (1, n) or not np.all(np.isfinite(R) & (R > 0)):
