@@ -82,6 +82,8 @@ def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys, method)
     assert rc == 0
     res = json.loads((out / "optimum.json").read_text())
     assert {p.name for p in out.iterdir()} >= {"optimum.json", "history.csv", "history.json", "noses.png", "report.md"}
+    # the classic noses are evaluated although the case has a crh (removed for the sphere and the cone)
+    assert all(r["status"] == "ok" for r in res["classic"].values()), res["classic"]
     x_opt, f_opt = res["optimum"]["x"][0], res["optimum"]["objective"]
     # the same objective, design by design, on a grid the optimiser did not choose
     problem = build_problem(load_case(case_file), ["projectile.crh=1:5"], "depth", ["mass"])

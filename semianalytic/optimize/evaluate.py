@@ -52,12 +52,17 @@ from semianalytic.optimize.case import Problem, design_case
 from semianalytic.optimize.model import Infeasible, deep_drag, depth_objective, quantise, confirmation_grid
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
+_SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
+               "projectile.tip_radius")
 CLASSIC_NOSES: dict[str, dict[str, Any]] = {
-    "hemisphere": {"projectile.nose": "sphere"},
-    "ogive crh 3": {"projectile.nose": "ogive", "projectile.crh": 3.0},
-    # the cone as long as the crh-3 ogive: tan(half angle) = (1/2) / sqrt(3 - 1/4)
-    "cone (ogive-3 length)": {"projectile.nose": "cone",
-                              "projectile.half_angle": f"{math.degrees(math.atan(0.5 / math.sqrt(2.75)))!r} deg"},
+    name: {**dict.fromkeys(_SHAPE_KEYS), **shape}  # None: the case's other shape keys removed (sharp tips)
+    for name, shape in {
+        "hemisphere": {"projectile.nose": "sphere"},
+        "ogive crh 3": {"projectile.nose": "ogive", "projectile.crh": 3.0},
+        # the cone as long as the crh-3 ogive: tan(half angle) = (1/2) / sqrt(3 - 1/4)
+        "cone (ogive-3 length)": {"projectile.nose": "cone",
+                                  "projectile.half_angle": f"{math.degrees(math.atan(0.5 / math.sqrt(2.75)))!r} deg"},
+    }.items()
 }
 
 

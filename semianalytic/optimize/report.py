@@ -20,7 +20,7 @@ def _shown(var: dict, value: float) -> str:
 def _design_text(result: dict, rec: dict) -> str:
     if "x" in rec:
         return ", ".join(f"{v['key'].split('.', 1)[1]} = {_shown(v, x)}" for v, x in zip(result["variables"], rec["x"]))
-    return ", ".join(f"{k.split('.', 1)[1]} = {_short(v)}" for k, v in rec["overrides"].items())
+    return ", ".join(f"{k.split('.', 1)[1]} = {_short(v)}" for k, v in rec["overrides"].items() if v is not None)
 
 
 def _short(v) -> str:
