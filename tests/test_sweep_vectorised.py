@@ -207,3 +207,16 @@ def test_geometry_sweep_on_a_local_cluster_equals_inline(tmp_path):
     assert s_lc.scheduler == "local" and s_lc.workers == 2 and s_in.n_ok == s_lc.n_ok == 6
     a, b = (pd.read_csv(tmp_path / d / "results.csv").sort_values("case_id").reset_index(drop=True) for d in ("in", "lc"))
     pd.testing.assert_frame_equal(a, b)  # same tables and the same arithmetic: identical rows
+
+
+def test_sweep_with_an_unreachable_scheduler_exits_2_and_writes_nothing(tmp_path, capsys):
+    from semianalytic.cli import main
+
+    p = tmp_path / "case.toml"
+    p.write_text(CASE.format(resistance=MODELS["elastic-plastic"][0]))
+    out = tmp_path / "o"
+    rc = main(["sweep", str(p), "--out", str(out), "--scheduler", "tcp://127.0.0.1:9",
+               "--vary", "impact.striking_velocity=400:800:200 m/s", "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: --scheduler"), err
+    assert not out.exists()

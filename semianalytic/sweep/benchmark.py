@@ -218,13 +218,13 @@ MC_MODELS = {
 }
 
 
-def _case_with_resistance(tmp: Path, resistance: str | None) -> Path:
+def _case_with_resistance(tmp: Path, resistance: str | None, name: str = "case") -> Path:
     text = MC_CASE.read_text()
     if resistance is not None:
         head, _, tail = text.partition("[target.resistance]")
         rest = tail.split("\n[", 1)
         text = head + "[target.resistance]\n" + resistance + "\n" + ("\n[" + rest[1] if len(rest) > 1 else "")
-    p = tmp / "case.toml"
+    p = tmp / f"{name}.toml"
     p.write_text(text)
     return p
 
@@ -240,7 +240,7 @@ def monte_carlo_rows() -> list[list[str]]:
     common = ["target.density=uniform(2690 kg/m^3, 2730 kg/m^3)", "projectile.density=normal(8020 kg/m^3, 50 kg/m^3)"]
     with tempfile.TemporaryDirectory(prefix="bench_mc_") as tmp:
         tmp = Path(tmp)
-        grid_case = _case_with_resistance(tmp, None)
+        grid_case = _case_with_resistance(tmp, None, "grid")
 
         def grid(label):
             s = run_sweep(grid_case, build_spec(VARY), tmp / "grid", scheduler="inline", progress=False, force=True)
@@ -249,7 +249,7 @@ def monte_carlo_rows() -> list[list[str]]:
 
         g0 = grid("grid sweep (Y x U_s, the 10,000 cases above), before")
         for name, (res, sample) in MC_MODELS.items():
-            case = _case_with_resistance(tmp, res)
+            case = _case_with_resistance(tmp, res, f"mc{len(runs)}")
             spec = build_spec([], [sample, *common], 1540, 1)
             s = run_sweep(case, spec, tmp / "mc", scheduler="inline", progress=False, force=True)
             runs.append((f"Monte Carlo on arrays: {name}", s, os.getloadavg()[0]))
@@ -283,7 +283,8 @@ class _RecordingKernel(PenetrationKernel):
             blas = None
         line = json.dumps({"pid": os.getpid(), "sid": os.getsid(0), "wall": time.perf_counter() - t,
                            "cpu": time.process_time() - c, "blas_threads": blas,
-                           "openblas_env": os.environ.get("OPENBLAS_NUM_THREADS")})
+                           "openblas_env": os.environ.get("OPENBLAS_NUM_THREADS"),
+                           "malloc_trim": os.environ.get("MALLOC_TRIM_THRESHOLD_")})
         with open(self.log, "a") as fh:
             fh.write(line + "\n")
         return table
@@ -301,7 +302,8 @@ def _worker_stats(log: Path) -> dict:
     return {"tables_per_process": sorted((len(v) for v in per.values()), reverse=True),
             "sessions": len({r["sid"] for r in recs}), "cpu_share": cpu / wall if wall > 0 else float("nan"),
             "cpu_per_table": cpu / max(len(recs), 1), "blas_threads": sorted({r["blas_threads"] for r in recs}, key=str),
-            "openblas_env": sorted({str(r["openblas_env"]) for r in recs})}
+            "openblas_env": sorted({str(r["openblas_env"]) for r in recs}),
+            "malloc_trim": sorted({str(r.get("malloc_trim")) for r in recs})}
 
 
 def engine_benchmark(n_designs: int = 64) -> dict:
@@ -351,8 +353,9 @@ def engine_benchmark(n_designs: int = 64) -> dict:
             # two worker processes, each in its own session, as workers started by another service are (and as
             # the LocalCluster's workers move themselves: sweep.engine.own_session)
             for _ in range(2):
-                procs.append(subprocess.Popen([dask, "worker", "--scheduler-file", str(sched_file), "--nworkers", "1",
-                                               "--nthreads", "1", "--no-dashboard"], env=env, start_new_session=True,
+                # --no-nanny: a nanny would set MALLOC_TRIM_THRESHOLD_ (see sweep.engine.connect)
+                procs.append(subprocess.Popen([dask, "worker", "--scheduler-file", str(sched_file), "--nthreads", "1",
+                                               "--no-nanny", "--no-dashboard"], env=env, start_new_session=True,
                                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
             address = json.loads(sched_file.read_text())["address"]
             from dask.distributed import Client
@@ -373,7 +376,7 @@ def engine_benchmark(n_designs: int = 64) -> dict:
     for engine, (wall, s, load, load_after, st) in results.items():
         speed = base / wall
         name = {"inline": "inline (this process)", "local": "LocalCluster (2 x 1 thread, processes, own sessions)",
-                "external": "dask scheduler + 2 x dask worker (own sessions)"}[engine]
+                "external": "dask scheduler + 2 x dask worker --no-nanny (own sessions)"}[engine]
         rows.append([name, str(s.workers), fmt(wall, 4), f"{speed:.2f}x", f"{100 * speed / max(s.workers, 1):.0f} %",
                      " / ".join(str(n) for n in st["tables_per_process"]), f"{st['cpu_per_table']:.2f}",
                      f"{st['cpu_share']:.2f}", ", ".join(map(str, st["blas_threads"])), f"{load:.1f} / {load_after:.1f}"])

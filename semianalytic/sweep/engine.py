@@ -392,10 +392,21 @@ def connect(scheduler: str | None, workers: int):
     from dask.distributed import Client, LocalCluster
 
     if sched == "local":
-        cluster = LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-            silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
-        )
+        import dask
+
+        # dask sets MALLOC_TRIM_THRESHOLD_ = 65536 in the workers it spawns; an explicit trim threshold turns
+        # off glibc's dynamic mmap threshold, so every large array is mmap-ed and page-faulted afresh: a BEM
+        # table then costs 1.6x the CPU (0.71 -> 1.12 s, mostly system time; reports/bench_sweep.md)
+        environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+                   if k != "MALLOC_TRIM_THRESHOLD_"}
+        environ.update(OPENBLAS_NUM_THREADS=1, OMP_NUM_THREADS=1, MKL_NUM_THREADS=1)
+        # and no statistical profiler in the workers (a thread that samples the task's stack every 10 ms,
+        # for the dashboard, which a sweep does not open)
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False}):
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+            )
         client = Client(cluster)
         client.run(own_session)
         return client, cluster, "local"
