@@ -306,6 +306,41 @@ def _worker_stats(log: Path) -> dict:
             "malloc_trim": sorted({str(r.get("malloc_trim")) for r in recs})}
 
 
+_DIAGNOSTIC = """
+import os, sys, time
+from pathlib import Path
+from semianalytic.case import load_case, parse_case
+from semianalytic.sweep.kernels import coefficient_table_for
+from semianalytic.sweep.spec import apply_overrides
+case_file, cache, n = Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
+case = load_case(case_file)
+coefficient_table_for(parse_case(apply_overrides(case.raw, {"projectile.crh": 9.9}), case_file), cache + "w")
+t0 = os.times()
+for k in range(n):
+    coefficient_table_for(parse_case(apply_overrides(case.raw, {"projectile.crh": 1.05 + 0.1 * k}), case_file), cache)
+t1 = os.times()
+print((t1.user - t0.user) / n, (t1.system - t0.system) / n)
+"""
+
+
+def malloc_diagnostic(case: Path, tmp: Path, n: int = 8) -> dict:
+    """CPU per table (user, system) in a plain process, with and without dask's MALLOC_TRIM_THRESHOLD_."""
+    import subprocess
+    import sys
+
+    out = {}
+    for label, trim in (("plain", None), ("MALLOC_TRIM_THRESHOLD_=65536", "65536")):
+        env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+        env["OPENBLAS_NUM_THREADS"] = "1"
+        if trim:
+            env["MALLOC_TRIM_THRESHOLD_"] = trim
+        res = subprocess.run([sys.executable, "-c", _DIAGNOSTIC, str(case), str(tmp / f"diag_{len(out)}"), str(n)],
+                             env=env, capture_output=True, text=True, check=True)
+        user, system = map(float, res.stdout.split()[-2:])
+        out[label] = (user, system)
+    return out
+
+
 def engine_benchmark(n_designs: int = 64) -> dict:
     """The geometry sweep on the three engines (see the module docstring)."""
     import json
@@ -334,6 +369,7 @@ def engine_benchmark(n_designs: int = 64) -> dict:
         text = (ROOT / "cases" / "optimize_fig5_into_fig15a.toml").read_text()
         case.write_text(text.replace("depths = 40", "depths = 20").replace("max_depth_nose_lengths = 60.0",
                                                                           "max_depth_nose_lengths = 40.0"))
+        diag = malloc_diagnostic(case, tmp)
         t = time.perf_counter()
         client, cluster, _ = connect("local", 2)  # what run_sweep starts for scheduler="local"
         local_start = time.perf_counter() - t
@@ -416,14 +452,17 @@ def engine_benchmark(n_designs: int = 64) -> dict:
             "time / wall time of the builds: 1.0 = a whole core while building) and the BLAS thread limit "
             "(threadpoolctl).\n\n"
             "What made the local cluster slower than inline (0.84x in the previous version of this report), found by "
-            "timing the same 10 table builds in one plain process and inside dask workers: (1) dask starts its "
+            "timing the same table builds in one plain process and inside dask workers: (1) dask starts its "
             "workers with MALLOC_TRIM_THRESHOLD_ = 65536 (`distributed.nanny.pre-spawn-environ`); an explicit trim "
             "threshold turns off glibc's dynamic mmap threshold, so every large array of the BEM is mmap-ed and "
-            "page-faulted afresh: 1.12 s of CPU per table instead of 0.71 s in the same plain process (system time "
-            "5.0 s against 1.35 s for the 10 tables); the LocalCluster now starts its workers without it, and the "
+            "page-faulted afresh. Measured in this run, 8 tables in a plain process: CPU per table (user + system) "
+            + " against ".join(f"{u + sy:.2f} s ({sy:.2f} s system) {lab}" for lab, (u, sy) in
+                               [("with MALLOC_TRIM_THRESHOLD_ = 65536", diag["MALLOC_TRIM_THRESHOLD_=65536"]),
+                                ("without", diag["plain"])])
+            + "; the LocalCluster now starts its workers without it, and the "
             "external workers here run without a nanny (`dask worker --no-nanny`), which does not set it; (2) the "
             "workers' statistical profiler (a thread sampling the task's stack every 10 ms, for the dashboard) is "
-            "off; with both, a table costs 0.82 s of CPU in a worker against 0.76 s in a plain process; (3) the "
+            "off (the table below gives the CPU per table in the workers against inline); (3) the "
             "kernel's autogroup scheduling (`/proc/sys/kernel/sched_autogroup_enabled` = "
             f"{ag}) shares the CPU between sessions, so workers left in the sweep's session share one session's "
             "share while other sessions keep the cores busy (measured: the two local workers at about 50 % of a core "
