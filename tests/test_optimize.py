@@ -69,7 +69,8 @@ def test_fixed_mass_shank_against_the_projectile_volume():
         shank_for_constraints(1e-6, 0.01, 7.11e-3, start_shank=0.05, density=rho, mass=1e-3)
 
 
-def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys):
+@pytest.mark.parametrize("method", ["grid-pattern", "grid-nm", "de"])
+def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys, method):
     from semianalytic.case import load_case
     from semianalytic.optimize.case import build_problem
     from semianalytic.optimize.evaluate import evaluate_design
@@ -77,10 +78,12 @@ def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys):
     out = tmp_path / "opt"
     rc = main(["optimize", str(case_file), "--out", str(out), "--vary", "projectile.crh=1:5", "--objective", "depth",
                "--constraint", "mass", "--scheduler", "inline", "--popsize", "3", "--maxiter", "3", "--confirm", "0",
-               "--no-progress"])
+               "--method", method, "--coarse", "3", "--no-progress"])
     assert rc == 0
     res = json.loads((out / "optimum.json").read_text())
     assert {p.name for p in out.iterdir()} >= {"optimum.json", "history.csv", "history.json", "noses.png", "report.md"}
+    # the classic noses are evaluated although the case has a crh (removed for the sphere and the cone)
+    assert all(r["status"] == "ok" for r in res["classic"].values()), res["classic"]
     x_opt, f_opt = res["optimum"]["x"][0], res["optimum"]["objective"]
     # the same objective, design by design, on a grid the optimiser did not choose
     problem = build_problem(load_case(case_file), ["projectile.crh=1:5"], "depth", ["mass"])
@@ -109,6 +112,10 @@ def test_optimum_against_a_brute_force_grid(case_file, tmp_path, capsys):
         (["--vary", "projectile.crh=1:12", "--constraint", "mass"], "--constraint mass"),
         (["--vary", "projectile.crh=1:4", "--vary", "projectile.meplat_diameter=0 mm:7.11 mm"], "--vary projectile.meplat_diameter"),
         (["--vary", "projectile.tip_radius=0 mm:9 mm"], "--vary projectile.tip_radius"),
+        (["--vary", "projectile.crh=1:4", "--table-depths", "4"], "--table-depths"),
+        (["--vary", "projectile.crh=1:4", "--table-nose-lengths", "0.5"], "--table-nose-lengths"),
+        (["--vary", "projectile.crh=1:4", "--method", "simplex"], "--method"),
+        (["--vary", "projectile.crh=1:4", "--coarse", "1"], "--coarse"),
     ],
 )
 def test_bad_input_exits_2_naming_the_flag(tmp_path, monkeypatch, capsys, args, flag):
@@ -120,6 +127,24 @@ def test_bad_input_exits_2_naming_the_flag(tmp_path, monkeypatch, capsys, args, 
     err = capsys.readouterr().err
     assert rc == 2 and err.startswith(f"error: {flag}"), err
     assert not out.exists() and not (tmp_path / "cache").exists()
+
+
+def test_design_tables_and_the_check_on_the_case_tables(case_file, tmp_path):
+    # lighter design tables (--table-depths/--table-nose-lengths): the optimum is evaluated again on the
+    # case's own tables, and the difference is the design tables' error in the objective
+    out = tmp_path / "opt"
+    rc = main(["optimize", str(case_file), "--out", str(out), "--vary", "projectile.crh=2:4", "--constraint", "mass",
+               "--scheduler", "inline", "--coarse", "3", "--maxfev", "4", "--confirm", "0", "--table-depths", "10",
+               "--table-nose-lengths", "20", "--no-progress"])
+    assert rc == 0
+    res = json.loads((out / "optimum.json").read_text())
+    chk = res["own_tables_check"]
+    assert chk["table_overrides"] == {"coefficients.depths": 10, "coefficients.max_depth_nose_lengths": 20.0}
+    assert chk["design_tables_objective"] == res["optimum"]["objective"]
+    # a coarser table than the case's 16 depths: not the same number, but the same depth to 1e-3 (a table
+    # of 10 depths interpolates the coefficients to about 1e-4, and the depth integrates them)
+    assert 0 < chk["relative_difference"] < 1e-3
+    assert "on the case's own tables" in (out / "report.md").read_text()
 
 
 def test_objective_not_defined_for_the_case(tmp_path, capsys):

@@ -47,6 +47,10 @@ MODELS = {
     "part4": ('model = "part4"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"',
               "target.resistance.youngs_modulus=uniform(60 GPa, 75 GPa)"),
     "constant": ('model = "constant"\nvalue = "1.2 GPa"', "target.resistance.value=lognormal(1.2 GPa, 0.1)"),
+    # Part II (no closed form): R_t on a Chebyshev grid of the strength, checked against direct solves
+    "cavity": ('model = "cavity"\nyoungs_modulus = "373.14 GPa"\npoisson_ratio = 0.232\ntensile_strength = "0.262 GPa"\n'
+               'compressive_strength = "2.62 GPa"',
+               "target.resistance.compressive_strength=uniform(2.5 GPa, 2.75 GPa)"),
 }
 
 
@@ -121,10 +125,11 @@ def test_cheap_sweep_runs_inline_without_a_scheduler(tmp_path):
     assert s.scheduler == "inline" and s.n_ok == 11
 
 
-@pytest.mark.parametrize("model", ["elastic-plastic", "brittle", "hardening", "limestone", "part4", "constant"])
+@pytest.mark.parametrize("model", ["elastic-plastic", "brittle", "hardening", "limestone", "part4", "constant", "cavity"])
 def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkeypatch):
     # R_t on a Chebyshev grid over the samples' box, interpolated, against the model's closed form
     # evaluated sample by sample (smooth in the fields: interpolation error ~1e-13, checked to 1e-10)
+    from semianalytic.cavity import BrittleMaterial
     from semianalytic.penetration import resistance as res
     from semianalytic.sweep.kernels import _pressures, resistance_per_sample
 
@@ -135,15 +140,83 @@ def test_interpolated_resistance_equals_the_closed_form_per_sample(model, monkey
         "limestone": (res.Limestone(), {"psi": (500e6, 700e6)}),
         "part4": (res.Part4(400e6, 68.9e9), {"youngs_modulus": (60e9, 75e9)}),
         "constant": (res.Constant(1.2e9), {"value": (1.0e9, 1.4e9)}),
+        "cavity": (res.Cavity(BrittleMaterial(373.14e9, 0.232, 0.262e9, 2.62e9)), {"compressive_strength": (2.5e9, 2.75e9)}),
     }[model]
     rng = np.random.default_rng(4)
-    samples = {f: rng.uniform(lo, hi, 2000) for f, (lo, hi) in fields.items()}
+    n = 200 if model == "cavity" else 2000  # a Part II solve per sample for the reference
+    samples = {f: rng.uniform(lo, hi, n) for f, (lo, hi) in fields.items()}
     import semianalytic.sweep.kernels as kernels
 
     sizes = []
     monkeypatch.setattr(kernels, "_pressures", lambda b, cols, d: sizes.append(len(next(iter(cols.values())))) or _pressures(b, cols, d))
     R, msg = resistance_per_sample(base, samples, D)
-    assert max(sizes) < 2000  # the grid and the three probes, not every sample
+    assert max(sizes, default=0) < n  # closed form on arrays, or the grid and three probes: not every sample
     exact, _ = _pressures(base, {f: v.tolist() for f, v in samples.items()}, D)
     assert (msg == "").all()
     np.testing.assert_allclose(R, exact, rtol=1e-10)
+
+
+def test_geometry_batches_hold_one_table_each():
+    # a geometry sweep on workers: every batch holds the cases of one nose (its task builds that table)
+    from semianalytic.sweep.engine import _geometry_batches
+
+    spec = build_spec(["projectile.crh=1,2,3,4", "impact.striking_velocity=400:1600:100 m/s"])
+    k = PenetrationKernel()
+    ids = np.arange(spec.n_cases, dtype=np.int64)
+    batches = _geometry_batches(spec, k, ids, {}, size=5)
+    crh = spec.values(ids)["projectile.crh"]
+    assert sorted(np.concatenate(batches).tolist()) == ids.tolist()  # every case once
+    assert all(len(set(crh[b].tolist())) == 1 and len(b) <= 5 for b in batches)
+    assert len(batches) == 4 * 3  # 13 velocities per nose in batches of at most 5
+
+
+def test_worker_moves_into_its_own_session():
+    # own_session (run in every LocalCluster worker): setsid, so the kernel's autogroup scheduler
+    # gives the worker its own CPU share; a child of this process starts in this process's session
+    import os
+    import subprocess
+    import sys
+
+    code = "import os; from semianalytic.sweep.engine import own_session; print(os.getsid(0), own_session(), os.getpid())"
+    before, after, pid = map(int, subprocess.run([sys.executable, "-c", code], capture_output=True, text=True,
+                                                 check=True).stdout.split())
+    assert before == os.getsid(0) and after == pid != before
+
+
+# the case above with coarse BEM tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design
+GEOMETRY_CASE = CASE.format(resistance=MODELS["elastic-plastic"][0]) + """
+[bem]
+order = 4
+refinement = 0.2
+[coefficients]
+depths = 16
+max_depth_nose_lengths = 30.0
+"""
+
+
+def test_geometry_sweep_on_a_local_cluster_equals_inline(tmp_path):
+    # coarse BEM tables (the check is of the engine: same tables, same rows); the inline run builds
+    # the tables, the cluster's tasks load them from the same disk cache (one table per task)
+    p = tmp_path / "case.toml"
+    p.write_text(GEOMETRY_CASE)
+    spec = build_spec(["projectile.crh=1.5,2.5,3.5"])
+    cache = str(tmp_path / "cache")
+    s_in = run_sweep(p, spec, tmp_path / "in", scheduler="inline", progress=False, kernel=PenetrationKernel(cache_dir=cache))
+    s_lc = run_sweep(p, spec, tmp_path / "lc", scheduler="local", workers=2, progress=False,
+                     kernel=PenetrationKernel(cache_dir=cache))
+    assert s_lc.scheduler == "local" and s_lc.workers == 2 and s_in.n_ok == s_lc.n_ok == 6
+    a, b = (pd.read_csv(tmp_path / d / "results.csv").sort_values("case_id").reset_index(drop=True) for d in ("in", "lc"))
+    pd.testing.assert_frame_equal(a, b)  # same tables and the same arithmetic: identical rows
+
+
+def test_sweep_with_an_unreachable_scheduler_exits_2_and_writes_nothing(tmp_path, capsys):
+    from semianalytic.cli import main
+
+    p = tmp_path / "case.toml"
+    p.write_text(CASE.format(resistance=MODELS["elastic-plastic"][0]))
+    out = tmp_path / "o"
+    rc = main(["sweep", str(p), "--out", str(out), "--scheduler", "tcp://127.0.0.1:9",
+               "--vary", "impact.striking_velocity=400:800:200 m/s", "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: --scheduler"), err
+    assert not out.exists()

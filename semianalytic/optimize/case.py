@@ -64,6 +64,8 @@ class Problem:
     fixed_length: float | None  # L0 [m] when --constraint length
     start_shank: float
     velocities: tuple[float, ...] = field(default=())
+    # [coefficients] settings of every design's table (--table-depths, --table-nose-lengths): key -> value
+    table_overrides: tuple[tuple[str, Any], ...] = field(default=())
 
     @property
     def low(self) -> list[float]:
@@ -129,7 +131,7 @@ def design_case(problem: Problem, overrides: Mapping[str, Any]) -> Case:
     from semianalytic.geometry import nose_from_section
 
     path = Path(problem.case_path) if problem.case_path else None
-    raw = _design_raw(problem, overrides)
+    raw = _design_raw(problem, {**dict(problem.table_overrides), **overrides})
     case = parse_case(raw, path)
     psec = case.require("projectile")
     nose = nose_from_section(psec)
@@ -152,8 +154,13 @@ def build_problem(
     objective: str,
     constraints: list[str],
     depth_model: str = "rigid",
+    table_depths: int | None = None,
+    table_nose_lengths: float | None = None,
 ) -> Problem:
-    """Parse and check everything the user gave (exit 2 naming the flag on bad input)."""
+    """Parse and check everything the user gave (exit 2 naming the flag on bad input).
+
+    ``table_depths`` / ``table_nose_lengths`` set every design's ``[coefficients] depths`` and
+    ``max_depth_nose_lengths`` (the design tables; None: the case's own)."""
     from semianalytic.geometry import projectile_from_section
 
     if objective not in OBJECTIVES:
@@ -211,9 +218,18 @@ def build_problem(
             fixed_mass = None
     if "length" in cons:
         fixed_length = start.length
+    tables: list[tuple[str, Any]] = []
+    if table_depths is not None:
+        if not 8 <= table_depths <= 2000:
+            raise InputError("--table-depths", f"must lie in [8, 2000] (depths of each design's table); got {table_depths}")
+        tables.append(("coefficients.depths", int(table_depths)))
+    if table_nose_lengths is not None:
+        if not table_nose_lengths > 1.0:
+            raise InputError("--table-nose-lengths", f"must be above 1 (nose lengths); got {table_nose_lengths:g}")
+        tables.append(("coefficients.max_depth_nose_lengths", float(table_nose_lengths)))
     problem = Problem(
         json.dumps(case.raw), str(case.path) if case.path else None, variables, objective, depth_model, cons,
-        fixed_mass, fixed_length, start.shank_length, velocities,
+        fixed_mass, fixed_length, start.shank_length, velocities, tuple(tables),
     )
     check_bounds(problem)
     return problem

@@ -28,9 +28,21 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
     parser.add_argument("--depth-model", default="rigid", help="rigid or exact-rod (elastic projectile, errata item 5)")
     parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")
+    parser.add_argument("--method", default="grid-pattern",
+                        help="grid-pattern (default: a coarse grid, then a compass search; each poll's designs in "
+                             "parallel), grid-nm (the coarse grid, then Nelder-Mead with bounds) or de (differential evolution)")
+    parser.add_argument("--coarse", type=int, default=5, help="grid-pattern, grid-nm: points per variable of the coarse grid (default 5)")
+    parser.add_argument("--maxfev", type=int, default=60, help="grid-pattern: at most this many polls; grid-nm: at most this many "
+                        "Nelder-Mead evaluations (default 60)")
+    parser.add_argument("--table-depths", type=int, default=None,
+                        help="depths of every design's coefficient table ([coefficients] depths; default: the case's)")
+    parser.add_argument("--table-nose-lengths", type=float, default=None,
+                        help="deepest depth of every design's table, in nose lengths ([coefficients] "
+                             "max_depth_nose_lengths; default: the case's); the optimum is re-evaluated on the case's own tables")
     parser.add_argument("--popsize", type=int, default=5, help="differential evolution: population per variable (default 5)")
     parser.add_argument("--maxiter", type=int, default=12, help="differential evolution: generations (default 12)")
-    parser.add_argument("--tol", type=float, default=1e-5, help="differential evolution: relative tolerance of the population's objectives (default 1e-5)")
+    parser.add_argument("--tol", type=float, default=1e-5,
+                        help="relative tolerance of the objectives (Nelder-Mead simplex; DE population) (default 1e-5)")
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--resolution", type=float, default=1e-3, help="designs rounded to this fraction of each range")
     parser.add_argument("--confirm", type=int, default=5, help="confirmation grid: points per variable (0: none)")

@@ -5,16 +5,36 @@ One design: the case with the design's overrides and the constrained shank
 per-user cache, keyed by the geometry hash (:func:`semianalytic.cache.coefficients_for_case`;
 built by the BEM when absent) -> the objective (:mod:`~semianalytic.optimize.model`).
 
-The optimiser is scipy's ``differential_evolution``, bounded, ``vectorized=True`` with
-deferred updating: each generation's whole population is handed to :meth:`Evaluator.map`,
-which evaluates the designs in parallel on the dask workers (the same connection as
-``sweep``, :func:`semianalytic.sweep.engine.connect`).  Why differential evolution: it needs
-no gradients (the BEM's panel layout changes with the geometry, so the objective has small
-discretisation steps that spoil finite differences and mislead a local simplex), it keeps to
-the bounds, and a generation is a batch of independent designs that fills the workers;
-``polish`` is off for the same reason as the gradients.  Designs are rounded to
-``resolution`` of each range, so the converging population re-uses designs (memo here) and
-their tables (disk cache).  The optimum is then checked on a finer grid around it.
+Optimisers (``method``):
+
+- ``grid-pattern`` (default): the coarse grid below, then a compass search (a generalised
+  pattern search: Torczon 1997; with bounds Lewis & Torczon 1999; review: Kolda, Lewis &
+  Torczon, SIAM Review 45, 2003) from its best point: each poll evaluates the 2k points
+  u +- h e_j of the current point together (in parallel on the workers), moves to the best if
+  it improves, else halves h, from half a grid step down to ``resolution``.  Derivative-free
+  and bounded like the simplex, but a poll's designs are independent, so both workers stay
+  busy (Nelder-Mead evaluates one design at a time); converges to a point where no
+  coordinate step of the finest size improves the objective (on a smooth objective, a
+  stationary point, or a bound for a monotone one).  scipy has no parallel-poll pattern search.
+- ``grid-nm``: a coarse grid over the bounds (``coarse`` points per variable, all
+  designs evaluated in parallel on the dask workers), then scipy's Nelder-Mead with bounds
+  from the grid's best point (initial simplex half a grid step wide, in coordinates scaled
+  to [0, 1] per variable; stops when the simplex is within ``resolution`` of each range and
+  the objectives within ``tol`` relative).  Why: the nose problems have one or two smooth
+  parameters, where a grid of a few designs per variable finds the basin (and every corner of
+  the bounds, where the optimum of a monotone objective lies) and a simplex converges in a few
+  tens of designs; it needs no gradients (the BEM's panel layout changes with the geometry, so
+  the objective has small discretisation steps that spoil finite differences) and keeps to
+  the bounds.  The simplex is sequential (one design at a time), the grid is not.
+- ``de``: scipy's ``differential_evolution``, bounded, ``vectorized=True`` with deferred
+  updating: each generation's population is evaluated in parallel; no polish (same reason
+  as the gradients).  More designs (popsize x variables per generation) for problems with
+  several basins.
+
+Designs are rounded to ``resolution`` of each range, so the search re-uses designs (memo
+here) and their tables (disk cache).  The optimum is then checked on a finer grid around it,
+and, when the design tables are lighter than the case's (``table_overrides``), re-evaluated
+on the case's own tables (the objective's table error, reported).
 """
 
 from __future__ import annotations
@@ -32,12 +52,17 @@ from semianalytic.optimize.case import Problem, design_case
 from semianalytic.optimize.model import Infeasible, deep_drag, depth_objective, quantise, confirmation_grid
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
+_SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
+               "projectile.tip_radius")
 CLASSIC_NOSES: dict[str, dict[str, Any]] = {
-    "hemisphere": {"projectile.nose": "sphere"},
-    "ogive crh 3": {"projectile.nose": "ogive", "projectile.crh": 3.0},
-    # the cone as long as the crh-3 ogive: tan(half angle) = (1/2) / sqrt(3 - 1/4)
-    "cone (ogive-3 length)": {"projectile.nose": "cone",
-                              "projectile.half_angle": f"{math.degrees(math.atan(0.5 / math.sqrt(2.75)))!r} deg"},
+    name: {**dict.fromkeys(_SHAPE_KEYS), **shape}  # None: the case's other shape keys removed (sharp tips)
+    for name, shape in {
+        "hemisphere": {"projectile.nose": "sphere"},
+        "ogive crh 3": {"projectile.nose": "ogive", "projectile.crh": 3.0},
+        # the cone as long as the crh-3 ogive: tan(half angle) = (1/2) / sqrt(3 - 1/4)
+        "cone (ogive-3 length)": {"projectile.nose": "cone",
+                                  "projectile.half_angle": f"{math.degrees(math.atan(0.5 / math.sqrt(2.75)))!r} deg"},
+    }.items()
 }
 
 
@@ -143,11 +168,65 @@ def _start_x(problem: Problem) -> list[float] | None:
     return x
 
 
+def _grid_nelder_mead(batch, k: int, coarse: int, resolution: float, tol: float, maxfev: int):
+    """Coarse grid, then Nelder-Mead with bounds (module docstring); ``batch(U, phase)`` evaluates
+    designs given in [0, 1]^k coordinates and returns their objectives.  Returns a summary dict."""
+    from scipy.optimize import minimize
+
+    U, u0, f0 = _coarse_grid(batch, k, coarse)
+    h = 0.5 / (coarse - 1)  # half a grid step: the simplex starts inside the grid cell of the best point
+    simplex = [u0] + [u0 + np.where(np.arange(k) == j, h if u0[j] + h <= 1.0 else -h, 0.0) for j in range(k)]
+    res = minimize(lambda u: float(batch(np.atleast_2d(u), "search")[0]), u0, method="Nelder-Mead",
+                   bounds=[(0.0, 1.0)] * k,
+                   options={"initial_simplex": np.array(simplex), "xatol": resolution,
+                            "fatol": tol * max(abs(f0), 1e-300), "maxfev": maxfev})
+    return {"method": "coarse grid + scipy.optimize.minimize(Nelder-Mead, bounds)", "coarse": coarse,
+            "maxfev": maxfev, "nfev": int(res.nfev) + len(U), "nit": int(res.nit), "message": str(res.message),
+            "success": bool(res.success)}
+
+
+def _coarse_grid(batch, k: int, coarse: int):
+    axes = [np.linspace(0.0, 1.0, coarse)] * k
+    U = np.column_stack([m.ravel() for m in np.meshgrid(*axes, indexing="ij")])
+    f = batch(U, "grid")
+    i = int(np.argmin(f))
+    return U, U[i], float(f[i])
+
+
+def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int):
+    """Coarse grid, then a compass (pattern) search from its best point (module docstring): each poll
+    evaluates the 2k points u +- h e_j (clipped to the bounds) together; the best one that improves
+    becomes u, else h is halved; from half a grid step down to ``resolution`` of each range."""
+    U, u, f = _coarse_grid(batch, k, coarse)
+    h = 0.5 / (coarse - 1)
+    polls = moves = 0
+    while h >= resolution and polls < max_polls:
+        pts = np.clip(np.vstack([u + s * h * np.eye(k)[j] for j in range(k) for s in (1.0, -1.0)]), 0.0, 1.0)
+        pts = np.unique(pts[np.any(np.abs(pts - u) > 0.5 * resolution, axis=1)], axis=0)
+        polls += 1
+        if len(pts):
+            fs = batch(pts, "search")
+            j = int(np.argmin(fs))
+            if fs[j] < f:
+                u, f = pts[j], float(fs[j])
+                moves += 1
+                continue
+        h *= 0.5
+    done = h < resolution
+    return {"method": "coarse grid + compass search (polls of 2 x variables designs in parallel)", "coarse": coarse,
+            "max_polls": max_polls, "polls": polls, "moves": moves, "final_step": h,
+            "message": "step below the resolution" if done else
+            "stopped at --maxfev polls", "success": bool(done)}
+
+
 def optimise(
     problem: Problem,
     *,
     client=None,
     cache_dir: str | None = None,
+    method: str = "grid-pattern",
+    coarse: int = 5,
+    maxfev: int = 60,
     popsize: int = 5,
     maxiter: int = 12,
     tol: float = 1e-5,
@@ -158,11 +237,9 @@ def optimise(
     classic_noses: bool = True,
     on_done: Callable[[int], None] | None = None,
 ) -> dict:
-    """Differential evolution over the problem's bounds, then the confirmation grid and the
-    classic noses.  Returns a plain dict (the optimum, the start, the grid, the classics, the
-    history); see the module docstring for the method."""
-    from scipy.optimize import differential_evolution
-
+    """Search the problem's bounds (``method``: see the module docstring), then the confirmation
+    grid, the optimum on the case's own tables (with lighter design tables) and the classic noses.
+    Returns a plain dict (the optimum, the start, the grid, the classics, the history)."""
     t0 = time.perf_counter()
     low, high = np.array(problem.low), np.array(problem.high)
     ev = Evaluator(problem, client, cache_dir, on_done)
@@ -179,12 +256,37 @@ def optimise(
         gen["n"] += 1
         return np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
 
-    x0 = None if start is None else np.clip(start, low, high)
-    res = differential_evolution(
-        objective, list(zip(low, high)), popsize=popsize, maxiter=maxiter, tol=tol, seed=seed, polish=False,
-        vectorized=True, updating="deferred", init="latinhypercube", x0=x0,
-    )
-    best_x = quantise(res.x, low, high, resolution)
+    if method == "de":
+        from scipy.optimize import differential_evolution
+
+        x0 = None if start is None else np.clip(start, low, high)
+        res = differential_evolution(
+            objective, list(zip(low, high)), popsize=popsize, maxiter=maxiter, tol=tol, seed=seed, polish=False,
+            vectorized=True, updating="deferred", init="latinhypercube", x0=x0,
+        )
+        info = {"method": "scipy.optimize.differential_evolution (vectorized, deferred, no polish)",
+                "popsize": popsize, "maxiter": maxiter, "nfev": int(res.nfev), "message": str(res.message),
+                "success": bool(res.success)}
+    elif method in ("grid-pattern", "grid-nm"):
+        def batch(U, phase):
+            pts = quantise(low + np.atleast_2d(U) * (high - low), low, high, resolution)
+            recs = ev.map([problem.overrides(p) for p in pts], phase, gen["n"], pts)
+            gen["n"] += 1
+            return np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
+
+        if method == "grid-nm":
+            info = _grid_nelder_mead(batch, len(low), coarse, resolution, tol, maxfev)
+        else:
+            info = _grid_pattern(batch, len(low), coarse, resolution, maxfev)
+    else:
+        raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {method!r}")
+    info.update(tol=tol, seed=seed, resolution=resolution, generations=gen["n"])
+    info.setdefault("nfev", sum(1 for r in ev.history if r["phase"] in ("grid", "search")))
+    # the optimum: the best design the search evaluated (the optimiser's own answer is one of them)
+    searched = [r for r in ev.history if r["phase"] in ("search", "grid") and r["status"] == "ok"]
+    if not searched:
+        raise InputError("--vary", "no design within the bounds could be evaluated (see history: all invalid)")
+    best_x = np.asarray(min(searched, key=lambda r: r["objective"])["x"])
     best = ev.map([problem.overrides(best_x)], "optimum", gen["n"], [best_x])[0]
     search_seconds = time.perf_counter() - t0
     n_search = len({json.dumps(r["overrides"], sort_keys=True) for r in ev.history})
@@ -210,6 +312,15 @@ def optimise(
             "confirmed": bool(f[k] >= best["objective"] - 1e-6 * abs(best["objective"]) or np.all(steps <= 1.0 + 1e-9)),
             "points": [{"x": p.tolist(), "objective": float(fi), "status": r["status"]} for p, fi, r in zip(pts, f, recs)],
         }
+    own_tables = None
+    if problem.table_overrides:  # the optimum again on the case's own tables: the design tables' error
+        import dataclasses
+
+        own = evaluate_design(dataclasses.replace(problem, table_overrides=()), problem.overrides(best_x), cache_dir)
+        if own["status"] == "ok":
+            own_tables = {"objective": own["objective"], "design_tables_objective": best["objective"],
+                          "relative_difference": abs(best["objective"] - own["objective"]) / abs(own["objective"]),
+                          "seconds": own["seconds"], "table_overrides": dict(problem.table_overrides)}
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -222,10 +333,8 @@ def optimise(
         "fixed_mass_kg": problem.fixed_mass,
         "fixed_length_m": problem.fixed_length,
         "striking_velocities_m_s": list(problem.velocities),
-        "optimizer": {"method": "scipy.optimize.differential_evolution (vectorized, deferred, no polish)",
-                      "popsize": popsize, "maxiter": maxiter, "tol": tol, "seed": seed, "resolution": resolution,
-                      "generations": gen["n"], "nfev": int(res.nfev), "message": str(res.message),
-                      "success": bool(res.success)},
+        "optimizer": info,
+        "own_tables_check": own_tables,
         "optimum": {**best, "x": best_x.tolist()},
         "start": start_rec,
         "confirmation": grid,

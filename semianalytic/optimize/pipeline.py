@@ -22,7 +22,7 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     from semianalytic.io import check_report_target
     from semianalytic.sweep.engine import connect
 
-    for name, low in (("--popsize", 2), ("--maxiter", 1), ("--workers", 1)):
+    for name, low in (("--popsize", 2), ("--maxiter", 1), ("--workers", 1), ("--coarse", 2), ("--maxfev", 1)):
         if getattr(args, name[2:].replace("-", "_")) < low:
             raise InputError(name, f"must be at least {low}")
     if not 0 < args.resolution <= 0.1:
@@ -32,7 +32,10 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     if args.confirm < 0 or args.confirm == 1:
         raise InputError("--confirm", "must be 0 (no grid) or at least 2")
     case = load_case(args.case)
-    problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model)
+    if args.method not in ("grid-pattern", "grid-nm", "de"):
+        raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {args.method!r}")
+    problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model,
+                            args.table_depths, args.table_nose_lengths)
     out = Path(args.out) if args.out else None
     report = Path(args.report) if args.report else None
     if out is not None:
@@ -48,12 +51,15 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
         if not args.no_progress:
             from tqdm import tqdm
 
-            total = args.popsize * n_var * (args.maxiter + 1) + args.confirm**n_var + 4
+            search = (args.popsize * n_var * (args.maxiter + 1) if args.method == "de"
+                      else args.coarse**n_var + min(args.maxfev, 15) * (2 * n_var if args.method == "grid-pattern" else 1))
+            total = search + args.confirm**n_var + 4
             bar = tqdm(total=total, unit="design", file=sys.stderr, dynamic_ncols=True, mininterval=0.5,
                        desc="optimize")
         workers = 1 if client is None else max(1, len(client.scheduler_info().get("workers", {})))
         result = optimise(
-            problem, client=client, cache_dir=cache_dir, popsize=args.popsize, maxiter=args.maxiter, tol=args.tol,
+            problem, client=client, cache_dir=cache_dir, method=args.method, coarse=args.coarse, maxfev=args.maxfev,
+            popsize=args.popsize, maxiter=args.maxiter, tol=args.tol,
             seed=args.seed, resolution=args.resolution, confirm=args.confirm,
             on_done=None if bar is None else bar.update,
         )

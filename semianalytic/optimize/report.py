@@ -20,7 +20,7 @@ def _shown(var: dict, value: float) -> str:
 def _design_text(result: dict, rec: dict) -> str:
     if "x" in rec:
         return ", ".join(f"{v['key'].split('.', 1)[1]} = {_shown(v, x)}" for v, x in zip(result["variables"], rec["x"]))
-    return ", ".join(f"{k.split('.', 1)[1]} = {_short(v)}" for k, v in rec["overrides"].items())
+    return ", ".join(f"{k.split('.', 1)[1]} = {_short(v)}" for k, v in rec["overrides"].items() if v is not None)
 
 
 def _short(v) -> str:
@@ -97,10 +97,25 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
              + ". Bounds: " + ", ".join(f"{v['key']} in [{_shown(v, v['low'])}, {_shown(v, v['high'])}]"
                                         for v in result["variables"]) + ".")
     o = result["optimizer"]
-    doc.para(f"Optimiser: {o['method']}, popsize {o['popsize']}, maxiter {o['maxiter']}, tol {o['tol']}, seed "
-             f"{o['seed']}, designs rounded to {o['resolution']:g} of each range: {o['generations']} generations, "
-             f"{result['n_designs_search']} distinct designs (BEM tables) in {result['seconds_search']:.1f} s "
-             f"({result['scheduler']}, {result['workers']} worker(s)); scipy says: {o['message']}.")
+    if "popsize" in o:
+        settings = f"popsize {o['popsize']}, maxiter {o['maxiter']}"
+    elif "max_polls" in o:
+        settings = (f"coarse grid {o['coarse']} points per variable, then {o['polls']} polls ({o['moves']} moves) down "
+                    f"to a step of {o['final_step']:.2g} of each range")
+    else:
+        settings = f"coarse grid {o['coarse']} points per variable, at most {o['maxfev']} simplex evaluations"
+    doc.para(f"Optimiser: {o['method']}, {settings}, tol {o['tol']}, seed "
+             f"{o['seed']}, designs rounded to {o['resolution']:g} of each range: {o['generations']} batches, "
+             f"{o['nfev']} evaluations, {result['n_designs_search']} distinct designs (BEM tables) in "
+             f"{result['seconds_search']:.1f} s ({result['scheduler']}, {result['workers']} worker(s)); "
+             f"stopped: {o['message']}.")
+    chk = result.get("own_tables_check")
+    if chk:
+        tabs = ", ".join(f"{k.split('.', 1)[1]} = {v:g}" for k, v in chk["table_overrides"].items())
+        doc.para(f"Design tables: every design's coefficient table with {tabs} (lighter than the case's). The optimum "
+                 f"on the case's own tables: objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
+                 f"on the design tables, relative difference **{chk['relative_difference']:.1e}** (the design tables' "
+                 "error in the objective; compare it with the change of the objective over one resolution step).")
     rows = [["optimum", _design_text(result, result["optimum"]), _value_text(result, result["optimum"])]]
     if result.get("start"):
         rows.append(["start", _design_text(result, result["start"]), _value_text(result, result["start"])])
@@ -110,7 +125,11 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
     for v, x in zip(result["variables"], result["optimum"].get("x", [])):
         side = "upper" if x >= v["high"] - 0.01 * (v["high"] - v["low"]) else (
             "lower" if x <= v["low"] + 0.01 * (v["high"] - v["low"]) else None)
-        if side:
+        if side == "lower" and v["low"] == 0.0 and v["key"] in ("projectile.meplat_diameter", "projectile.tip_radius"):
+            doc.note(f"The optimum of {v['key']} is on its lower bound 0, the physical limit (a sharp tip): every flat or "
+                     "rounded tip the search and the confirmation grid evaluated gives a worse objective, so within "
+                     "this model the sharp nose is best; the bound is not what stops the improvement.")
+        elif side:
             doc.note(f"The optimum of {v['key']} lies on its {side} bound ({_shown(v, x)}): within these bounds and "
                      "constraints the objective still improves towards it; the bound, not the physics of the model, "
                      "stops the search. Widen it or add a constraint to find where the improvement ends.")

@@ -32,6 +32,8 @@ import math
 from dataclasses import dataclass
 from typing import TYPE_CHECKING
 
+import numpy as np
+
 from semianalytic.errors import InputError
 
 if TYPE_CHECKING:
@@ -61,9 +63,18 @@ __all__ = [
 # closed forms (pure functions, SI)
 
 
+def _log(x):
+    return math.log(x) if np.ndim(x) == 0 else np.log(x)  # floats as before (ValueError <= 0); arrays
+
+
+def _sqrt(x):
+    return math.sqrt(x) if np.ndim(x) == 0 else np.sqrt(x)
+
+
 def elastic_plastic_resistance(Y: float, E: float, nu: float) -> float:
-    """Part I, eq. (16): R_t = (2/3) Y (1 + ln(E / (3 Y (1 - nu)))) [Pa] (elastic-perfectly plastic)."""
-    return 2.0 / 3.0 * Y * (1.0 + math.log(E / (3.0 * Y * (1.0 - nu))))
+    """Part I, eq. (16): R_t = (2/3) Y (1 + ln(E / (3 Y (1 - nu)))) [Pa] (elastic-perfectly plastic).
+    Floats or arrays (Monte Carlo on arrays)."""
+    return 2.0 / 3.0 * Y * (1.0 + _log(E / (3.0 * Y * (1.0 - nu))))
 
 
 def brittle_resistance(Y: float, sigma_f: float, E: float, nu: float, alpha: float) -> float:
@@ -71,9 +82,10 @@ def brittle_resistance(Y: float, sigma_f: float, E: float, nu: float, alpha: flo
 
     Y: strength in uniaxial compression, sigma_f: tensile strength, alpha: characteristic of
     the fractured medium (ref. [23] of Part I).  Needs (1 - nu) sqrt(sigma_f / (2 Y)) < 1.
+    Floats or arrays (Monte Carlo on arrays).
     """
-    q = 1.0 - (1.0 - nu) * math.sqrt(sigma_f / (2.0 * Y))
-    if not q > 0:
+    q = 1.0 - (1.0 - nu) * _sqrt(sigma_f / (2.0 * Y))
+    if not np.all(q > 0):
         raise ValueError("(1 - nu) sqrt(tensile_strength / (2 compressive_strength)) must be below 1 in eq. (17)")
     return Y * (E / (3.0 * Y * q)) ** (2.0 * alpha / 3.0)
 
@@ -202,6 +214,10 @@ class Part4:
     equation = "Part IV, eq. (6)"
 
     def pressure(self, diameter: float | None = None) -> float:
+        if np.ndim(self.yield_stress) or np.ndim(self.youngs_modulus):  # arrays (Monte Carlo)
+            from semianalytic.ballistic_limit.theory import resistance_part4
+
+            return resistance_part4(self.yield_stress, self.youngs_modulus)
         return part4_resistance(self.yield_stress, self.youngs_modulus)
 
 

@@ -29,9 +29,12 @@ import os
 import platform
 import tempfile
 import time
+from dataclasses import dataclass
 from pathlib import Path
 
 import numpy as np
+
+from semianalytic.sweep.kernels import PenetrationKernel
 
 ROOT = Path(__file__).resolve().parent.parent.parent
 CASE = ROOT / "cases" / "demo_fig5_ogive.toml"
@@ -163,21 +166,33 @@ def main(argv=None) -> int:
              f"exactly once: **{'yes' if complete else 'NO'}**.")
     doc.image(png.name, "Final depth over the swept (U_s, Y) plane.")
     doc.heading("Monte Carlo on arrays (issue 14)")
-    doc.para("Each Monte-Carlo batch validates the case once at every corner of the sampled ranges (the fields' "
-             "validity is a range), draws the samples as arrays and evaluates them together: R_t per sample from "
-             "the resistance model's closed form, the final depth of eq. (11) for all (m, rho, R_t, U_s) on one "
-             "coefficient table (`semianalytic/penetration/batch.py`), U_sC per sample. The case-by-case path "
+    doc.para("A Monte-Carlo run validates the case once at every corner of the box spanned by all its samples "
+             "(the fields' validity is a range; a run whose box has an invalid corner checks each batch's box, and a "
+             "batch with an invalid corner goes case by case, reporting each invalid sample), draws the samples as "
+             "arrays and evaluates them together: R_t from the resistance model's closed form on the arrays "
+             "(eqs. (16), (17), (19), Part IV eq. (6), constant; eq. (18)'s integral and the Part II cavity solve on "
+             "a Chebyshev grid of 17 points per sampled field over the samples' box, checked against direct "
+             "evaluation at three samples to 1e-11, else sample by sample), the final depth of eq. (11) "
+             "for all (m, rho, R_t, U_s) on one coefficient table (`semianalytic/penetration/batch.py`), U_sC of "
+             "eqs. (33)/(34) on arrays, and the results written as columns. The case-by-case path "
              "(`PenetrationKernel(vectorised=False)`) validates every sample as its own case through pydantic and pint, "
-             "as before. Inline (one process), BEM table cached; 1540 samples x 13 striking velocities of "
+             "as before; `tests/test_sweep_vectorised.py` compares the two on the same samples for every "
+             "model. Inline (one process), BEM table cached; 1540 samples x 13 striking velocities of "
              "`cases/fig15a_ogive_6061T651.toml`-like cases, samplers: the model's strength, "
-             "`target.density=uniform(2690, 2730 kg/m^3)`, `projectile.density=normal(8020, 50 kg/m^3)`.")
-    doc.table(["run", "cases", "ok", "cases/s", "load average (1 min)"], mc_rows,
+             "`target.density=uniform(2690, 2730 kg/m^3)`, `projectile.density=normal(8020, 50 kg/m^3)`. The grid "
+             "sweep (a velocity-by-strength grid, also evaluated on arrays) is run before and after the Monte-Carlo "
+             "runs; the ratio is to the mean of its two rates.")
+    doc.table(["run", "cases", "ok", "cases/s (cases)", "ratio to the grid sweep", "cases/s (whole call)",
+               "load average (1 min)"], mc_rows,
               caption="Target: >= 20,000 cases/s inline for every model. All rates measured in this one run on the "
-                      "shared machine; compare them as ratios.")
+                      "shared machine; compare them as ratios. 'cases' excludes reading the case and checking the "
+                      "spec and the sampled box (once per run), 'whole call' includes them.")
     if engine_rows is not None:
         doc.heading("Engines: a geometry sweep (issue 14)")
         doc.para(engine_rows["text"])
-        doc.table(["engine", "workers", "wall time [s]", "speed-up vs inline", "parallel efficiency", "load average (1 min) before"],
+        doc.table(["engine", "workers", "wall time [s]", "speed-up vs inline", "parallel efficiency", "cases ok",
+                   "tables per process", "CPU per table [s]", "CPU share while building", "BLAS threads",
+                   "load average (1 min) before each block"],
                   engine_rows["rows"], caption="Target: >= 1.6x on 2 workers (efficiency >= 80 %).")
     atomic_write_text(report, to_markdown(doc))
     print(f"{s.cases_per_second:.0f} cases/s on {s.workers} workers; report: {report}")
@@ -196,46 +211,134 @@ MC_MODELS = {
     "part4 (Part IV eq. 6)": ('model = "part4"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"',
                               "target.resistance.yield_stress=normal(400 MPa, 20 MPa)"),
     "constant": ('model = "constant"\nvalue = "1.2 GPa"', "target.resistance.value=lognormal(1.2 GPa, 0.05)"),
+    # Part II's AD995 constants (cases/cavity_ad995.toml) as the target's R_t, for the rate only
+    "cavity (Part II, AD995 constants)": ('model = "cavity"\nyoungs_modulus = "373.14 GPa"\npoisson_ratio = 0.232\n'
+                                          'tensile_strength = "0.262 GPa"\ncompressive_strength = "2.62 GPa"',
+                                          "target.resistance.compressive_strength=normal(2.62 GPa, 0.05 GPa)"),
 }
 
 
-def _case_with_resistance(tmp: Path, resistance: str | None) -> Path:
+def _case_with_resistance(tmp: Path, resistance: str | None, name: str = "case") -> Path:
     text = MC_CASE.read_text()
     if resistance is not None:
         head, _, tail = text.partition("[target.resistance]")
         rest = tail.split("\n[", 1)
         text = head + "[target.resistance]\n" + resistance + "\n" + ("\n[" + rest[1] if len(rest) > 1 else "")
-    p = tmp / "case.toml"
+    p = tmp / f"{name}.toml"
     p.write_text(text)
     return p
 
 
 def monte_carlo_rows() -> list[list[str]]:
-    """Rates of the Monte-Carlo path per resistance model, the case-by-case path and the grid sweep."""
+    """Rates of the Monte-Carlo path per resistance model, the case-by-case path and the grid sweep,
+    in one run (the grid sweep first and last: the load drifts), with the ratio to the grid sweep."""
     from semianalytic.sweep.engine import run_sweep
     from semianalytic.sweep.kernels import PenetrationKernel
     from semianalytic.sweep.spec import build_spec
 
-    rows = []
+    runs = []
     common = ["target.density=uniform(2690 kg/m^3, 2730 kg/m^3)", "projectile.density=normal(8020 kg/m^3, 50 kg/m^3)"]
     with tempfile.TemporaryDirectory(prefix="bench_mc_") as tmp:
         tmp = Path(tmp)
+        grid_case = _case_with_resistance(tmp, None, "grid")
+
+        def grid(label):
+            s = run_sweep(grid_case, build_spec(VARY), tmp / "grid", scheduler="inline", progress=False, force=True)
+            runs.append((label, s, os.getloadavg()[0]))
+            return s.cases_per_second
+
+        g0 = grid("grid sweep (Y x U_s, the 10,000 cases above), before")
         for name, (res, sample) in MC_MODELS.items():
-            case = _case_with_resistance(tmp, res)
+            case = _case_with_resistance(tmp, res, f"mc{len(runs)}")
             spec = build_spec([], [sample, *common], 1540, 1)
             s = run_sweep(case, spec, tmp / "mc", scheduler="inline", progress=False, force=True)
-            rows.append([f"Monte Carlo on arrays: {name}", str(s.n_run), str(s.n_ok), f"{s.cases_per_second:.0f}",
-                         f"{os.getloadavg()[0]:.1f}"])
-        case = _case_with_resistance(tmp, None)
+            runs.append((f"Monte Carlo on arrays: {name}", s, os.getloadavg()[0]))
         spec = build_spec([], [MC_MODELS["elastic-plastic (eq. 16)"][1], *common], 40, 1)
-        s = run_sweep(case, spec, tmp / "mc", scheduler="inline", progress=False, force=True,
+        s = run_sweep(grid_case, spec, tmp / "mc", scheduler="inline", progress=False, force=True,
                       kernel=PenetrationKernel(vectorised=False))
-        rows.append(["case by case (before issue 14): elastic-plastic", str(s.n_run), str(s.n_ok),
-                     f"{s.cases_per_second:.0f}", f"{os.getloadavg()[0]:.1f}"])
-        s = run_sweep(case, build_spec(VARY), tmp / "grid", scheduler="inline", progress=False, force=True)
-        rows.append(["grid sweep (Y x U_s, the 10,000 cases above)", str(s.n_run), str(s.n_ok),
-                     f"{s.cases_per_second:.0f}", f"{os.getloadavg()[0]:.1f}"])
-    return rows
+        runs.append(("case by case (before issue 14): elastic-plastic", s, os.getloadavg()[0]))
+        g1 = grid("grid sweep, after")
+    ref = 0.5 * (g0 + g1)
+    return [[label, str(s.n_run), str(s.n_ok), f"{s.cases_per_second:.0f}", f"{s.cases_per_second / ref:.2f}",
+             f"{s.n_run / s.seconds_total:.0f}", f"{load:.1f}"] for label, s, load in runs]
+
+
+@dataclass(frozen=True)
+class _RecordingKernel(PenetrationKernel):
+    """The penetration kernel, recording per coefficient table the worker (pid, session), its wall
+    and CPU time and its BLAS thread limit (one line per table, appended to ``log``)."""
+
+    log: str = ""
+
+    def prepare(self, case):
+        import json
+
+        t, c = time.perf_counter(), time.process_time()
+        table = super().prepare(case)
+        try:
+            from threadpoolctl import threadpool_info
+
+            blas = max((i.get("num_threads", 1) for i in threadpool_info()), default=1)
+        except ImportError:
+            blas = None
+        line = json.dumps({"pid": os.getpid(), "sid": os.getsid(0), "wall": time.perf_counter() - t,
+                           "cpu": time.process_time() - c, "blas_threads": blas,
+                           "openblas_env": os.environ.get("OPENBLAS_NUM_THREADS"),
+                           "malloc_trim": os.environ.get("MALLOC_TRIM_THRESHOLD_")})
+        with open(self.log, "a") as fh:
+            fh.write(line + "\n")
+        return table
+
+
+def _worker_stats(log: Path) -> dict:
+    import json
+
+    recs = [json.loads(x) for x in log.read_text().splitlines()] if log.exists() else []
+    per = {}
+    for r in recs:
+        per.setdefault(r["pid"], []).append(r)
+    wall = sum(r["wall"] for r in recs)
+    cpu = sum(r["cpu"] for r in recs)
+    return {"tables_per_process": sorted((len(v) for v in per.values()), reverse=True),
+            "sessions": len({r["sid"] for r in recs}), "cpu_share": cpu / wall if wall > 0 else float("nan"),
+            "cpu_per_table": cpu / max(len(recs), 1), "blas_threads": sorted({r["blas_threads"] for r in recs}, key=str),
+            "openblas_env": sorted({str(r["openblas_env"]) for r in recs}),
+            "malloc_trim": sorted({str(r.get("malloc_trim")) for r in recs})}
+
+
+_DIAGNOSTIC = """
+import os, sys, time
+from pathlib import Path
+from semianalytic.case import load_case, parse_case
+from semianalytic.sweep.kernels import coefficient_table_for
+from semianalytic.sweep.spec import apply_overrides
+case_file, cache, n = Path(sys.argv[1]), sys.argv[2], int(sys.argv[3])
+case = load_case(case_file)
+coefficient_table_for(parse_case(apply_overrides(case.raw, {"projectile.crh": 9.9}), case_file), cache + "w")
+t0 = os.times()
+for k in range(n):
+    coefficient_table_for(parse_case(apply_overrides(case.raw, {"projectile.crh": 1.05 + 0.1 * k}), case_file), cache)
+t1 = os.times()
+print((t1.user - t0.user) / n, (t1.system - t0.system) / n)
+"""
+
+
+def malloc_diagnostic(case: Path, tmp: Path, n: int = 8) -> dict:
+    """CPU per table (user, system) in a plain process, with and without dask's MALLOC_TRIM_THRESHOLD_."""
+    import subprocess
+    import sys
+
+    out = {}
+    for label, trim in (("plain", None), ("MALLOC_TRIM_THRESHOLD_=65536", "65536")):
+        env = {k: v for k, v in os.environ.items() if k != "MALLOC_TRIM_THRESHOLD_"}
+        env["OPENBLAS_NUM_THREADS"] = "1"
+        if trim:
+            env["MALLOC_TRIM_THRESHOLD_"] = trim
+        res = subprocess.run([sys.executable, "-c", _DIAGNOSTIC, str(case), str(tmp / f"diag_{len(out)}"), str(n)],
+                             env=env, capture_output=True, text=True, check=True)
+        user, system = map(float, res.stdout.split()[-2:])
+        out[label] = (user, system)
+    return out
 
 
 def engine_benchmark(n_designs: int = 64) -> dict:
@@ -247,12 +350,18 @@ def engine_benchmark(n_designs: int = 64) -> dict:
 
     from semianalytic.report.document import fmt
     from semianalytic.sweep.engine import run_sweep
-    from semianalytic.sweep.kernels import PenetrationKernel
     from semianalytic.sweep.spec import build_spec
 
+    from semianalytic.sweep.engine import connect
+
     step = 0.1
-    spec = build_spec([f"projectile.crh=1.0:{1.0 + step * (n_designs - 1):.4f}:{step}"])
-    results = {}
+    crh = [1.0 + step * k for k in range(n_designs)]
+    n_blocks = 4 if n_designs >= 16 else 1
+    blocks = [crh[i::n_blocks] for i in range(n_blocks)]  # interleaved: each block spans the whole range
+    engines = ("inline", "local", "external")
+    walls = dict.fromkeys(engines, 0.0)
+    loads: dict[str, list] = {e: [] for e in engines}
+    summaries: dict = {}
     with tempfile.TemporaryDirectory(prefix="bench_engines_") as tmp:
         tmp = Path(tmp)
         # the optimize case with lighter tables (20 depths to 40 nose lengths): a design costs about a second
@@ -260,17 +369,11 @@ def engine_benchmark(n_designs: int = 64) -> dict:
         text = (ROOT / "cases" / "optimize_fig5_into_fig15a.toml").read_text()
         case.write_text(text.replace("depths = 40", "depths = 20").replace("max_depth_nose_lengths = 60.0",
                                                                           "max_depth_nose_lengths = 40.0"))
-
-        def run(engine, sched):
-            cache = tmp / f"cache_{engine}"
-            load = os.getloadavg()[0]
-            t = time.perf_counter()
-            s = run_sweep(case, spec, tmp / engine, scheduler=sched, workers=2, progress=False, force=True,
-                          kernel=PenetrationKernel(cache_dir=str(cache)))
-            results[engine] = (time.perf_counter() - t, s, load)
-
-        run("inline", "inline")
-        run("local", "local")
+        diag = malloc_diagnostic(case, tmp)
+        t = time.perf_counter()
+        client, cluster, _ = connect("local", 2)  # what run_sweep starts for scheduler="local"
+        local_start = time.perf_counter() - t
+        client.close()
         sched_file = tmp / "scheduler.json"
         env = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         dask = shutil.which("dask", path=str(Path(sys.executable).parent)) or "dask"
@@ -282,19 +385,35 @@ def engine_benchmark(n_designs: int = 64) -> dict:
                 if sched_file.exists() and sched_file.stat().st_size > 0:
                     break
                 time.sleep(0.1)
-            # two worker processes, each in its own session, as workers started by another service are (the
-            # kernel's autogroup scheduling shares the CPU per session: see the report)
+            # two worker processes, each in its own session, as workers started by another service are (and as
+            # the LocalCluster's workers move themselves: sweep.engine.own_session)
             for _ in range(2):
-                procs.append(subprocess.Popen([dask, "worker", "--scheduler-file", str(sched_file), "--nworkers", "1",
-                                               "--nthreads", "1", "--no-dashboard"], env=env, start_new_session=True,
+                # --no-nanny: a nanny would set MALLOC_TRIM_THRESHOLD_ (see sweep.engine.connect)
+                procs.append(subprocess.Popen([dask, "worker", "--scheduler-file", str(sched_file), "--nthreads", "1",
+                                               "--no-nanny", "--no-dashboard"], env=env, start_new_session=True,
                                               stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL))
             address = json.loads(sched_file.read_text())["address"]
             from dask.distributed import Client
 
             with Client(address, timeout="30s") as c:
                 c.wait_for_workers(2, timeout=120)
-            run("external", address)
+            sched = {"inline": "inline", "local": cluster.scheduler_address, "external": address}
+            # the engines take turns block by block (order rotated), so each sees the same load of the other
+            # sessions on this shared machine
+            for b, values in enumerate(blocks):
+                spec = build_spec(["projectile.crh=" + ",".join(f"{v:.4f}" for v in values)])
+                for engine in engines[b % 3:] + engines[: b % 3]:
+                    loads[engine].append(os.getloadavg()[0])
+                    t = time.perf_counter()
+                    s = run_sweep(case, spec, tmp / f"{engine}{b}", scheduler=sched[engine], workers=2,
+                                  progress=False, force=True,
+                                  kernel=_RecordingKernel(cache_dir=str(tmp / f"cache_{engine}"),
+                                                          log=str(tmp / f"log_{engine}.jsonl")))
+                    walls[engine] += time.perf_counter() - t
+                    summaries.setdefault(engine, []).append(s)
+            stats = {e: _worker_stats(tmp / f"log_{e}.jsonl") for e in engines}
         finally:
+            cluster.close()
             for p in reversed(procs):
                 p.terminate()
             for p in procs:
@@ -302,28 +421,59 @@ def engine_benchmark(n_designs: int = 64) -> dict:
                     p.wait(timeout=30)
                 except subprocess.TimeoutExpired:
                     p.kill()
-    base = results["inline"][0]
+    base = walls["inline"]
     rows = []
-    for engine, (wall, s, load) in results.items():
+    for engine in engines:
+        wall, st = walls[engine], stats[engine]
+        n_ok = sum(x.n_ok for x in summaries[engine])
+        workers = summaries[engine][0].workers
         speed = base / wall
-        rows.append([f"{engine} ({s.scheduler if engine != 'external' else 'dask scheduler + 2 x dask worker, own sessions'})",
-                     str(s.workers), fmt(wall, 4), f"{speed:.2f}x", f"{100 * speed / max(s.workers, 1):.0f} %",
-                     f"{load:.1f}"])
+        name = {"inline": "inline (this process)", "local": "LocalCluster (2 x 1 thread, processes, own sessions)",
+                "external": "dask scheduler + 2 x dask worker --no-nanny (own sessions)"}[engine]
+        started = f"{speed:.2f}x" if engine != "local" else f"{speed:.2f}x ({base / (wall + local_start):.2f}x with the start)"
+        rows.append([name, str(workers), fmt(wall, 4) + (f" + {local_start:.1f} start" if engine == "local" else ""),
+                     started, f"{100 * speed / max(workers, 1):.0f} %", str(n_ok),
+                     " / ".join(str(n) for n in st["tables_per_process"]), f"{st['cpu_per_table']:.2f}",
+                     f"{st['cpu_share']:.2f}", ", ".join(map(str, st["blas_threads"])),
+                     ", ".join(f"{v:.1f}" for v in loads[engine])])
+    autogroup = Path("/proc/sys/kernel/sched_autogroup_enabled")
+    ag = autogroup.read_text().strip() if autogroup.exists() else "n/a"
     text = (f"`--vary projectile.crh=1.0:{1.0 + step * (n_designs - 1):.1f}:{step}` on "
             f"`cases/optimize_fig5_into_fig15a.toml` with lighter tables (20 depths to 40 nose lengths): "
             f"{n_designs} ogive designs x 7 striking velocities; every design builds its own BEM coefficient table, "
-            "each engine with an empty table cache. Wall time of the whole `run_sweep` call, including starting the LocalCluster (the external "
-            "cluster is started beforehand, as a user's would be). Without `--scheduler` the sweep now picks the "
-            f"engine itself: this sweep ({n_designs} geometries) goes to a local cluster, a velocity or material "
-            "sweep on one table runs inline (`sweep/engine.py: choose_engine`). "
-            "How to read the speed-ups on this shared machine: the kernel schedules with autogroups "
-            "(`/proc/sys/kernel/sched_autogroup_enabled` = 1), which share the CPU fairly between *sessions*, not "
-            "processes. The inline run and the LocalCluster's workers (started by this process) are one session: "
-            "while the other helpers keep both cores busy, two local workers get the same CPU share as one inline "
-            "process, so the local cluster cannot be faster here (measured inside the tasks: CPU time per table "
-            "about the same, wall time per table two to four times longer on the workers). The external workers are "
-            "started in their own sessions, as workers started by another service or on other machines are, and get "
-            "their own shares. On an otherwise idle machine the three engines share the same two cores.")
+            "each engine with an empty table cache. The designs run in 4 interleaved blocks of 16 and the engines "
+            "take turns block by block (order rotated), so that all three see the same load of the other sessions "
+            "on this shared machine; wall time = the sum of the blocks' `run_sweep` calls; the LocalCluster "
+            "(started by `sweep.engine.connect`, as `run_sweep` starts it) is started once and its start time given "
+            "apart, the external cluster is started beforehand, as a user's would be. Without `--scheduler` "
+            "the sweep picks the engine itself (`sweep/engine.py: choose_engine`): this sweep goes to a local "
+            "cluster, a velocity or material sweep on one table runs inline. Recorded inside every table build: "
+            "which process built it (tables per process: both workers get work), its CPU time, the CPU share (CPU "
+            "time / wall time of the builds: 1.0 = a whole core while building) and the BLAS thread limit "
+            "(threadpoolctl).\n\n"
+            "What made the local cluster slower than inline (0.84x in the previous version of this report), found by "
+            "timing the same table builds in one plain process and inside dask workers: (1) dask starts its "
+            "workers with MALLOC_TRIM_THRESHOLD_ = 65536 (`distributed.nanny.pre-spawn-environ`); an explicit trim "
+            "threshold turns off glibc's dynamic mmap threshold, so every large array of the BEM is mmap-ed and "
+            "page-faulted afresh. Measured in this run, 8 tables in a plain process: CPU per table (user + system) "
+            + " against ".join(f"{u + sy:.2f} s ({sy:.2f} s system) {lab}" for lab, (u, sy) in
+                               [("with MALLOC_TRIM_THRESHOLD_ = 65536", diag["MALLOC_TRIM_THRESHOLD_=65536"]),
+                                ("without", diag["plain"])])
+            + "; the LocalCluster now starts its workers without it, and the "
+            "external workers here run without a nanny (`dask worker --no-nanny`), which does not set it; (2) the "
+            "workers' statistical profiler (a thread sampling the task's stack every 10 ms, for the dashboard) is "
+            "off (the table below gives the CPU per table in the workers against inline); (3) the "
+            "kernel's autogroup scheduling (`/proc/sys/kernel/sched_autogroup_enabled` = "
+            f"{ag}) shares the CPU between sessions, so workers left in the sweep's session share one session's "
+            "share while other sessions keep the cores busy (measured: the two local workers at about 50 % of a core "
+            "each beside another session's one process at 95 %); the LocalCluster's workers now move into sessions "
+            "of their own (`own_session`), as workers started by a scheduler service are; (4) every table went to "
+            "the client and was broadcast to every worker before the cases started; now one task per design "
+            "builds its table and evaluates its cases. The BLAS thread limit is 1 in the workers (the inline "
+            "process keeps its 2 threads). The speed-up still depends on the other sessions' load: with k busy "
+            "sessions on 2 cores, one inline process gets about 2/(k+1) of a core and two workers about "
+            "2 x 2/(k+2), so at best 2 on an idle machine and (2k+2)/(k+2) on a shared one (1.33 for k = 1); "
+            "the load averages are given.")
     return {"rows": rows, "text": text}
 
 

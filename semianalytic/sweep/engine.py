@@ -32,7 +32,7 @@ from semianalytic.errors import InputError
 from semianalytic.io import atomic_write_json
 from semianalytic.sweep.kernels import Kernel, select_kernel
 from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
-from semianalytic.sweep.store import ResultStore, results_path
+from semianalytic.sweep.store import Columns, ResultStore, results_path
 
 BASE_COLUMNS = ("case_id", "status", "message")
 MANIFEST = "sweep.json"
@@ -49,6 +49,7 @@ class Payload:
     kernel: Kernel
     draws: Mapping[str, np.ndarray]
     resources: Mapping[Any, Any]  # geometry key -> prepared resource (coefficient table)
+    arrays_valid: bool = False  # the sampled box of the whole run checked once (Monte Carlo on arrays)
 
 
 @dataclass
@@ -100,8 +101,9 @@ def _parse_cached(raw_json: str, overrides_json: str, case_path: str | None) -> 
     return parse_case(raw, Path(case_path) if case_path else None)
 
 
-def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
-    """Rows for the case ids: inputs (SI), status and the kernel's outputs.
+def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict] | Columns:
+    """Rows for the case ids: inputs (SI), status and the kernel's outputs (as columns on the
+    Monte-Carlo array path).
 
     Cases that differ only in the kernel's fast keys (the striking velocity) share one
     validated case and are evaluated together, vectorised.
@@ -115,7 +117,7 @@ def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict]:
     slow = [k for k in spec.keys if k not in kernel.fast_keys]
     fast = [k for k in spec.keys if k in kernel.fast_keys]
     arrays = [k for k in slow if getattr(kernel, "is_array_key", lambda _: False)(k)]
-    if arrays and _ranges_valid(payload, values, arrays):
+    if arrays and (payload.arrays_valid or _ranges_valid(payload, values, arrays)):
         return _evaluate_arrays(payload, ids, values, [k for k in slow if k not in arrays], fast + arrays)
 
     groups: dict[tuple, list[int]] = defaultdict(list)
@@ -177,20 +179,40 @@ def _ranges_valid(payload: Payload, values: Mapping[str, np.ndarray], keys: list
     return payload.kernel.accepts_arrays(case, keys)
 
 
-def _evaluate_arrays(payload: Payload, ids: np.ndarray, values, slow: list[str], vector: list[str]) -> list[dict]:
-    """Rows of a batch whose sampled fields are evaluated on arrays (kernel.evaluate_arrays): one
+def _check_arrays_once(payload: Payload, pending: np.ndarray) -> Payload:
+    """Monte Carlo on arrays: check the corners of the whole run's sampled box once, here, so the
+    batches need not (a batch whose box is not known valid checks its own corners)."""
+    import dataclasses
+
+    kernel, spec = payload.kernel, payload.spec
+    is_array = getattr(kernel, "is_array_key", lambda _: False)
+    arrays = [k for k in spec.keys if k not in kernel.fast_keys and is_array(k)]
+    if not arrays or len(arrays) > 6:
+        return payload
+    values = spec.values(pending, payload.draws)
+    return dataclasses.replace(payload, arrays_valid=_ranges_valid(payload, values, arrays))
+
+
+def _evaluate_arrays(payload: Payload, ids: np.ndarray, values, slow: list[str], vector: list[str]) -> Columns:
+    """Columns of a batch whose sampled fields are evaluated on arrays (kernel.evaluate_arrays): one
     validated case per combination of the remaining slow (grid) keys."""
     spec, kernel = payload.spec, payload.kernel
     units, integer, columns = spec.units(), spec.integer_keys(), spec.columns
-    groups: dict[tuple, list[int]] = defaultdict(list)
-    for j in range(len(ids)):
-        groups[tuple(float(values[k][j]) for k in slow)].append(j)
-    out_rows: list[dict] = [None] * len(ids)  # type: ignore[list-item]
+    n = len(ids)
+    if slow:
+        groups: dict[tuple, list[int]] = defaultdict(list)
+        for j in range(n):
+            groups[tuple(float(values[k][j]) for k in slow)].append(j)
+        parts = [(g, np.asarray(i)) for g, i in groups.items()]
+    else:
+        parts = [((), np.arange(n))]
     names = list(kernel.columns)
-    for gvals, idx in groups.items():
-        idx = np.asarray(idx)
+    data: dict[str, np.ndarray] = {"case_id": np.asarray(ids, np.int64)}
+    data.update({columns[k]: np.asarray(values[k], float) for k in spec.keys})
+    data["status"] = np.full(n, "", dtype=object)
+    data["message"] = np.full(n, "", dtype=object)
+    for gvals, idx in parts:
         overrides = {k: raw_value(v, units[k], k in integer) for k, v in zip(slow, gvals)}
-        inputs = {columns[k]: values[k][idx] for k in spec.keys}
         try:
             case = _parse_cached(payload.raw_json, json.dumps(overrides, sort_keys=True), payload.case_path)
             resource = payload.resources.get(kernel.resource_key(case))
@@ -201,15 +223,14 @@ def _evaluate_arrays(payload: Payload, ids: np.ndarray, values, slow: list[str],
         except InputError as exc:
             res = {c: np.full(len(idx), np.nan) for c in names}
             status, message = np.full(len(idx), "invalid", object), np.full(len(idx), str(exc), object)
-        cols = {c: np.asarray(res[c]).tolist() for c in names}
-        ins = {c: v.tolist() for c, v in inputs.items()}
-        st, msg = status.tolist(), message.tolist()
-        for n, j in enumerate(idx.tolist()):
-            row = {"case_id": int(ids[j]), **{c: v[n] for c, v in ins.items()}, "status": st[n], "message": msg[n]}
-            for c in names:
-                row[c] = cols[c][n]
-            out_rows[j] = row
-    return out_rows
+        for c in names:
+            col = np.asarray(res[c])
+            if c not in data:
+                data[c] = np.empty(n, dtype=col.dtype if col.dtype.kind in "fb" else object)
+            data[c][idx] = col
+        data["status"][idx] = status
+        data["message"][idx] = message
+    return Columns(data)
 
 
 def warm_up() -> bool:
@@ -278,6 +299,16 @@ def _batches(ids: np.ndarray, size: int) -> list[np.ndarray]:
     return [ids[i : i + size] for i in range(0, len(ids), size)]
 
 
+def _geometry_batches(spec: SweepSpec, kernel: Kernel, pending: np.ndarray, draws, size: int) -> list[np.ndarray]:
+    """Batches that each hold the cases of one geometry (one coefficient table), at most ``size``."""
+    geo = [k for k in spec.keys if kernel.affects_resource(k)]
+    vals = spec.values(pending, draws)
+    groups: dict[tuple, list[int]] = defaultdict(list)
+    for j, cid in enumerate(pending.tolist()):
+        groups[tuple(float(vals[k][j]) for k in geo)].append(cid)
+    return [b for ids in groups.values() for b in _batches(np.asarray(ids, np.int64), size)]
+
+
 def check_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict) -> bool:
     """Check the output folder (nothing is changed); returns True for a fresh start."""
     res = results_path(out, fmt)
@@ -333,6 +364,25 @@ def choose_engine(scheduler: str | None, n_cases: int, n_geometries: int, second
     return "local" if work > 2.0 * LOCAL_START_SECONDS else "inline"
 
 
+def own_session() -> int:
+    """Move this (worker) process into a session of its own (``setsid``); returns its session id.
+
+    Linux's autogroup scheduling (``/proc/sys/kernel/sched_autogroup_enabled``) shares the CPU
+    fairly between sessions, not processes: a LocalCluster's workers, started by the sweep's
+    process, would share its session's one share, so on a machine where other sessions keep the
+    cores busy two local workers run no faster than one inline process (measured: two workers at
+    about 50 % of a core each beside another session's process at 95 %; reports/bench_sweep.md).
+    In their own sessions they get a share each, as workers started by a dask scheduler service
+    or a batch system do.  Harmless otherwise: the nanny still supervises and stops the worker
+    (it exits with its nanny's pipe, not with the terminal), and no CPU is taken that another
+    session of the same size would not get."""
+    try:
+        os.setsid()
+    except OSError:  # already a session or group leader (e.g. an external worker): nothing to do
+        pass
+    return os.getsid(0)
+
+
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address (InputError if it cannot be used)."""
@@ -342,11 +392,24 @@ def connect(scheduler: str | None, workers: int):
     from dask.distributed import Client, LocalCluster
 
     if sched == "local":
-        cluster = LocalCluster(
-            n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-            silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
-        )
-        return Client(cluster), cluster, "local"
+        import dask
+
+        # dask sets MALLOC_TRIM_THRESHOLD_ = 65536 in the workers it spawns; an explicit trim threshold turns
+        # off glibc's dynamic mmap threshold, so every large array is mmap-ed and page-faulted afresh: a BEM
+        # table then costs 1.6x the CPU (0.71 -> 1.12 s, mostly system time; reports/bench_sweep.md)
+        environ = {k: v for k, v in dask.config.get("distributed.nanny.pre-spawn-environ", {}).items()
+                   if k != "MALLOC_TRIM_THRESHOLD_"}
+        environ.update(OPENBLAS_NUM_THREADS=1, OMP_NUM_THREADS=1, MKL_NUM_THREADS=1)
+        # and no statistical profiler in the workers (a thread that samples the task's stack every 10 ms,
+        # for the dashboard, which a sweep does not open)
+        with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False}):
+            cluster = LocalCluster(
+                n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
+                silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+            )
+        client = Client(cluster)
+        client.run(own_session)
+        return client, cluster, "local"
     client = None
     try:
         client = Client(sched, timeout="10s")
@@ -422,9 +485,17 @@ def run_sweep(
         if len(rcases) > 20:
             print(f"warning: {len(rcases)} distinct nose geometries: each needs its own BEM coefficient table "
                   "(seconds each, cached on disk)", file=sys.stderr)
+        per_geometry = client is not None and len(rcases) > 1
         if client is None:
             resources = {k: kernel.prepare(c) for k, c in rcases.items()}
             summary.workers = 1
+        elif per_geometry:
+            # a geometry sweep on workers: each task builds (or loads from the disk cache) the table of its
+            # own geometry and evaluates that geometry's cases, so no table travels to the client and back
+            # to every worker, and no worker waits for all tables before the cases start
+            summary.workers = len(client.scheduler_info().get("workers", {})) or workers
+            client.run(warm_up)
+            resources = {}
         else:
             summary.workers = len(client.scheduler_info().get("workers", {})) or workers
             client.run(warm_up)
@@ -433,9 +504,10 @@ def run_sweep(
         summary.seconds_prepare = time.perf_counter() - t_prep
 
         payload = Payload(json.dumps(case.raw), str(case_path), spec, kernel, draws, resources)
+        payload = _check_arrays_once(payload, pending)
         nw = max(1, summary.workers)
         size = batch_size or int(min(2000, max(20, math.ceil(len(pending) / (8 * nw)))))
-        batches = _batches(pending, size)
+        batches = _geometry_batches(spec, kernel, pending, draws, size) if per_geometry else _batches(pending, size)
         t_cases = time.perf_counter()
         bar = _progress(len(pending), progress)
         try:
@@ -486,16 +558,13 @@ def output_statistics(store: ResultStore, columns) -> dict:
     return out
 
 
-def _record(store: ResultStore, rows: list[dict], summary: SweepSummary, bar, on_batch) -> None:
+def _record(store: ResultStore, rows: list[dict] | Columns, summary: SweepSummary, bar, on_batch) -> None:
     store.append(rows)
-    for r in rows:
-        s = r.get("status")
-        if s == "ok":
-            summary.n_ok += 1
-        elif s == "invalid":
-            summary.n_invalid += 1
-        else:
-            summary.n_error += 1
+    statuses = rows.data["status"].tolist() if isinstance(rows, Columns) else [r.get("status") for r in rows]
+    n_ok, n_invalid = statuses.count("ok"), statuses.count("invalid")
+    summary.n_ok += n_ok
+    summary.n_invalid += n_invalid
+    summary.n_error += len(statuses) - n_ok - n_invalid
     if bar is not None:
         bar.update(len(rows))
     if on_batch is not None:

@@ -88,6 +88,8 @@ class PenetrationKernel:
     fast_keys: frozenset = frozenset({VELOCITY_KEY})
     # per-process cache of unit-resistance depth profiles (see _rigid); not part of the identity
     _profiles: dict = field(default_factory=dict, compare=False, repr=False)
+    _derived: dict = field(default_factory=dict, compare=False, repr=False)  # per-case constants (evaluate_arrays)
+    _tables: dict = field(default_factory=dict, compare=False, repr=False)  # geometry key -> table (prepare)
 
     @property
     def seconds_per_case(self) -> float:
@@ -135,62 +137,83 @@ class PenetrationKernel:
             model = resistance_from_case(case)
         except InputError:
             return False
-        names = {f.name for f in dataclasses.fields(model)}
+        names = {f.name for f in dataclasses.fields(_fields_owner(model))}
         return all(f in names for f in res)
+
+    def _per_case(self, case: Case, coefficients):
+        """What a batch needs from its (validated, cached) case: the resistance model, the
+        projectile's volume and mass, and the U_sC inputs; kept per worker, reused by every batch."""
+        key = (id(case), id(coefficients))
+        hit = self._derived.get(key)
+        if hit is not None and hit[0] is case and hit[1] is coefficients:
+            return hit[2]
+        from semianalytic.geometry import projectile_from_section
+        from semianalytic.penetration.curve import PenetrationSetup
+        from semianalytic.penetration.resistance import resistance_from_case
+
+        psec = case.require("projectile")
+        proj = projectile_from_section(psec)
+        setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
+        derived = {
+            "resistance": resistance_from_case(case),
+            "volume": proj.volume(),
+            "mass": proj.mass,
+            "target_density": float(case.require("target").density),
+            "critical": setup.critical_inputs() if setup.rod is not None and setup.yield_stress is not None else None,
+            "yield_stress": setup.yield_stress,
+            "phi": setup.phi,
+        }
+        if len(self._derived) > 64:
+            self._derived.clear()
+        self._derived[key] = (case, coefficients, derived)
+        return derived
 
     def evaluate_arrays(self, case: Case, coefficients, arrays: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         """Rigid depth, U_sC and the yield flag per sample (see :func:`semianalytic.penetration.batch.final_depths`).
 
         R_t per sample from the case's resistance model with the sampled fields replaced (its
-        closed form: eqs. (16)-(19), Part IV eq. (6)); rho, m per sample; one table for all."""
-        import dataclasses
-
-        from semianalytic.geometry import projectile_from_section
-        from semianalytic.penetration import critical as crit
-        from semianalytic.penetration.batch import final_depths
-        from semianalytic.penetration.curve import PenetrationSetup
-        from semianalytic.penetration.resistance import resistance_from_case
+        closed form on arrays: eqs. (16)-(19), Part IV eq. (6)); rho, m per sample; one table for
+        all; U_sC of eqs. (33)/(34) on arrays (:func:`semianalytic.penetration.batch.critical_velocities`)."""
+        from semianalytic.penetration.batch import critical_velocities, final_depths
 
         U = np.asarray(arrays[VELOCITY_KEY], float)
         n = U.size
         psec = case.require("projectile")
+        d = self._per_case(case, coefficients)
         status = np.full(n, "ok", dtype=object)
         message = np.full(n, "", dtype=object)
-        base = resistance_from_case(case)
+        base = d["resistance"]
         res_fields = {k.rsplit(".", 1)[1]: np.asarray(v, float) for k, v in arrays.items() if k.startswith("target.resistance.")}
         if res_fields:
             R, bad_msg = resistance_per_sample(base, res_fields, psec.diameter)
+            R = np.broadcast_to(np.asarray(R, float), (n,))
             status[bad_msg != ""] = "invalid"
             message[:] = bad_msg
         else:
             R = np.full(n, float(base.pressure(psec.diameter)))
-        rho = np.broadcast_to(np.asarray(arrays.get("target.density", case.require("target").density), float), (n,))
-        proj = projectile_from_section(psec)
+        rho = np.broadcast_to(np.asarray(arrays.get("target.density", d["target_density"]), float), (n,))
         rho_p = None
         if "projectile.mass" in arrays:
             m = np.asarray(arrays["projectile.mass"], float)
         elif "projectile.density" in arrays and psec.mass is None:
             rho_p = np.asarray(arrays["projectile.density"], float)
-            m = rho_p * proj.volume()
+            m = rho_p * d["volume"]
         else:
-            m = np.full(n, proj.mass)
+            m = np.full(n, d["mass"])
         m = np.broadcast_to(m, (n,))
         bad = ~(np.isfinite(R) & (R > 0) & (U > 0))
         status[bad & (status == "ok")] = "invalid"
         message[bad & (message == "")] = "R_t and U_s must be positive"
         ok = ~bad
         depth = np.full(n, np.nan)
+        Usc = np.full(n, np.nan)
         if ok.any():
             depth[ok] = final_depths(coefficients, m[ok], rho[ok], R[ok], U[ok])
-        setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
-        Usc = np.full(n, np.nan)
-        if setup.rod is not None and setup.yield_stress is not None:
-            ci = setup.critical_inputs()
-            dens = np.full(n, ci.density) if rho_p is None else rho_p
-            Rl, rl, ml, dl = R.tolist(), rho.tolist(), m.tolist(), dens.tolist()
-            for i in np.flatnonzero(ok).tolist():
-                c = crit.CriticalInputs(ci.youngs_modulus, dl[i], ml[i], ci.diameter, ci.A, ci.B, ci.C, rl[i], Rl[i])
-                Usc[i] = crit.critical_velocity(setup.yield_stress, c, setup.phi)
+            ci = d["critical"]
+            if ci is not None:
+                dens = np.full(n, ci.density) if rho_p is None else rho_p
+                Usc[ok] = critical_velocities(d["yield_stress"], ci.youngs_modulus, dens[ok], m[ok], ci.diameter, ci.A,
+                                              ci.B, ci.C, rho[ok], R[ok], d["phi"])
         return {
             "depth_rigid_m": depth,
             "critical_velocity_m_s": Usc,
@@ -208,7 +231,13 @@ class PenetrationKernel:
     def prepare(self, case: Case):
         if self.coefficients is not None:
             return self.coefficients
-        return coefficient_table_for(case, self.cache_dir)
+        key = geometry_key(case)
+        table = self._tables.get(key)
+        if table is None:  # kept per worker: the batches of a geometry sweep ask again for their table
+            if len(self._tables) >= 8:
+                self._tables.pop(next(iter(self._tables)))
+            table = self._tables[key] = coefficient_table_for(case, self.cache_dir)
+        return table
 
     def evaluate(self, case: Case, coefficients, fast: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
         U = np.asarray(fast[VELOCITY_KEY], float)
@@ -263,22 +292,50 @@ class PenetrationKernel:
         }
 
 
-def _pressures(base, cols: Mapping[str, list], diameter) -> tuple[np.ndarray, np.ndarray]:
-    """R_t of the model ``base`` with the fields in ``cols`` replaced, sample by sample."""
+def _fields_owner(model):
+    """The dataclass holding a resistance model's case fields: the model, or the Part II cavity
+    model's material (``[target.resistance]`` of model "cavity" gives the material's fields)."""
+    material = getattr(model, "material", None)
+    return material if material is not None else model
+
+
+def _with_fields(base, values: Mapping[str, Any]):
+    """The resistance model ``base`` with the case fields in ``values`` replaced."""
     import dataclasses
 
+    owner = _fields_owner(base)
+    kw = {f.name: getattr(owner, f.name) for f in dataclasses.fields(owner)}
+    kw.update(values)
+    new = type(owner)(**kw)
+    return type(base)(new) if owner is not base else new
+
+
+def _pressures(base, cols: Mapping[str, list], diameter) -> tuple[np.ndarray, np.ndarray]:
+    """R_t of the model ``base`` with the fields in ``cols`` replaced, sample by sample."""
     n = len(next(iter(cols.values())))
     R = np.empty(n)
     msg = np.full(n, "", dtype=object)
-    model, kw = type(base), {f.name: getattr(base, f.name) for f in dataclasses.fields(base)}
     for i in range(n):
         try:
-            for f, v in cols.items():
-                kw[f] = v[i]
-            R[i] = model(**kw).pressure(diameter)
+            R[i] = _with_fields(base, {f: v[i] for f, v in cols.items()}).pressure(diameter)
         except (ValueError, ArithmeticError, InputError) as exc:
             R[i], msg[i] = np.nan, f"target.resistance: {exc}"
     return R, msg
+
+
+def _pressures_on_arrays(base, fields: Mapping[str, np.ndarray], diameter):
+    """R_t of the model's closed form evaluated on the sample arrays at once (eqs. (16), (17), (19),
+    Part IV eq. (6), constant), or None where the model has no array form (eq. (18)'s integral
+    and the Part II cavity model) or a sample is out of its range (then per sample, with messages)."""
+    n = len(next(iter(fields.values())))
+    try:
+        with np.errstate(all="ignore"):
+            R = np.asarray(_with_fields(base, {f: np.asarray(v, float) for f, v in fields.items()}).pressure(diameter), float)
+    except (TypeError, ValueError, ArithmeticError, InputError):
+        return None
+    if R.ndim > 1 or R.size not in (1, n) or not np.all(np.isfinite(R) & (R > 0)):
+        return None
+    return np.broadcast_to(R, (n,)).copy()
 
 
 def resistance_per_sample(base, fields: Mapping[str, np.ndarray], diameter, n_nodes: int = 17):
@@ -289,6 +346,9 @@ def resistance_per_sample(base, fields: Mapping[str, np.ndarray], diameter, n_no
     three samples and used only if it agrees to 1e-11, else every sample is evaluated."""
     n = len(next(iter(fields.values())))
     names = list(fields)
+    R = _pressures_on_arrays(base, fields, diameter)
+    if R is not None:
+        return R, np.full(n, "", dtype=object)
     if len(names) <= 2 and n > 4 * n_nodes ** len(names):
         from semianalytic.penetration.batch import chebyshev_weights
 

@@ -49,6 +49,37 @@ def _cell(v) -> str:
     return str(v)
 
 
+class Columns:
+    """A batch of results as columns (name -> array), the Monte-Carlo array path's output: written
+    without building a dict per row."""
+
+    def __init__(self, data: Mapping[str, np.ndarray]):
+        self.data = dict(data)
+
+    def __len__(self) -> int:
+        return len(next(iter(self.data.values()))) if self.data else 0
+
+    def rows(self) -> list[dict]:
+        cols = {c: np.asarray(v).tolist() for c, v in self.data.items()}
+        return [dict(zip(cols, vals)) for vals in zip(*cols.values())]
+
+
+def _cells(values) -> list[str]:
+    """The CSV cells of a column, as :func:`_cell` writes them one by one."""
+    a = np.asarray(values)
+    if a.dtype.kind == "f":
+        out = list(map(repr, a.tolist()))  # Python floats: repr round-trips
+        if not np.all(np.isfinite(a)):
+            for i in np.flatnonzero(~np.isfinite(a)).tolist():
+                out[i] = ""
+        return out
+    if a.dtype.kind == "b":
+        return np.where(a, "true", "false").tolist()
+    if a.dtype.kind in "iu":
+        return list(map(str, a.tolist()))
+    return [_cell(v) for v in a.tolist()]
+
+
 class ResultStore:
     """Append-only results of one sweep (see the module docstring)."""
 
@@ -132,6 +163,8 @@ class ResultStore:
 
     def append(self, rows: Iterable[Mapping]) -> int:
         """Append finished rows (dicts keyed by column); returns how many were written."""
+        if isinstance(rows, Columns):
+            return self._append_columns(rows)
         rows = list(rows)
         if not rows:
             return 0
@@ -152,6 +185,20 @@ class ResultStore:
             atomic_write_bytes(self.path / f"part-{self._part:06d}.parquet", buf.getvalue())
             self._part += 1
         return len(rows)
+
+    def _append_columns(self, batch: Columns) -> int:
+        n = len(batch)
+        if n == 0:
+            return 0
+        if self.fmt != "csv":
+            return self.append(batch.rows())
+        empty = [""] * n
+        cells = [_cells(batch.data[c]) if c in batch.data else empty for c in self.columns]
+        buf = io.StringIO()
+        csv.writer(buf, lineterminator="\n").writerows(zip(*cells))
+        os.write(self._fh.fileno(), buf.getvalue().encode())  # one write per batch
+        os.fsync(self._fh.fileno())
+        return n
 
     def close(self) -> None:
         if self._fh is not None:
