@@ -37,7 +37,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-from scipy.optimize import brentq
 
 from semianalytic.errors import InputError
 
@@ -166,4 +165,6 @@ def yield_stress_from_critical_velocity(U_sC: float, inputs: CriticalInputs, phi
         lo, hi = hi, hi * 2.0
         if hi > 1e13:
             raise InputError("critical_velocity", f"{U_sC:g} m/s is not reached by eq. (33) for any yield stress")
+    from scipy.optimize import brentq  # only the inverse problem needs it (start-up time)
+
     return brentq(f, lo, hi, xtol=1e-6, rtol=1e-14)

@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.optimize import brentq
 
 from semianalytic.penetration import rod as rodmod
 from semianalytic.penetration.motion import MotionResult, deep_coefficients, solve_motion
@@ -271,6 +270,8 @@ def solve_elastic(
         if len(idx) == 0 or idx[0] == 0:
             t_star = T if len(idx) == 0 else 0.0
         else:
+            from scipy.optimize import brentq  # loaded on use (start-up time)
+
             j = idx[0]
             t_star = T if vals[j] == 0.0 and j == len(grid) - 1 else brentq(g, grid[j - 1], grid[j], xtol=1e-16, rtol=1e-15)
     res = ElasticResult(U_s=float(U_s), U0=U0, sigma0=sigma0, t_star=float(t_star), final_depth=0.0,

@@ -27,7 +27,6 @@ import math
 from dataclasses import dataclass, field
 
 import numpy as np
-from scipy.integrate import solve_ivp
 
 __all__ = [
     "MotionResult",
@@ -235,6 +234,8 @@ def solve_motion(
         t_max = 10.0 * ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U0).penetration_time + 100.0 * d / U0
     if atol is None:
         atol = rtol * np.array([d, U0])
+    from scipy.integrate import solve_ivp  # time histories only (start-up time)
+
     sol = solve_ivp(rhs, (0.0, t_max), [0.0, U0], method=method, rtol=rtol, atol=atol, events=stop, dense_output=True)
     if sol.status != 1 or not len(sol.t_events[0]):
         raise RuntimeError(f"eq. (11) did not reach u = 0 before t = {t_max:g} s ({sol.message})")
@@ -523,6 +524,8 @@ class SeparatedProfile:
             stop.terminal, stop.direction = True, -1
             A8, B8, C8 = deep_coefficients(wc.table)
             P_end = 10.0 * ConstantCoefficientSolution(A8, B8, C8, wc.mass, wc.rho, wc.R, U0).final_depth + 100.0 * d
+            from scipy.integrate import solve_ivp  # separated contact only (start-up time)
+
             sol = solve_ivp(rhs, (0.0, P_end), [U0 * U0], method="DOP853", rtol=self.rtol, atol=self.rtol * U0 * U0,
                             events=stop, dense_output=True)
             if U0 == 0.0:
