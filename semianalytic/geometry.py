@@ -301,6 +301,13 @@ class Nose:
     def radius(self) -> float:
         return 0.5 * self.diameter
 
+    @property
+    def depth_unit(self) -> float:
+        """The unit of a table's depth range (``max_depth_nose_lengths``): L_h, or the radius
+        where the nose is shorter than its radius (flat, short blunted noses), so that the
+        deep limit is always reached within the same number of calibres."""
+        return max(self.length, self.radius)
+
     def meridian(self) -> Meridian:
         return Meridian(self.segments, closed=False)
 

@@ -112,7 +112,7 @@ def _estimated_nose_panels(nose, refinement: float, levels: int) -> float:
 def _arithmetic_unknowns(nose, order: int, refinement: float, max_depth_nose_lengths: float, levels: int = 12) -> float:
     """Primary unknowns of the deepest half-space layout by arithmetic only (no layout built)."""
     estimate = _estimated_nose_panels(nose, refinement, levels)
-    length = (max_depth_nose_lengths - 1) * max(nose.length, nose.radius)
+    length = (max_depth_nose_lengths - 1) * nose.depth_unit
     shank = levels + max(0.0, math.log2(max(length / nose.radius, 1.0)) * refinement) + 2
     return order * (estimate + shank)
 
@@ -125,9 +125,7 @@ def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_de
     estimate = _estimated_nose_panels(nose, refinement, levels)
     if estimate > EXACT_PLAN_PANELS:
         return _arithmetic_unknowns(nose, order, refinement, max_depth_nose_lengths, levels)
-    # the tables' depth unit: L_h, or the radius for a flat nose (L_h = 0)
-    scale = nose.length if nose.length > 0.05 * nose.radius else nose.radius
-    layout = halfspace_layout(nose, max_depth_nose_lengths * scale, LayoutOptions(order, refinement, levels))
+    layout = halfspace_layout(nose, max_depth_nose_lengths * nose.depth_unit, LayoutOptions(order, refinement, levels))
     return float(order * sum(len(p.panels) for p in layout.pieces))
 
 

@@ -276,3 +276,18 @@ def test_table_study_200_depths(kind):
         assert study[q]["bounded"] == study[q]["n"], (q, study[q])
         if table.options["noise_limited_intervals"] == 0:
             assert study[q]["max_rel_error"] <= TOL, (q, study[q])
+
+
+def test_short_blunt_nose_reaches_its_deep_limit_with_the_defaults(capsys, tmp_path, monkeypatch):
+    """A flat nose with a 1 mm edge radius (L_h = 1 mm, shorter than its 3.555 mm radius): the
+    default depth range counts radii for such a nose, so the certified table reaches the deep
+    limit (it stopped at 84 radii, 'too shallow', when the range counted L_h). Independent
+    check: deep in the target the wetted nose is the whole nose, so C -> the frontal area
+    (C_bar = 1, eq. (14) with n_x integrated over the nose), to the table's tolerance."""
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path))
+    case = tmp_path / "rounded_flat.toml"
+    text = open("cases/flat_nose.toml").read()
+    case.write_text(text.replace('nose = "flat"\n', 'nose = "flat"\ncorner_radius = "1 mm"\n', 1))
+    out = _json(capsys, ["coefficients", str(case), "--json"])
+    assert out["deep_limit"]["C_bar"] == pytest.approx(1.0, abs=1e-5)
+    assert max(out["depth_m"]) > 84 * 3.555e-3  # beyond where the L_h-counted range stopped

@@ -42,8 +42,8 @@ def cornered_noses():
 
 
 def length_scale(nose) -> float:
-    """L_h, or the radius for a flat nose (L_h = 0), as the tables use."""
-    return nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    """The tables' depth unit (L_h, or the radius for a nose shorter than it)."""
+    return nose.depth_unit
 
 
 def refinement_study(nose, multiples=MULTIPLES, sequence=SEQUENCE, reference=REFERENCE) -> list[dict]:

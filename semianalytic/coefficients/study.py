@@ -39,7 +39,7 @@ def random_depths(nose, n: int, seed: int) -> np.ndarray:
     """Seeded random depths: a third in 0.9-1.3 L_h (just past the shoulder, where the
     coefficients change fastest), the rest log-uniform from 0.01 to 200 nose lengths."""
     rng = np.random.default_rng(seed)
-    L = nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    L = nose.depth_unit
     k = n // 3
     near = rng.uniform(0.9, 1.3, k)
     far = np.exp(rng.uniform(math.log(0.01), math.log(200.0), n - k))

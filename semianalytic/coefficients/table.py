@@ -785,7 +785,7 @@ class _Builder:
             self.update_limit()
 
     def too_shallow(self, what: str, P_needed: float):
-        unit = max(self.nose.length, self.nose.radius) if self.nose.length > 0.05 * self.nose.radius else self.nose.radius
+        unit = self.nose.depth_unit
         raise InputError(
             "coefficients.max_depth_nose_lengths",
             f"{self.P_max / unit:g} nose lengths is too shallow: {what} needs solves to {P_needed / unit:.4g} nose "
@@ -921,11 +921,10 @@ def coefficient_table(
     (default 1e-5) of each coefficient's largest magnitude (see the module docstring).
     With ``depths`` (or ``n_depths``, the legacy geometric grid) the knots are those depths
     and the error estimates come from dropping every other knot.  ``max_depth_nose_lengths``
-    bounds the deepest solve (in nose lengths, or radii for a flat nose).
+    bounds the deepest solve (in nose lengths L_h, or radii for a nose shorter than its radius: ``Nose.depth_unit``).
     """
     tol = check_tolerance(DEFAULT_TOLERANCE if tolerance is None else tolerance)
-    scale = nose.length if nose.length > 0.05 * nose.radius else nose.radius
-    P_max = max_depth_nose_lengths * scale
+    P_max = max_depth_nose_lengths * nose.depth_unit
     from semianalytic.bem.panels import LayoutOptions  # the BEM: imported when a table is built
 
     opts = LayoutOptions(order, refinement, levels)
@@ -977,7 +976,7 @@ def default_depths(nose: Nose, n_depths: int = 60, max_depth_nose_lengths: float
     """The legacy fixed grid: half of the depths while the nose enters (geometric from 1% of
     L_h, then linear), half beyond, geometric up to ``max_depth_nose_lengths``."""
     Lh = nose.length
-    scale = Lh if Lh > 0.05 * nose.radius else nose.radius
+    scale = nose.depth_unit
     P_max = max_depth_nose_lengths * scale
     if Lh > 0.05 * nose.radius:
         n_in = n_depths // 2
