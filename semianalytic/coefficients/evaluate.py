@@ -7,7 +7,8 @@ import math
 
 import numpy as np
 
-__all__ = ["ROW_KEYS", "table_output", "rows_at", "direct_rows", "interpolated_rows"]
+__all__ = ["ROW_KEYS", "coefficients_output", "body_output", "projectile_output", "table_output", "rows_at",
+           "direct_rows", "interpolated_rows"]
 
 ROW_KEYS = ("depth_m", "A_m3", "B_m2", "B_literal_m2", "B_bernoulli_m2", "C_m2", "A_bar_m", "B_bar", "C_bar",
             "phi_tip_m", "dA_dP_m2", "A_err_m3", "B_err_m2", "C_err_m2")
@@ -120,3 +121,77 @@ def rows_at(case, depths_text: str, *, reading: str, interpolated: bool, order: 
         rows = direct_rows(nose, depths, reading, order, refinement)
     return {"rows": rows, "reading": reading, "source": "interpolated" if interpolated else "direct",
             "nose_length_m": nose.length, "diameter_m": nose.diameter}
+
+
+def coefficients_output(case, **options) -> dict:
+    """What ``coefficients`` gives for a case: :func:`body_output` for a ``[body]`` case, else
+    :func:`projectile_output` (``options`` are the command's flags, None = the case's value)."""
+    if case.body is not None:
+        return body_output(case, order=options.get("order"), refinement=options.get("refinement"))
+    case.require("projectile")
+    return projectile_output(case, **options)
+
+
+def body_output(case, *, order=None, refinement=None) -> dict:
+    """Added-mass coefficient of a body in unbounded fluid (BEM), with Lamb's exact value and
+    the relative error for a sphere or spheroid."""
+    from semianalytic.bem import solve_body
+    from semianalytic.exact import spheroid_added_mass_coefficient
+    from semianalytic.geometry import body_from_section
+    from semianalytic.guards import check_body
+
+    check_body(case, order, refinement)  # refuse before assembly what would not fit in memory
+    body = case.body
+    meridian = body_from_section(body)
+    sol = solve_body(meridian, order=order or case.bem.order, refinement=refinement or case.bem.refinement or 1.0)
+    out = {
+        "added_mass_coefficient": sol.added_mass_coefficient,
+        "unknowns": sol.unknowns,
+        "A_m3": sol.A,
+        "volume_m3": meridian.volume(),
+    }
+    if body.shape in ("sphere", "spheroid"):
+        length = body.length if body.shape == "spheroid" else body.diameter
+        exact = spheroid_added_mass_coefficient(length, body.diameter)
+        out["added_mass_coefficient_exact"] = exact
+        out["relative_error"] = sol.added_mass_coefficient / exact - 1.0
+    return out
+
+
+def projectile_output(case, *, at=None, interpolated=False, reading=None, depths=None, max_depth=None, tolerance=None,
+                      order=None, refinement=None, cache_dir=None, progress=False) -> dict:
+    """The certified table of the case's nose (:func:`table_output`), or with ``at`` the rows at
+    those depths (:func:`rows_at`).  Each option None takes the case's value."""
+    from semianalytic.cache import cached_coefficient_table
+    from semianalytic.coefficients.case import parse_tolerance
+    from semianalytic.errors import InputError
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.guards import check_coefficients
+
+    check_coefficients(case, order, refinement, max_depth)  # refuse what would not fit in memory
+    nose = nose_from_section(case.projectile)
+    reading = reading or case.coefficients.reading
+    n_depths = depths or case.coefficients.depths
+    tol = parse_tolerance(tolerance) if tolerance is not None else case.coefficients.tolerance
+    if n_depths is not None and n_depths < 8:
+        raise InputError("--depths", "needs at least 8 depths")
+    if interpolated and at is None:
+        raise InputError("--interpolated", "needs --at DEPTHS (the depths to read from the table)")
+    order = order or case.bem.order
+    refinement = refinement or case.bem.refinement or 0.3
+    options = dict(order=order, refinement=refinement,
+                   max_depth_nose_lengths=max_depth or case.coefficients.max_depth_nose_lengths, progress=progress)
+    options.update(n_depths=n_depths) if n_depths is not None else options.update(tolerance=tol)
+
+    def build():
+        try:
+            return cached_coefficient_table(nose, cache_dir, **options)
+        except InputError as exc:  # name the flag when the flag set it
+            if exc.field == "coefficients.max_depth_nose_lengths" and max_depth:
+                raise InputError("--max-depth", exc.message) from None
+            raise
+
+    if at is not None:
+        return rows_at(case, at, reading=reading, interpolated=interpolated, order=order, refinement=refinement,
+                       table_factory=build)
+    return table_output(build(), nose, reading)
