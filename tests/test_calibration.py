@@ -15,6 +15,7 @@ from semianalytic.calibration.models import MODELS, DepthModelInputs, ShotSet, b
 from semianalytic.calibration.priors import HalfNormal, LogNormal
 from semianalytic.calibration.sampler import Problem, ResistanceMap, mixture_quantiles, sample_posterior
 from semianalytic.cli import main
+from case_blocks import TARGET_6061_T651
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ROOT / "cases"
@@ -204,14 +205,7 @@ density = "7850 kg/m^3"
 youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.5 GPa"
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-[impact]
+{TARGET_6061_T651}[impact]
 striking_velocities = ["433 m/s", "917 m/s"]
 """)
         code, stdout, err = _run(capsys, "penetrate", other, "--posterior", out / "posterior.json", "--json",

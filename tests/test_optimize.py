@@ -17,6 +17,7 @@ import pytest
 from semianalytic.cli import main
 from semianalytic.geometry import Projectile, ogive_nose
 from semianalytic.optimize.model import Infeasible, shank_for_constraints
+from case_blocks import TARGET_6061_T651
 
 # Coarse tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design on one core.
 CASE = """
@@ -30,14 +31,7 @@ density = "7830 kg/m^3"
 youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.5 GPa"
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-[impact]
+""" + TARGET_6061_T651 + """[impact]
 striking_velocities = ["0.6 km/s", "1.2 km/s"]
 [bem]
 order = 4

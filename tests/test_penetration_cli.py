@@ -12,6 +12,7 @@ from pathlib import Path
 import pytest
 
 from semianalytic.cli import main
+from case_blocks import TARGET_6061_T651
 
 D = 7.11e-3
 AREA = math.pi * D**2 / 4
@@ -27,14 +28,7 @@ density = "7830 kg/m^3"
 youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.64 GPa"
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-[impact]
+""" + TARGET_6061_T651 + """[impact]
 striking_velocities = ["600 m/s", "1.0 km/s", "1.3 km/s"]
 """
 

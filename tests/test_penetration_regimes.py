@@ -14,6 +14,7 @@ import pytest
 from semianalytic.cli import main
 from semianalytic.penetration import regime as rg
 from semianalytic.penetration.peers import tate_penetration
+from case_blocks import TARGET_6061_T651
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 ROD = dict(length=0.0711, nose_length=0.0118, diameter=7.11e-3)
@@ -161,14 +162,7 @@ youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.64 GPa"
 {extra}
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-{res_extra}
+""" + TARGET_6061_T651 + """{res_extra}
 [impact]
 striking_velocities = ["733 m/s", "1411 m/s", "2333 m/s", "2987 m/s"]
 """

@@ -17,6 +17,7 @@ import numpy as np
 import pytest
 
 from semianalytic.cli import main
+from case_blocks import TARGET_6061_T651
 
 CASE = """
 title = "run test: Fig. 5 ogive into 6061-T651 with the paper's constants"
@@ -30,14 +31,7 @@ density = "7830 kg/m^3"
 youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.64 GPa"
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-[impact]
+""" + TARGET_6061_T651 + """[impact]
 striking_velocities = ["0.6 km/s", "1.0 km/s"]
 [run]
 analyses = ["penetration", "critical_velocity", "velocity_field"]

@@ -17,6 +17,7 @@ from semianalytic.coefficients import ConstantCoefficients
 from semianalytic.sweep.engine import run_sweep
 from semianalytic.sweep.kernels import PenetrationKernel
 from semianalytic.sweep.spec import build_spec
+from case_blocks import TARGET_6061_T651
 
 D = 7.11e-3
 COEF = ConstantCoefficients.from_normalised(1.0e-3, 0.11, 1.0, D)  # the paper's quoted ogive values
@@ -31,14 +32,7 @@ mass = "20.9 g"
 youngs_modulus = "210 GPa"
 poisson_ratio = 0.29
 yield_stress = "1.5 GPa"
-[target]
-density = "2710 kg/m^3"
-[target.resistance]
-model = "elastic-plastic"
-yield_stress = "400 MPa"
-youngs_modulus = "68.9 GPa"
-poisson_ratio = 0.33
-[impact]
+""" + TARGET_6061_T651 + """[impact]
 striking_velocities = ["1 km/s"]
 """
 
