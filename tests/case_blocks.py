@@ -9,3 +9,13 @@ yield_stress = "400 MPa"
 youngs_modulus = "68.9 GPa"
 poisson_ratio = 0.33
 """
+
+# coarse BEM tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design on one core, for
+# tests of engines and optimisers (the same tables on every path), not of the coefficients' accuracy
+COARSE_TABLES = """[bem]
+order = 4
+refinement = 0.2
+[coefficients]
+depths = 16
+max_depth_nose_lengths = 30.0
+"""

@@ -17,7 +17,7 @@ import pytest
 from semianalytic.cli import main
 from semianalytic.geometry import Projectile, ogive_nose
 from semianalytic.optimize.model import Infeasible, shank_for_constraints
-from case_blocks import TARGET_6061_T651
+from case_blocks import COARSE_TABLES, TARGET_6061_T651
 
 # Coarse tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design on one core.
 CASE = """
@@ -33,13 +33,7 @@ poisson_ratio = 0.29
 yield_stress = "1.5 GPa"
 """ + TARGET_6061_T651 + """[impact]
 striking_velocities = ["0.6 km/s", "1.2 km/s"]
-[bem]
-order = 4
-refinement = 0.2
-[coefficients]
-depths = 16
-max_depth_nose_lengths = 30.0
-"""
+""" + COARSE_TABLES
 
 
 @pytest.fixture()

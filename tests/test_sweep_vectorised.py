@@ -15,6 +15,7 @@ from semianalytic.coefficients import ConstantCoefficients
 from semianalytic.sweep.engine import choose_engine, run_sweep
 from semianalytic.sweep.kernels import PenetrationKernel
 from semianalytic.sweep.spec import build_spec
+from case_blocks import COARSE_TABLES
 
 D = 7.11e-3
 COEF = ConstantCoefficients.from_normalised(1.0e-3, 0.11, 1.0, D)
@@ -185,13 +186,7 @@ def test_worker_moves_into_its_own_session():
 
 # the case above with coarse BEM tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design
 GEOMETRY_CASE = CASE.format(resistance=MODELS["elastic-plastic"][0]) + """
-[bem]
-order = 4
-refinement = 0.2
-[coefficients]
-depths = 16
-max_depth_nose_lengths = 30.0
-"""
+""" + COARSE_TABLES
 
 
 def test_geometry_sweep_on_a_local_cluster_equals_inline(tmp_path):
