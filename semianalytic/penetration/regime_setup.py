@@ -108,7 +108,8 @@ def eroding_inputs(case, setup) -> ErodingInputs:
         used.append(f"target.resistance.eroding_resistance not given: the eroding rod uses the Part I R_t = "
                     f"{R_t / 1e6:.0f} MPa (default)")
     if not nose.length < projectile.length:
-        raise InputError("projectile.length", "the rod must be longer than its nose")
+        raise InputError("projectile.length", f"the rod ({projectile.length * 1e3:.4g} mm: shank_length + nose) must "
+                                              f"be longer than its nose ({nose.length * 1e3:.4g} mm); give a shank_length > 0")
     return ErodingInputs(float(projectile.length), float(nose.length), float(psec.diameter), float(density),
                          float(case.target.density), float(R_t), float(Y_p), tuple(used))
 
