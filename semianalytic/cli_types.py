@@ -114,6 +114,16 @@ def number_list(low: float, high: float, *, low_open: bool = True, max_items: in
     return parse
 
 
+def _check_name_lengths(path: Path, text: str) -> None:
+    """Refuse what the file system would refuse (ENAMETOOLONG) before any stat or write."""
+    name_max = 255  # bytes per path component on Linux file systems
+    for part in path.parts:
+        if len(os.fsencode(part)) > name_max:
+            _fail(f"a folder or file name may have at most {name_max} bytes; {part[:20]!r}... has {len(os.fsencode(part))}")
+    if len(os.fsencode(str(path.absolute()))) > 4000:
+        _fail(f"the path {text[:40]!r}... is too long")
+
+
 def output_dir(text: str) -> str:
     """A folder that can be created (or exists as a folder) and written into.
 
@@ -124,6 +134,7 @@ def output_dir(text: str) -> str:
     if "\x00" in text:
         _fail("a path may not contain a NUL character")
     path = Path(text).expanduser()
+    _check_name_lengths(path, text)
     if path.exists() and not path.is_dir():
         _fail(f"{text!r} exists and is not a folder")
     probe = path.absolute()

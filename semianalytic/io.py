@@ -66,6 +66,10 @@ def contained_path(root: str | os.PathLike, relative: str, field: str) -> Path:
 def check_report_target(path: str | os.PathLike, force: bool) -> Path:
     """A report path that may be written: refuse to overwrite an existing one without force."""
     path = Path(path)
-    if path.exists() and not force:
+    try:
+        exists = path.exists()
+    except OSError as exc:  # e.g. a name longer than the file system allows
+        raise InputError("--report", f"cannot use {str(path)[:60]!r}: {exc.strerror}") from None
+    if exists and not force:
         raise InputError(str(path), "exists; pass --force to overwrite it")
     return path

@@ -159,3 +159,36 @@ def test_output_folder_never_the_working_folder(tmp_path, monkeypatch, capsys, o
     assert main(["run", case, "--out", out, "--force"]) == 2
     assert "--out" in capsys.readouterr().err
     assert sorted(p.name for p in work.iterdir()) == ["sentinel.txt"]
+
+
+LONG_NAME = "x" * 300  # longer than a file name may be (255 bytes): the file system says ENAMETOOLONG
+
+
+@pytest.mark.parametrize("argv", [
+    ["run", "cases/fig5_ogive.toml", "--out", LONG_NAME],
+    ["penetrate", "cases/fig5_ogive.toml", "--report", LONG_NAME],
+    ["calibrate", "cases/piekutowski1999_var4340.toml", "--out", "ok", "--report", LONG_NAME + ".md"],
+    ["calibrate", "cases/piekutowski1999_var4340.toml", "--out", LONG_NAME],
+    ["bench-bem", "--out", LONG_NAME],
+    ["coefficients", "cases/fig5_ogive.toml", "--cache-dir", LONG_NAME],
+    ["sweep", "cases/fig5_ogive.toml", "--out", LONG_NAME, "--vary", "impact.striking_velocity=400:600:100"],
+])
+def test_too_long_a_name_is_bad_input(argv, tmp_path, monkeypatch, capsys):
+    """A path the file system cannot hold: exit 2 naming the flag, no traceback, nothing written."""
+    root = Path(__file__).resolve().parent.parent
+    argv = [str(root / a) if a.startswith("cases/") else a for a in argv]
+    monkeypatch.chdir(tmp_path)
+    assert main(argv) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: --") and "Traceback" not in err and len(err.strip().splitlines()) == 1, err
+    assert list(tmp_path.iterdir()) == []
+
+
+def test_fem_check_too_long_a_name_is_bad_input(tmp_path, monkeypatch, capsys):
+    from fem_check.cli import main as fem_main
+
+    monkeypatch.chdir(tmp_path)
+    case = str(Path(__file__).resolve().parent.parent / "cases" / "fig5_ogive.toml")
+    assert fem_main(["verify", case, "--out", LONG_NAME]) == 2
+    assert capsys.readouterr().err.startswith("error: --out")
+    assert list(tmp_path.iterdir()) == []
