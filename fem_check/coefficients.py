@@ -158,8 +158,9 @@ class HalfspaceCoefficients:
 
 
 def depth_scale(nose: Nose) -> float:
-    """The length scale of depths: L_h, or the radius for a flat nose (L_h = 0; as the BEM's table)."""
-    return nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    """The length scale of depths: the tables' depth unit (L_h, or the radius of a nose shorter
+    than its radius; ``Nose.depth_unit``), so that ``--depths`` means the same on both sides."""
+    return nose.depth_unit
 
 
 def halfspace_mesh(nose: Nose, depth: float, options: MeshOptions) -> DomainMesh:

@@ -299,7 +299,7 @@ def check_fem(case, h: float, depths_nose_lengths=(), far: float = 20.0) -> floa
 
         nose = nose_from_section(case.projectile)
         d = nose.diameter
-        deepest = max(depths_nose_lengths or (1.0,)) * nose.length
+        deepest = max(depths_nose_lengths or (1.0,)) * nose.depth_unit  # fem_check's depths are in this unit
         wetted = sum(_arc(seg) for seg in nose.segments) + max(deepest - nose.length, 0.0)
         dofs = fem_unknowns(d, wetted, far * (d + deepest), h)
         field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
@@ -330,7 +330,7 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
         check_coefficients(case, order, refinement, max_depth)
         if field and case.section("run") is not None:
             check_coefficients(case, order, refinement, 1.0 + 1e-9 + max(
-                [d / max(_nose_length(case), 1e-300) for d in (case.section("run").field_depths or [])] or [1.0]),
+                [d / _depth_unit(case) for d in (case.section("run").field_depths or [])] or [1.0]),
                 default_refinement=1.0)
     if case.body is not None:
         check_body(case, order, refinement)
@@ -338,7 +338,8 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
         check_field_grid(case)
 
 
-def _nose_length(case) -> float:
+def _depth_unit(case) -> float:
+    """The tables' depth unit of the case's nose (L_h, or the radius of a nose shorter than it)."""
     from semianalytic.geometry import nose_from_section
 
-    return nose_from_section(case.projectile).length
+    return nose_from_section(case.projectile).depth_unit

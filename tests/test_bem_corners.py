@@ -49,7 +49,7 @@ TOL = 1e-6
 
 
 def _scale(nose):
-    return nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    return nose.depth_unit
 
 
 # --- geometry (exact, by hand) --------------------------------------------------------

@@ -121,3 +121,23 @@ def test_cli_bernoulli_reading_no_traceback(tmp_path, capsys):
     assert res["critical_velocity_m_s"][0] is None and not any(res["yields"])
     assert "eq. (33) has no real root" in out.err and "Traceback" not in out.err
     assert all(d > 0 for d in res["depth_rigid_m"])
+
+
+@pytest.mark.parametrize("B", [0.58 * AREA, -2.0e-14, 0.0])
+@pytest.mark.parametrize("Y_p", [2146e6, 1.0e9])
+def test_array_form_equals_the_scalar_form(B, Y_p):
+    """The Monte-Carlo kernel's array U_sC (penetration/batch.py) against critical_velocity, also
+    where eq. (33) has no real root (Bbar <= 0: inf in both, no warning) and under eq. (34)."""
+    import dataclasses
+    import warnings
+
+    import numpy as np
+
+    from semianalytic.penetration.batch import critical_velocities
+
+    c = dataclasses.replace(APPENDIX, B=B)
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        got = critical_velocities(Y_p, c.youngs_modulus, np.array([c.density]), np.array([c.mass]), c.diameter, c.A,
+                                  c.B, c.C, np.array([c.target_density]), np.array([c.resistance_pa]))
+    assert got[0] == pytest.approx(crit.critical_velocity(Y_p, c), rel=1e-14)

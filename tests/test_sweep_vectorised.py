@@ -84,6 +84,20 @@ def test_arrays_equal_the_case_by_case_path(tmp_path, monkeypatch, model):
     assert (vec.yields == ref.yields).all()
 
 
+def test_sampled_density_with_a_fixed_mass_equals_the_case_by_case_path(tmp_path):
+    """A case that fixes the mass and samples the density: the density still sets c_0 of
+    eq. (33) in every sample (the array path once kept the case's density for U_sC)."""
+    p = tmp_path / "case.toml"
+    p.write_text(CASE.format(resistance=MODELS["elastic-plastic"][0]).replace(
+        'density = "7830 kg/m^3"\n', 'density = "7830 kg/m^3"\nmass = "20.4 g"\n', 1))
+    spec = build_spec([], ["projectile.density=uniform(4000 kg/m^3, 16000 kg/m^3)"], 12, 5)
+    _, vec = _run(p, spec, tmp_path / "vec", True)
+    _, ref = _run(p, spec, tmp_path / "ref", False)
+    assert ref.critical_velocity_m_s.std() > 1.0  # the reference does vary with the density
+    np.testing.assert_allclose(vec.critical_velocity_m_s, ref.critical_velocity_m_s, rtol=1e-12)
+    np.testing.assert_allclose(vec.depth_rigid_m, ref.depth_rigid_m, rtol=1e-9)  # the mass is the case's
+
+
 def test_arrays_against_the_closed_form(tmp_path):
     p = tmp_path / "case.toml"
     p.write_text(CASE.format(resistance=MODELS["elastic-plastic"][0]))

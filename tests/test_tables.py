@@ -54,7 +54,7 @@ def test_table_against_direct_solves_at_random_depths(tables, kind, seed):
     solve, and the table's own estimate at least the actual difference at every depth."""
     nose, table = tables(kind)
     depths = random_depths(nose, 20, seed)
-    L = nose.length if nose.length > 0.05 * nose.radius else nose.radius
+    L = nose.depth_unit
     assert np.sum((depths >= 0.9 * L) & (depths <= 1.3 * L)) >= 6
     assert not np.any(np.isin(depths, table.depth))  # off the knots
     study = table_error_study(nose, table, depths)

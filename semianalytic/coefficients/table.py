@@ -978,7 +978,7 @@ def default_depths(nose: Nose, n_depths: int = 60, max_depth_nose_lengths: float
     Lh = nose.length
     scale = nose.depth_unit
     P_max = max_depth_nose_lengths * scale
-    if Lh > 0.05 * nose.radius:
+    if Lh > 0.05 * nose.radius:  # a nose to enter (not a flat face): half the depths while it enters
         n_in = n_depths // 2
         n_geo = n_in // 3
         entry = np.concatenate(

@@ -74,18 +74,21 @@ def final_depths(coefficients, mass, target_density, resistance_pa, U0, *, n_rat
 
 def critical_velocities(yield_stress: float, youngs_modulus: float, density, mass, diameter: float, A: float, B: float,
                         C: float, target_density, resistance_pa, phi: float = 1.0) -> np.ndarray:
-    """U_sC [m/s] of Part I, eqs. (33)/(34) with eq. (35), per sample (arrays broadcast together).
+    """U_sC [m/s] of Part I, eqs. (33)/(36) (eq. (34) below, eq. (35) for the reduced strengths), per sample (arrays broadcast together).
 
     Y_c = phi Y_p; Ybar_p = (1 + rho A/m) Y_c, Rbar_t = (C/a) R_t, Bbar = B/a with a = pi d^2/4;
     U_sC = Y_c c_0/E_p + sqrt(2 (Ybar_p - Rbar_t) / (rho Bbar)) if Ybar_p >= Rbar_t (eq. (33)),
     else Y_c c_0/E_p (eq. (34)); c_0 = sqrt(E_p/rho_p).  The array form of
     :func:`semianalytic.penetration.critical.critical_velocity` (deep-limit A, B, C)."""
+    from semianalytic.penetration.critical import reduced_strengths
+
     rho_p, m, rho, R = (np.asarray(v, float) for v in (density, mass, target_density, resistance_pa))
     Yc = phi * yield_stress
     area = np.pi * diameter**2 / 4.0
-    Ybar = (1.0 + rho * A / m) * Yc
-    Rbar = (C / area) * R
+    Ybar, Rbar = reduced_strengths(Yc, R, A=A, C=C, mass=m, diameter=diameter, target_density=rho)  # eq. (35)
     elastic = Yc * np.sqrt(youngs_modulus / rho_p) / youngs_modulus
+    if not B / area > 0:  # no velocity term (the 'bernoulli' reading at depth): no real root, as critical_velocity
+        return np.where(Ybar < Rbar, elastic, np.inf)
     excess = np.maximum(Ybar - Rbar, 0.0)
     return np.where(Ybar < Rbar, elastic, elastic + np.sqrt(2.0 / (rho * (B / area)) * excess))
 

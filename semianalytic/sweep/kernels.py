@@ -192,11 +192,11 @@ class PenetrationKernel:
         else:
             R = np.full(n, float(base.pressure(psec.diameter)))
         rho = np.broadcast_to(np.asarray(arrays.get("target.density", d["target_density"]), float), (n,))
-        rho_p = None
+        # a sampled projectile density sets c_0 of eq. (33) always, and the mass only when the case gives none
+        rho_p = np.asarray(arrays["projectile.density"], float) if "projectile.density" in arrays else None
         if "projectile.mass" in arrays:
             m = np.asarray(arrays["projectile.mass"], float)
-        elif "projectile.density" in arrays and psec.mass is None:
-            rho_p = np.asarray(arrays["projectile.density"], float)
+        elif rho_p is not None and psec.mass is None:
             m = rho_p * d["volume"]
         else:
             m = np.full(n, d["mass"])
