@@ -10,7 +10,6 @@ times the hemisphere series both ways in-process.
 
 from __future__ import annotations
 
-import argparse
 import math
 import os
 import subprocess
@@ -109,20 +108,19 @@ def _run(pythonpath: Path, argv: list[str], env: dict, cwd: Path) -> tuple[float
 def main(argv: list[str] | None = None) -> int:
     from fem_check.verify import hemisphere_reference
 
-    ap = argparse.ArgumentParser(prog="python -m fem_check.bench_verify", description=__doc__.splitlines()[0])
+    from semianalytic.cli_types import OneLineParser, integer
+    from semianalytic.io import extract_revision
+
+    ap = OneLineParser(prog="python -m fem_check.bench_verify", description=__doc__.splitlines()[0])
     ap.add_argument("--out", default="reports", help="folder of bench_fem_verify.md (default reports)")
     ap.add_argument("--base", default="main", help="git revision to compare with (default main)")
     ap.add_argument("--case", default="cases/fig5_ogive.toml")
-    ap.add_argument("--repeat", type=int, default=1, help="timed runs of each version after a warm-up run")
+    ap.add_argument("--repeat", type=integer(1, 20), default=1, help="timed runs of each version after a warm-up run")
     args = ap.parse_args(argv)
     cmd = ["verify", str((ROOT / args.case).resolve()), "--no-report", "--json"]
     shown = ["verify", args.case, "--no-report", "--json"]
     with tempfile.TemporaryDirectory(prefix="bench_fem_verify_") as tmp:
-        base = Path(tmp) / "base"
-        base.mkdir()
-        archive = subprocess.run(["git", "archive", args.base, "fem_check", "semianalytic"], cwd=ROOT, check=True,
-                                 capture_output=True).stdout
-        subprocess.run(["tar", "-x", "-C", str(base)], input=archive, check=True)
+        base = extract_revision(args.base, Path(tmp) / "base", "fem_check", "semianalytic")
         env = dict(os.environ, OMP_NUM_THREADS="1", OPENBLAS_NUM_THREADS="1", MKL_NUM_THREADS="1")
         envs = {"this tree": dict(env, FEM_CHECK_MESH_CACHE=str(Path(tmp) / "mesh_new")),
                 args.base: dict(env, FEM_CHECK_MESH_CACHE=str(Path(tmp) / "mesh_base"))}
@@ -204,4 +202,6 @@ def main(argv: list[str] | None = None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from semianalytic.errors import exit_status
+
+    raise SystemExit(exit_status(main))

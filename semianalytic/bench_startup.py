@@ -13,7 +13,6 @@ posterior), and the ``python -X importtime`` budget of ``penetrate --help`` and 
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import re
@@ -113,9 +112,11 @@ def _fifty_velocities_case(folder: Path) -> Path:
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m semianalytic.bench_startup", description=__doc__.splitlines()[0])
+    from semianalytic.cli_types import OneLineParser, integer
+
+    parser = OneLineParser(prog="python -m semianalytic.bench_startup", description=__doc__.splitlines()[0])
     parser.add_argument("--force", action="store_true", help="overwrite the report")
-    parser.add_argument("--repeat", type=int, default=3, help="timed runs of each command and version (after a warm-up)")
+    parser.add_argument("--repeat", type=integer(1, 20), default=3, help="timed runs of each command and version (after a warm-up)")
     parser.add_argument("--base", default="main", help="git revision to compare with (default main; '' for none)")
     parser.add_argument("--report", default=str(REPORT))
     args = parser.parse_args(argv)
@@ -129,12 +130,9 @@ def main(argv=None) -> int:
         env0 = {**os.environ, "OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"}
         versions = {"this tree": ROOT}
         if args.base:
-            base = tmp / "base"
-            base.mkdir()
-            archive = subprocess.run(["git", "archive", args.base, "semianalytic", "fem_check"], cwd=ROOT, check=True,
-                                     capture_output=True).stdout
-            subprocess.run(["tar", "-x", "-C", str(base)], input=archive, check=True)
-            versions[args.base] = base
+            from semianalytic.io import extract_revision
+
+            versions[args.base] = extract_revision(args.base, tmp / "base", "semianalytic", "fem_check")
         envs = {k: dict(env0, SEMIANALYTIC_CACHE_DIR=str(tmp / f"cache_{i}")) for i, k in enumerate(versions)}
         work = tmp / "work"
         work.mkdir()
@@ -234,4 +232,6 @@ def main(argv=None) -> int:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from semianalytic.errors import exit_status
+
+    raise SystemExit(exit_status(main))

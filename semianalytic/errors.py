@@ -26,3 +26,15 @@ class InputError(ValueError):
 
 class ModelValidityWarning(UserWarning):
     """An input the model accepts but that lies outside its stated validity."""
+
+
+def exit_status(main) -> int:
+    """Run ``main()`` of a ``python -m`` tool outside the CLI dispatcher (benchmarks): bad input
+    is one line on stderr and exit 2, as in every command, never a traceback."""
+    import sys
+
+    try:
+        return int(main() or 0)
+    except InputError as exc:
+        print(f"error: {exc}", file=sys.stderr)
+        return 2

@@ -73,3 +73,18 @@ def check_report_target(path: str | os.PathLike, force: bool) -> Path:
     if exists and not force:
         raise InputError(str(path), "exists; pass --force to overwrite it")
     return path
+
+
+def extract_revision(revision: str, dest: str | os.PathLike, *paths: str, field: str = "--base") -> Path:
+    """The folders ``paths`` of git ``revision`` of this repository, extracted into ``dest``
+    (benchmarks against an earlier version).  A revision git does not know: InputError."""
+    import subprocess
+
+    root = Path(__file__).resolve().parent.parent
+    got = subprocess.run(["git", "archive", revision, *paths], cwd=root, capture_output=True)
+    if got.returncode != 0:
+        raise InputError(field, f"git does not know the revision {revision!r} ({got.stderr.decode().strip()[:80]})")
+    dest = Path(dest)
+    dest.mkdir(parents=True, exist_ok=True)
+    subprocess.run(["tar", "-x", "-C", str(dest)], input=got.stdout, check=True)
+    return dest

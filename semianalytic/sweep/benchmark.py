@@ -24,7 +24,6 @@ coefficient table, on a dask LocalCluster with two single-threaded workers.  Wri
 
 from __future__ import annotations
 
-import argparse
 import os
 import platform
 import tempfile
@@ -43,12 +42,14 @@ VARY = ["target.resistance.yield_stress=250:745:5 MPa", "impact.striking_velocit
 
 
 def main(argv=None) -> int:
-    parser = argparse.ArgumentParser(prog="python -m semianalytic.sweep.benchmark", description=__doc__.splitlines()[0])
+    from semianalytic.cli_types import OneLineParser, integer
+
+    parser = OneLineParser(prog="python -m semianalytic.sweep.benchmark", description=__doc__.splitlines()[0])
     parser.add_argument("--force", action="store_true", help="overwrite reports/bench_sweep.md")
-    parser.add_argument("--workers", type=int, default=2)
+    parser.add_argument("--workers", type=integer(1, 64), default=2)
     parser.add_argument("--report", default=str(REPORT))
     parser.add_argument("--skip-engines", action="store_true", help="leave out the 64-design geometry sweep")
-    parser.add_argument("--designs", type=int, default=64, help="designs of the geometry sweep (default 64)")
+    parser.add_argument("--designs", type=integer(1, 1000), default=64, help="designs of the geometry sweep (default 64)")
     args = parser.parse_args(argv)
 
     import pandas as pd
@@ -478,4 +479,6 @@ def engine_benchmark(n_designs: int = 64) -> dict:
 
 
 if __name__ == "__main__":
-    raise SystemExit(main())
+    from semianalytic.errors import exit_status
+
+    raise SystemExit(exit_status(main))
