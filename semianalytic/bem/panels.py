@@ -422,7 +422,6 @@ def corner_power(turning: float) -> float:
     return float(min(max(k / lam, 1.0), MAX_POWER))
 
 
-_segment_arc_length = segment_arc_length  # one measure of arc length (geometry), shared with the memory guard
 
 
 def _count(arc: float, scale: float, refinement: float, per_scale: float, minimum: int = 2) -> int:
@@ -492,7 +491,7 @@ def body_panels(meridian: Meridian, options: LayoutOptions = LayoutOptions()) ->
     joints[-1] = (joints[-1][0], 0.0)
     pieces = []
     for k, seg in enumerate(segs):
-        arc = _segment_arc_length(seg, seg.t0, seg.t1)
+        arc = segment_arc_length(seg, seg.t0, seg.t1)
         n = _count(arc, scale, options.refinement, 1.6)
         if isinstance(seg, EllipseArc):
             # a slender ellipse needs panels in proportion to its length in the parameter
@@ -606,7 +605,7 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         x_end = float(seg.point(seg.t1)[0])
         cut_here = cut_on_nose and -depth >= x_end - 1e-15 * max(Lh, R)
         t1 = param_at_x(seg, -depth) if cut_here else seg.t1
-        arc = _segment_arc_length(seg, seg.t0, t1)
+        arc = segment_arc_length(seg, seg.t0, t1)
         if arc <= 0:
             continue
         # a straight segment next to a corner whose s^1 term is not polynomial in the substituted

@@ -21,7 +21,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["pressure_terms", "wetted_coefficients", "separated_acceleration"]
+__all__ = ["pressure_terms", "separated_acceleration"]
 
 
 def pressure_terms(nodes: dict, reading: str):
@@ -33,14 +33,6 @@ def pressure_terms(nodes: dict, reading: str):
     else:
         q = -nodes["grad2"] + 2 * nodes["dphi_dP_literal"]
     return nodes["phi"], q
-
-
-def wetted_coefficients(nodes: dict, reading: str, rho: float, u: float, du_dt: float, R_t: float):
-    """(A_w, B_w, C_w) over the nodes where p_c > 0 (Part I, eqs. (12), (15)) [m^3, m^2, m^2]."""
-    phi, q = pressure_terms(nodes, reading)
-    p = rho * phi * du_dt + q * rho * u * u / 2 + R_t
-    wn = nodes["weight"] * nodes["nx"] * (p > 0)
-    return float(np.sum(wn * phi)), float(np.sum(wn * q)), float(np.sum(wn))
 
 
 def separated_acceleration(nodes: dict, reading: str, mass: float, rho: float, u: float, R_t: float, iterations: int = 20):

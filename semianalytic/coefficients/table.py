@@ -498,9 +498,6 @@ class CoefficientTable:
         j = self._index(P)
         return (np.asarray(self.intervals[f"err_{name}"])[j] + self.bem_errors.get(name, 0.0))[()]
 
-    def B_error(self, P, reading: str | None = None):
-        return self.error(f"B_{reading or self.reading}", P)
-
     def with_reading(self, reading: str) -> "CoefficientTable":
         """The same table with another default B reading."""
         return replace(self, reading=reading)

@@ -116,7 +116,7 @@ def evaluate_batch(payload: Payload, ids: np.ndarray) -> list[dict] | Columns:
     columns = spec.columns
     slow = [k for k in spec.keys if k not in kernel.fast_keys]
     fast = [k for k in spec.keys if k in kernel.fast_keys]
-    arrays = [k for k in slow if getattr(kernel, "is_array_key", lambda _: False)(k)]
+    arrays = [k for k in slow if kernel.is_array_key(k)]
     if arrays and (payload.arrays_valid or _ranges_valid(payload, values, arrays)):
         return _evaluate_arrays(payload, ids, values, [k for k in slow if k not in arrays], fast + arrays)
 
@@ -185,7 +185,7 @@ def _check_arrays_once(payload: Payload, pending: np.ndarray) -> Payload:
     import dataclasses
 
     kernel, spec = payload.kernel, payload.spec
-    is_array = getattr(kernel, "is_array_key", lambda _: False)
+    is_array = kernel.is_array_key
     arrays = [k for k in spec.keys if k not in kernel.fast_keys and is_array(k)]
     if not arrays or len(arrays) > 6:
         return payload
@@ -421,9 +421,6 @@ def connect(scheduler: str | None, workers: int):
     return client, None, sched
 
 
-_connect = connect  # old name
-
-
 def run_sweep(
     case_path: str | os.PathLike,
     spec: SweepSpec,
@@ -470,7 +467,7 @@ def run_sweep(
     draws = spec.draws() if spec.samplers else {}
     t_prep = time.perf_counter()
     rcases = _resource_cases(case, spec, kernel, pending, draws) if len(pending) else {}
-    engine = choose_engine(scheduler, len(pending), len(rcases), getattr(kernel, "seconds_per_case", 0.0), workers)
+    engine = choose_engine(scheduler, len(pending), len(rcases), kernel.seconds_per_case, workers)
     client, cluster, summary.scheduler = connect(engine, workers) if len(pending) else (None, None, "none")
     try:
         # from here on the folder is written
