@@ -112,7 +112,6 @@ def write_report(out_dir, cases, args=None, *, name: str | None = None, force: b
     )
     _coefficients_section(doc, ctx)
     _validation_section(doc, ctx, w)
-    _eroding_section(doc, ctx)
     _regimes_section(doc, ctx, w, getattr(args, "part1_model", None) or "elastic_exact_rod")
     _histories_section(doc, ctx, w)
     _curves_section(doc, ctx, w)
@@ -315,43 +314,6 @@ def _curve(ctx, case, U, mass=None):
 
     setup = ctx.setup(case, mass=mass)
     return penetration_curve(setup, U, w1=ctx.w1), peer_depths(case, setup, U)
-
-
-def _eroding_section(doc, ctx):
-    """Alekseevskii-Tate against the shots the data mark as eroding (same cases, other regimes)."""
-    import dataclasses
-
-    from semianalytic.penetration.peers import tate_penetration
-    from semianalytic.penetration.validation import load_shots
-
-    rows = []
-    done = set()
-    for case in ctx.validation_cases():
-        data = case.section("data")
-        if "regime" not in data.select:
-            continue
-        key = (data.file, tuple(data.select.get("material", [])))
-        if key in done:
-            continue
-        done.add(key)
-        sel = dict(data.select, regime=["eroded", "broken_eroding"])
-        eroding = dataclasses.replace(case, sections={**case.sections, "data": data.model_copy(update={"select": sel})})
-        setup = ctx.setup(case)
-        for s in load_shots(eroding):
-            m = s.mass or setup.mass
-            L = setup.rod.length
-            rho_rod = m / (setup.rod.area * L)  # the rod of the same mass and length
-            t = tate_penetration(L, rho_rod, setup.yield_stress, setup.target_density, setup.resistance_pa, s.velocity)
-            rows.append([s.id, _material(case), s.row.get("regime", ""), f"{s.velocity:.0f}", f"{s.depth * MM:.0f}",
-                         f"{t.depth * MM:.1f}", _pct((t.depth - s.depth) / s.depth), f"{t.residual_length * MM:.1f}",
-                         _target_label(case)])
-    if rows:
-        doc.heading("Eroding regime: Alekseevskii-Tate")
-        doc.para("Above the rigid regime the rods eroded or broke; Part I does not apply there. The Alekseevskii-Tate "
-                 "equations with the rod strength Y_p of the case (the dynamic yield stress used for U_sC) and the "
-                 "target resistance R_t of the case, for a cylindrical rod of the projectile's length and mass:")
-        doc.table(["shot", "projectile", "regime", "U_s [m/s]", "measured P [mm]", "Tate P [mm]", "error [%]",
-                   "residual rod [mm]", "target"], rows, caption="Alekseevskii-Tate against the eroding-regime shots.")
 
 
 _RESPONSE_MARKERS = {"rigid": "ko", "curved": "bs", "exited": "b^", "turned_around": "mv", "broken": "rx",
