@@ -14,6 +14,7 @@ import sys
 
 def add_arguments(parser) -> None:
     from semianalytic.calibration.names import CALIBRATION_MODELS
+    from semianalytic.cli_types import file_stem, output_dir
 
     parser.add_argument("case", metavar="CASE.toml", help="case with [projectile], [target], [data] (and [calibration])")
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
@@ -28,9 +29,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--transfer", action="append", default=[], metavar="CASE.toml",
                         help="a case with the same target whose shots the calibration predicts (repeatable)")
     parser.add_argument("--steps", type=int, default=None, help="emcee steps per walker (default: [calibration] steps)")
-    parser.add_argument("--report-name", default="report", help="stem of the report files in DIR (default: report)")
+    parser.add_argument("--report-name", default="report", type=file_stem, help="stem of the report files in DIR (default: report)")
     parser.add_argument("--coefficients", choices=("bem", "paper"), default="bem", help="A, B, C source (default: BEM table)")
-    parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
     parser.add_argument("--diagnose", action="store_true",
                         help="add the study of the over-prediction of the Part I models (B reading, W1, contact region, Y)")
     parser.add_argument("--report", metavar="PATH.md", default=None,

@@ -26,8 +26,6 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
 
     if args.steps is not None and args.steps < 50:
         raise InputError("--steps", f"must be at least 50; got {args.steps}")
-    if not args.report_name.replace("_", "").replace("-", "").isalnum():
-        raise InputError("--report-name", "letters, digits, '_' and '-' only")
     check_output_dir(args.out, args.force)
     if args.report is not None:
         from semianalytic.io import check_report_target
