@@ -24,7 +24,7 @@ import math
 
 import numpy as np
 
-from fem_check.coefficients import depth_scale, halfspace_coefficients
+from fem_check.coefficients import depth_scale
 from fem_check.meshing import MeshOptions, halfspace_domain
 
 STUDY_KEYS = ("A", "B_body", "B_surface", "dA_dP", "B_bernoulli", "C")
@@ -66,21 +66,26 @@ def has_singular_corners(nose, depths_m) -> bool:
 
 
 def refinement_study(nose, depths_over_scale, h_list=(0.16, 0.08, 0.04, 0.02), grading: float | None = None,
-                     bem_refinement: float = 1.0) -> list[dict]:
+                     bem_refinement: float = 1.0, memo: dict | None = None) -> list[dict]:
     """FEM under refinement at each depth (in units of :func:`depth_scale`), with observed orders,
-    Richardson extrapolation and the BEM (``coefficients_at``) beside it."""
+    Richardson extrapolation and the BEM (``coefficients_at``) beside it.  ``memo``: the dict of
+    :func:`fem_check.verify.compare_depths`, so the solves both need (its h) run once."""
     from semianalytic.coefficients.table import coefficients_at
+
+    from fem_check.verify import _solved
 
     scale = depth_scale(nose)
     Ps = np.asarray(depths_over_scale, float) * scale
-    bem = coefficients_at(nose, Ps, refinement=bem_refinement)
+    bem = (memo or {}).get(("bem", id(nose), tuple(Ps), bem_refinement))
+    if bem is None:
+        bem = coefficients_at(nose, Ps, refinement=bem_refinement)
     S = math.pi * nose.diameter**2 / 4
     out = []
     for i, P in enumerate(Ps):
         rows = []
         for h in h_list:
             opts = MeshOptions(h=h) if grading is None else MeshOptions(h=h, grading=grading)
-            f = halfspace_coefficients(nose, float(P), opts)
+            f = _solved(memo, nose, float(P), opts)
             rows.append({"h_over_d": h, "n_dofs": f.n_dofs, "seconds": f.seconds, "A": f.A, "B_body": f.B_body,
                          "B_surface": f.G_surface + 2 * f.Q, "dA_dP": f.dA_dP, "B_bernoulli": f.B_bernoulli, "C": f.C,
                          "G_source": f.G_source})

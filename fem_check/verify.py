@@ -151,6 +151,8 @@ def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_re
     t0 = time.perf_counter()
     bem = coefficients_at(nose, Ps, refinement=bem_refinement)
     t_bem = (time.perf_counter() - t0) / len(Ps)
+    if memo is not None:  # the refinement study compares with the same BEM solves
+        memo[("bem", id(nose), tuple(Ps), bem_refinement)] = bem
     rows = []
     for i, P in enumerate(Ps):
         opts = MeshOptions(h=h, order=order) if grading is None else MeshOptions(h=h, order=order, grading=grading)
@@ -313,7 +315,7 @@ def run(args) -> int:
                    "max_rel_diff": max(r["max_rel_diff"] for r in rows)}
         cornered = has_singular_corners(nose, np.asarray(depths) * scale)
         if not args.quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
-            payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading)
+            payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading, memo=memo)
         elif not args.quick:
             payload["convergence"] = convergence_study(nose, memo=memo)
             if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
