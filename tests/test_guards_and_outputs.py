@@ -192,3 +192,12 @@ def test_fem_check_too_long_a_name_is_bad_input(tmp_path, monkeypatch, capsys):
     assert fem_main(["verify", case, "--out", LONG_NAME]) == 2
     assert capsys.readouterr().err.startswith("error: --out")
     assert list(tmp_path.iterdir()) == []
+
+
+def test_field_depths_of_a_flat_nose_are_in_its_depth_unit(tmp_path):
+    """[run] field_depths of a flat nose (L_h = 0): the guard counts them in radii, as the tables
+    do (it divided by L_h and asked for ~1e297 nose lengths of panels)."""
+    case = tmp_path / "flat_field.toml"
+    case.write_text(Path(__file__).resolve().parent.parent.joinpath("cases", "flat_nose.toml").read_text()
+                    + '\n[run]\nanalyses = ["coefficients", "velocity_field"]\nfield_depths = ["10 mm"]\n')
+    guards.check_case(load_case(case), field=True)  # 10 mm = 2.8 radii: far inside the default budget
