@@ -1,6 +1,7 @@
 """``python -m semianalytic nanostrength``: output, bad input (exit 2, field named, nothing
 written), report written atomically and not overwritten without --force."""
 
+import re
 import json
 from pathlib import Path
 
@@ -33,7 +34,17 @@ def test_json_output_table4(capsys):
 def test_text_output_table3(capsys):
     assert main(["nanostrength", str(CASES / "part3_table3.toml")]) == 0
     out = capsys.readouterr().out
-    assert "Fracture (eq16/printed)" in out and "23.7330" in out  # Y_1c I of diamond (Table 3: 23.6728)
+    assert "Fracture (eq16/printed)" in out
+    block = out.split("Fracture (eq16/printed)", 1)[1]
+    # the paper's Table 3 (tension I): Y_1c [N/m], K_1c [MPa m^1/2], independent of the code
+    table3 = {"C": (23.6728, 5.1067), "BN": (20.6484, 4.479), "SiC": (20.1584, 3.89), "AlN": (12.056, 2.33)}
+    for crystal, (Y_paper, K_paper) in table3.items():
+        row = re.search(rf"^{crystal}\s+([-\d.]+)\s+[-\d.]+\s+([-\d.]+)", block, re.M)
+        assert row, crystal
+        # 0.5 %: eq. (16) from the printed Delta Phi and e, which the paper rounds to 3-4 digits
+        # (reports/part3_nanostrength.md: the tension column differs by at most 0.25 %)
+        assert float(row.group(1)) == pytest.approx(Y_paper, rel=5e-3), crystal
+        assert float(row.group(2)) == pytest.approx(K_paper, rel=5e-3), crystal
 
 
 @pytest.mark.parametrize(

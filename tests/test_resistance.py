@@ -100,7 +100,28 @@ GOOD = {"model": "elastic-plastic", "yield_stress": "400 MPa", "youngs_modulus":
 def test_each_model_parses(spec, cls):
     model = parse_resistance(spec)
     assert isinstance(model, cls)
-    assert model.pressure(7.11e-3) > 0
+    assert model.pressure(7.11e-3) == pytest.approx(_EXPECTED_MPA[cls.__name__] * 1e6, rel=_REL[cls.__name__])
+
+
+# Independent values [MPa] of the same inputs: eq. (16) against the paper's Appendix (R_t = 1455 MPa
+# for Y = 400 MPa, E = 68.9 GPa, nu = 0.33; errata item 3: printed "GPa"), the paper rounding
+# ln(E/(3Y(1-nu))) (hence 2e-3); the others transcribed by hand from the printed equations with the
+# test's inputs (errata item 6 for Part IV's log coefficient), to round-off.
+_EXPECTED_MPA = {
+    "ElasticPlastic": 1455.0,
+    # eq. (17): Y [E / (3 Y (1 - (1 - nu) sqrt(sf / (2 Y))))]^(2 alpha / 3)
+    "Brittle": 2600.0 * (370e3 / (3 * 2600.0 * (1 - 0.78 * math.sqrt(260.0 / 5200.0)))) ** (2 * 0.9 / 3),
+    # eq. (18): (2/3) Y (1 + (2E/(3Y))^n I), I by adaptive quadrature here (the code sums a series)
+    "Hardening": 2 / 3 * 276.0 * (1 + (2 * 68.9e3 / (3 * 276.0)) ** 0.051 * integrate.quad(
+        lambda x: (-math.log(x)) ** 0.051 / (1 - x), 0, 1 - 3 * 276.0 / (2 * 68.9e3), limit=400, epsrel=1e-12)[0]),
+    # eq. (19) with Frew's defaults Psi = 607 MPa, phi = 86 MPa, 2 a_0 = 25.4 mm, 2 a = 7.11 mm
+    "Limestone": 607.0 + 86.0 * 25.4 / 7.11,
+    # Part IV, eq. (6): Y (2/3 + ln(2E/(3Y)))
+    "Part4": 400.0 * (2 / 3 + math.log(2 * 68.9e3 / (3 * 400.0))),
+    "Constant": 1455.0,
+}
+_REL = {"ElasticPlastic": 2e-3, "Brittle": 1e-12, "Hardening": 1e-8, "Limestone": 1e-12, "Part4": 1e-12,
+        "Constant": 1e-15}
 
 
 @pytest.mark.parametrize(
