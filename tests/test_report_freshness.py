@@ -48,20 +48,6 @@ def test_report_names_its_version(path):
     assert f"penetration-mechanics {semianalytic.__version__}" in path.read_text()
 
 
-@pytest.mark.parametrize("path", REPORTS, ids=IDS)
-def test_table_depth_counts_are_current(path):
-    """A report quoting the coefficient table's depth count (e.g. '64 depths to 300 nose
-    lengths') must quote the current default of ``[coefficients] depths``."""
-    text = path.read_text()
-    default = CoefficientsSection().depths
-    # a claim about the default table (to its default deepest depth); a benchmark's deliberately
-    # lighter table ("20 depths to 40 nose lengths") is not one
-    deepest = CoefficientsSection().max_depth_nose_lengths
-    quoted = [int(n) for n, to in re.findall(r"(\d+) depths to ([\d.]+) nose lengths", text) if float(to) == deepest]
-    quoted += [int(n) for n in re.findall(r"(?<!legacy )(?<![\d])(\d+)-depth table", text)]  # not the old table a benchmark compares with
-    assert all(n == default for n in quoted), (quoted, default)
-
-
 def test_part4_report_regenerates_identically():
     """Part IV's report is fast: rebuilt here, it equals the committed one but for the version."""
     from semianalytic.ballistic_limit.report import build
