@@ -8,7 +8,7 @@ export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 export PYVISTA_OFF_SCREEN ?= true
 
-.PHONY: demo test bench reports clean
+.PHONY: demo test check bench reports clean
 
 # The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
 # executable_path (never `playwright install`: no browser download); installed here when missing.
@@ -27,6 +27,12 @@ demo: $(VENV)/.installed
 test: $(VENV)/.installed $(CHROMIUM)
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile
+
+# The inner loop (about a minute on two idle cores): the suite without the `long` tests
+# (tests/conftest.py lists them; `make test` runs them too).
+check: $(VENV)/.installed
+	$(VENV)/bin/lint-imports --no-cache
+	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not long"
 
 $(CHROMIUM):
 	$(SUDO) apt-get update

@@ -19,3 +19,48 @@ if settings is not None:
     settings.register_profile("ci", derandomize=True, print_blob=True, deadline=None)
     settings.register_profile("dev", print_blob=True, deadline=None)
     settings.load_profile(os.environ.get("HYPOTHESIS_PROFILE") or ("ci" if os.environ.get("CI") else "dev"))
+
+
+# --------------------------------------------------------------------------------------------
+# The inner loop.  `make check` runs the suite without the tests below (each takes more than a
+# few seconds of CPU: benchmarks on small problems, certified tables of cornered noses, sampler
+# runs, FEM studies, subprocess sweeps); `make test` (and so CI) runs everything that is not
+# `slow`.  A node id here is a file, or a test function of a file (all its parameters).
+LONG = {
+    "tests/test_benchmarks_small.py",
+    "tests/test_bad_input.py::test_bad_case_exit_status_in_a_subprocess",
+    "tests/test_browser_report.py",
+    "tests/test_cache.py::test_commands_write_no_cache_into_the_working_directory",
+    "tests/test_calibration.py::test_calibrate_cli_files_keys_and_penetrate_posterior_other_noses",
+    "tests/test_calibration.py::test_sampler_against_quadrature_of_the_same_posterior",
+    "tests/test_calibration_crossval.py",
+    "tests/test_calibration_eroding.py",
+    "tests/test_cli_noses.py",
+    "tests/test_corpus.py",
+    "tests/test_fem_cli.py::test_cavity_json",
+    "tests/test_fem_corners.py::test_fem_flat_nose_converges_at_the_graded_rate",
+    "tests/test_guards_and_outputs.py::test_run_and_penetrate_write_no_cache_into_the_cwd",
+    "tests/test_hardening_properties.py",
+    "tests/test_optimize.py",
+    "tests/test_penetration_cli.py::test_report_is_not_overwritten_without_force",
+    "tests/test_readme_commands.py",
+    "tests/test_run_report.py",
+    "tests/test_separation_onset.py::test_onset_is_the_first_knot_where_eq9_turns_negative",
+    "tests/test_startup_imports.py",
+    "tests/test_sweep_engine.py::test_killed_sweep_process_resumes",
+    "tests/test_sweep_penetration.py::test_velocity_by_material_on_an_existing_dask_cluster",
+    "tests/test_sweep_vectorised.py",
+    "tests/test_table_corners.py::test_certified_table_within_tolerance_off_knots_and_beside_breakpoints",
+    "tests/test_tables.py::test_depth_error_estimate_bounds_a_tighter_table",
+    "tests/test_tables.py::test_short_blunt_nose_reaches_its_deep_limit_with_the_defaults",
+    "tests/test_tables.py::test_table_against_direct_solves_at_random_depths",
+}
+
+
+def pytest_collection_modifyitems(config, items):
+    import pytest
+
+    for item in items:
+        test = item.nodeid.split("[", 1)[0]
+        if test in LONG or test.split("::", 1)[0] in LONG:
+            item.add_marker(pytest.mark.long)
