@@ -28,7 +28,7 @@ __all__ = ["run_case", "introduction"]
 
 
 def run_case(case_path, out, *, force: bool = False, only=None, render: bool = True, cache_dir=None,
-             contact=None, tolerance=None) -> dict:
+             contact=None, tolerance=None, quiet: bool = True) -> dict:
     """Run a case into ``out``; returns the results dict (also written to ``out/results.json``).
     ``contact`` / ``tolerance`` override ``[coefficients]`` (flags ``--contact``, ``--tolerance``)."""
     from semianalytic.case import load_case
@@ -54,10 +54,15 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
         title = case.title or Path(case_path).stem
         ctx = Context(case, staged, run_section, Document(f"Report: {title}"), render=render, cache_dir=cache_dir)
         introduction(ctx, identity, steps, skipped, _command(identity, out, case_path))
+        from semianalytic.progress import stages
+
+        bar = stages(len(steps), "run", quiet=quiet)  # stderr only, and only on a terminal
         for step in steps:
+            bar.step(step.name)
             t = time.perf_counter()
             step.run(ctx)
             ctx.timings[step.name] = time.perf_counter() - t
+        bar.close()
         ctx.timings["total"] = time.perf_counter() - t0
         ctx.doc.heading("Run")
         ctx.doc.table(
