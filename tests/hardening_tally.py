@@ -76,7 +76,10 @@ def run_option(package: str, argv: list[str], tmp: Path) -> Outcome:
     err, out = io.StringIO(), io.StringIO()
     with contextlib.redirect_stderr(err), contextlib.redirect_stdout(out):
         rc = main(argv)
-    return Outcome(rc, err.getvalue(), out.getvalue())
+    def unplace(text: str) -> str:  # the report names no machine path: the temporary folder as {tmp}
+        return text.replace(str(tmp.resolve()), "{tmp}").replace(str(tmp), "{tmp}")
+
+    return Outcome(rc, unplace(err.getvalue()), unplace(out.getvalue()))
 
 
 def classify(res: Outcome) -> str:

@@ -183,8 +183,44 @@ def revolved_surface(profile: np.ndarray, segments: int = 48):
     return meshio.Mesh(pts, [("quad", quads)])
 
 
+# The unit of every array the writers here produce (point data and field data), and of the
+# coordinates; written into each .vtu as string field data (``units``, ``coordinates_unit``).
+UNITS = {
+    "coordinates": "m",
+    "velocity": "m/s",
+    "speed": "m/s",
+    "phi": "m (potential at unit striking speed)",
+    "Phi": "m^2/s",
+    "phi_bem": "m (potential at unit striking speed)",
+    "phi_difference": "m (potential at unit striking speed)",
+    "speed_u_m_s": "m/s",
+    "depth_m": "m",
+}
+
+
+def _field_data_xml(mesh) -> str:
+    """A VTK XML ``<FieldData>`` block: the mesh's field data (meshio's VTU writer drops it)
+    and, as strings, the unit of the coordinates and of every array (:data:`UNITS`)."""
+    from xml.sax.saxutils import quoteattr
+
+    def strings(name: str, values: list[str]) -> str:
+        codes = " ".join(" ".join(str(b) for b in v.encode("utf-8")) + " 0" for v in values)
+        return (f'<DataArray type="String" Name={quoteattr(name)} NumberOfTuples="{len(values)}" format="ascii">'
+                f"{codes}</DataArray>")
+
+    names = ["coordinates", *mesh.point_data, *(mesh.field_data or {})]
+    arrays = [strings("units", [f"{n}: {UNITS.get(n, 'dimensionless')}" for n in names]),
+              strings("coordinates_unit", [UNITS["coordinates"]])]
+    for name, value in (mesh.field_data or {}).items():
+        v = np.atleast_1d(np.asarray(value, float))
+        arrays.append(f'<DataArray type="Float64" Name={quoteattr(name)} NumberOfTuples="{v.size}" format="ascii">'
+                      + " ".join(repr(float(x)) for x in v) + "</DataArray>")
+    return "<FieldData>\n" + "\n".join(arrays) + "\n</FieldData>\n"
+
+
 def write_vtu(mesh, path: str | os.PathLike) -> Path:
-    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename)."""
+    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename),
+    with the units of its coordinates and arrays as field data (:data:`UNITS`)."""
     import meshio
 
     path = Path(path)
@@ -196,6 +232,9 @@ def write_vtu(mesh, path: str | os.PathLike) -> Path:
     os.chmod(tmp, 0o666 & ~_umask())
     try:
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
+        text = Path(tmp).read_text(encoding="ascii")
+        at = text.index("<UnstructuredGrid>") + len("<UnstructuredGrid>\n")
+        Path(tmp).write_text(text[:at] + _field_data_xml(mesh) + text[at:], encoding="ascii")
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
