@@ -5,19 +5,11 @@ the same cached coefficient tables, the same evaluation), so a script gets exact
 ``python -m semianalytic penetrate`` prints.  Quantities in a case are unit strings
 (``"7.11 mm"``); everything returned is in SI units, named in the keys (``depth_m``).
 
-Example::
+Example (more in ``docs/examples/``, the gallery of the docs site):
 
     from semianalytic import api
 
-    case = api.case_from_dict({
-        "projectile": {"nose": "ogive", "crh": 3.0, "diameter": "7.11 mm", "shank_length": "59.3 mm",
-                       "density": "7830 kg/m^3", "youngs_modulus": "210 GPa", "poisson_ratio": 0.29,
-                       "yield_stress": "1.5 GPa"},
-        "target": {"density": "2710 kg/m^3",
-                   "resistance": {"model": "elastic-plastic", "yield_stress": "400 MPa",
-                                  "youngs_modulus": "68.9 GPa", "poisson_ratio": 0.33}},
-        "impact": {"striking_velocities": ["500 m/s", "1.0 km/s"]},
-    })
+    case = api.load_case("cases/piekutowski1999_var4340.toml")
     print(api.depth(case, 800.0))          # m, the regime-aware depth at 800 m/s
 """
 
@@ -93,7 +85,7 @@ def case_from_keywords(**sections: Any):
     Returns
     -------
     semianalytic.case.Case
-        The validated case, as :func:`case_from_dict` would return it.
+        The validated case, as ``case_from_dict`` would return it.
     """
     return case_from_dict(sections)
 
@@ -214,7 +206,7 @@ def depth(case, velocity: float | Sequence[float], model: str = "regime_aware", 
     Parameters
     ----------
     case : semianalytic.case.Case
-        A penetration case (see :func:`penetrate`).
+        A penetration case (see ``penetrate``).
     velocity : float or sequence of float
         Striking velocity U_s [m/s].
     model : str
@@ -222,7 +214,7 @@ def depth(case, velocity: float | Sequence[float], model: str = "regime_aware", 
         ``"rigid"``, ``"quasi_rigid"``, ``"elastic"``, ``"elastic_exact_rod"``,
         ``"forrestal"``, ``"chen_li"`` or ``"eroding"``.
     **options : dict
-        Passed to :func:`penetrate` (``source``, ``w1``, ``part1_model``, ``cache_dir``).
+        Passed to ``penetrate`` (``source``, ``w1``, ``part1_model``, ``cache_dir``).
 
     Returns
     -------

@@ -21,7 +21,7 @@ from pathlib import Path
 import pytest
 
 ROOT = Path(__file__).resolve().parents[1]
-READMES = (ROOT / "README.md", ROOT / "cases" / "README.md")
+READMES = (ROOT / "README.md", ROOT / "cases" / "README.md", ROOT / "docs" / "getting-started.md")
 SLOW = ("semianalytic run ", "fem_check verify", "semianalytic demo", "semianalytic sweep")
 
 
