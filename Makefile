@@ -39,6 +39,8 @@ bench: $(VENV)/.installed
 reports: bench
 	$(PY) -m pytest -q -m slow
 	for c in fig5_ogive fig5_sphere body_sphere body_spheroid_7to1; do $(PY) -m fem_check verify cases/$$c.toml --out reports --force || exit 1; done
+	$(PY) -m fem_check verify cases/cone30.toml --depths 0.5,2,5,20 --out reports --force
+	$(PY) -m fem_check verify cases/flat_nose.toml --depths 0.5,2,5,20 --name fem_verify_flat --out reports --force
 	$(PY) -m fem_check rod cases/fig9_ogive_7075T651.toml --out reports --force
 	$(PY) -m fem_check cavity --out reports --force
 	$(PY) -m fem_check bench --out reports --force
