@@ -154,3 +154,22 @@ def test_progress_on_a_terminal_only_and_not_with_quiet(tmp_path):
     assert "fem_check verify:" not in _with_a_terminal([*VERIFY, "--quiet"], tmp_path)
     piped = _run(VERIFY, tmp_path)  # stderr a pipe: no bar
     assert piped.returncode == 0 and "fem_check verify:" not in piped.stderr
+
+
+def test_run_csv_one_row_per_velocity_and_model(tmp_path):
+    """`run --csv`: the penetration of the case, one row per striking velocity (the 13 of the
+    Fig. 15a case, 0.4-1.6 km/s, written here by hand) and model."""
+    case = ROOT / "cases" / "fig15a_ogive_6061T651.toml"
+    out_csv = tmp_path / "depths.csv"
+    proc = _run(["semianalytic", "run", str(case), "--out", str(tmp_path / "out"), "--only", "penetration",
+                 "--no-render", "--csv", str(out_csv)], tmp_path)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    rows = list(csv.reader(out_csv.read_text().splitlines()))
+    assert rows[0][:4] == ["case", "striking_velocity [m/s]", "model", "depth [m]"]
+    velocities = sorted({round(float(r[1])) for r in rows[1:]})
+    assert velocities == list(range(400, 1700, 100))
+    models = {r[2] for r in rows[1:]}
+    assert {"rigid", "quasi_rigid", "elastic", "elastic_exact_rod"} <= models
+    assert len(rows) - 1 == len(velocities) * len(models)
+    results = json.loads((tmp_path / "out" / "results.json").read_text())
+    assert "--csv" not in results["generated_by"]["command"]  # the report's command reproduces the folder

@@ -41,9 +41,9 @@ def _num(x) -> str:
 
 def depth_rows(result: dict, case_name: str) -> list[list[str]]:
     """Rows of :data:`CSV_HEADER` for one case's results (models the results lack are left out)."""
-    U = list(result.get("striking_velocity_m_s") or [])
+    U = list(result.get("striking_velocity_m_s", []))  # lists (penetrate) or arrays (run's results)
     valid = result.get("valid") or {}
-    regime = result.get("regime") or [""] * len(U)
+    regime = list(result.get("regime", [""] * len(U)))
     rows = []
     for i, u in enumerate(U):
         for model, (dkey, tkey) in MODELS.items():
