@@ -77,9 +77,13 @@ def command_page(prog: str, name: str, module_name: str, help_: str) -> str:
     usage = parser.format_usage().replace("usage: ", "").strip()
     lines = [f"# `{prog} {name}`", "", _md_escape(help_[:1].upper() + help_[1:]) + ".", ""]
     doc = inspect.getdoc(importlib.import_module(module_name)) or ""
-    first = doc.split("\n\n")[0].strip()
-    if first:
-        lines += ["", "```text", first, "```", ""]
+    doc = re.sub(r":\w+:`~?([^`]+)`", r"`\1`", doc).replace("``", "`")  # reST roles and literals as Markdown code
+    paragraphs = [p for p in doc.split("\n\n") if p.strip()]
+    if paragraphs and paragraphs[0].strip().startswith("`python -m"):
+        paragraphs = paragraphs[1:]  # the usage line: the section below says it
+    prose = [" ".join(p.split()) for p in paragraphs if not p.lstrip().startswith(("-", "|", "    "))]
+    if prose:
+        lines += ["", *[f"{p}\n" for p in prose]]
     lines += ["## Usage", "", "```text", usage, "```", "", "## Arguments and options", "",
               "| argument | value | default | description |", "|---|---|---|---|"]
     for action in parser._actions:

@@ -57,7 +57,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--contact", choices=("full", "separated"), default=None,
                         help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
     parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
-    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+    parser.add_argument("--force", action="store_true", help="overwrite an existing report (and --csv file)")
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
                         "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
@@ -65,7 +65,7 @@ def add_arguments(parser) -> None:
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
                              "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding)")
     parser.add_argument("--csv", metavar="FILE", default=None,
-                        help="also write FILE.csv: one row per case, striking velocity and model (units in the header)")
+                        help="also write FILE (CSV): one row per case, striking velocity and model (units in the header)")
 
 
 def _load(paths):
