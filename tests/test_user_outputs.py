@@ -106,7 +106,7 @@ def test_penetrate_csv_and_per_shot_table(tmp_path):
     assert len(body) == len(velocities) * len(models)  # one row per velocity and model
     # the per-shot table: every rigid shot of the data file, its measured depth as the file prints it
     shots = _data_depths_mm()
-    table = proc.stdout.split("per shot, model elastic_exact_rod")[1]
+    table = proc.stdout.split("model elastic_exact_rod: error")[1]
     for shot, depth in shots.items():
         m = re.search(rf"^\s+{re.escape(shot)}\s+(\d+)\s+([\d.]+)\s+([\d.]+)\s+([+-][\d.]+)", table, re.M)
         assert m, shot

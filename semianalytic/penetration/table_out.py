@@ -93,7 +93,7 @@ def shot_table(rows: list[dict], model: str, intervals: dict | None = None) -> l
     m); ``intervals``: optional ``{"0.05": [...], "0.95": [...]}`` at the shots' velocities (the
     90 % predictive interval of the posterior), else the column says ``-``.
     """
-    lines = [f"  per shot, model {model}: error = (predicted - measured) / measured; "
+    lines = [f"  per shot (the shots of the statistics above), model {model}: error = (predicted - measured) / measured; "
              + ("inside = measured depth inside the 90 % predictive interval" if intervals else
                 "inside: needs --posterior (90 % predictive interval)"),
              f"    {'shot':<10} {'U_s [m/s]':>9} {'predicted [mm]':>14} {'measured [mm]':>13} {'error [%]':>9} "
