@@ -247,6 +247,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--grading", type=float, default=None,
                         help="corner grading mu = grading * lambda / 2 of the FEM meshes (default 0.4; 0: none)")
     add_output_arguments(parser, "")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar on stderr (it is off anyway when stderr is not a terminal)")
 
 
 def _parse_depths(text: str | None) -> tuple[float, ...]:
@@ -273,6 +274,30 @@ def _parse_study_h(text: str) -> tuple[float, ...]:
     return vals
 
 
+def verify_command(args) -> str:
+    """The command line that reproduces a report exactly: the case as given (relative) and every
+    option that changes the result, with ``--force`` (the report then exists)."""
+    import shlex
+
+    case = Path(args.case)
+    words = ["python", "-m", "fem_check", "verify", case.as_posix() if not case.is_absolute() else case.name]
+    if args.depths is not None:
+        words += ["--depths", ",".join(f"{v:g}" for v in _parse_depths(args.depths))]
+    if args.h != 0.04:
+        words += ["--h", f"{args.h:g}"]
+    if args.quick:
+        words.append("--quick")
+    if args.study_h != "0.16,0.08,0.04,0.02":
+        words += ["--study-h", args.study_h]
+    if args.grading is not None:
+        words += ["--grading", f"{args.grading:g}"]
+    if args.name:
+        words += ["--name", args.name]
+    out = Path(args.out)
+    words += ["--out", out.as_posix() if not out.is_absolute() else out.name, "--force"]
+    return " ".join(shlex.quote(w) for w in words)
+
+
 def run(args) -> int:
     from fem_check.report import Report, emit_json
     from semianalytic.case import load_case
@@ -295,11 +320,16 @@ def run(args) -> int:
     report = None if args.no_report else Report(Path(args.out), name, args.force)
     if report:
         report.check()
+    from semianalytic.progress import stages
+
+    bar = stages(1 if args.quick else 2, "fem_check verify", quiet=getattr(args, "quiet", False))
     if case.body is not None:
         meridian = body_from_section(case.body)
         exact = exact_added_mass(case.body)
+        bar.step("added mass, FEM (P1, P2) against BEM" + ("" if args.quick else " and convergence"))
         res = body_verification(meridian, exact, h_main=min(args.h, 0.1), convergence=not args.quick)
         if not args.quick and exact is not None:
+            bar.step("far-field study")
             res["far_field"] = body_far_field_study(meridian, exact)
         payload = {"case": case.title, "kind": "body", **res}
     else:
@@ -307,6 +337,7 @@ def run(args) -> int:
 
         nose = nose_from_section(case.projectile)
         memo: dict = {}  # solves shared by the comparison and the convergence study
+        bar.step(f"A, B, C by FEM and BEM at {len(depths)} depths")
         rows = compare_depths(nose, depths, h=args.h, grading=args.grading, memo=memo)
         scale = depth_scale(nose)
         payload = {"case": case.title, "kind": "halfspace", "nose": nose.kind, "diameter_m": nose.diameter,
@@ -314,6 +345,8 @@ def run(args) -> int:
                    "depth_scale_m": scale, "h_over_d": args.h, "depths": rows,
                    "max_rel_diff": max(r["max_rel_diff"] for r in rows)}
         cornered = has_singular_corners(nose, np.asarray(depths) * scale)
+        if not args.quick:
+            bar.step("refinement study (cornered nose)" if cornered else "convergence and far-field studies")
         if not args.quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
             payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading, memo=memo)
         elif not args.quick:
@@ -321,8 +354,11 @@ def run(args) -> int:
             if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
                 payload["far_field"] = halfspace_far_field_study()
                 payload["hemisphere_exact"] = hemisphere_check()
+    bar.close()
     if report:
         from fem_check.verify_report import write_verify_report
+
+        payload["command"] = verify_command(args)
 
         write_verify_report(report, case, payload)
         payload["report"] = str(report.path)

@@ -303,7 +303,10 @@ def parse_case(data: Mapping[str, Any], path: Path | None = None) -> Case:
     unknown = [k for k in data if k not in _CORE and k not in SECTIONS and k not in _META_KEYS]
     if unknown:
         known = ", ".join(sorted([*_CORE, *SECTIONS]))
-        raise InputError(unknown[0], f"unknown section or key; known sections: {known}")
+        from semianalytic.schema import did_you_mean
+
+        hint = did_you_mean(unknown[0], [*_CORE, *SECTIONS, *_META_KEYS])
+        raise InputError(unknown[0], f"unknown section or key{hint} (known sections: {known})")
     for key in _META_KEYS:
         if key in data and not isinstance(data[key], str):
             raise InputError(key, "must be a string")

@@ -37,12 +37,31 @@ COMMANDS: dict[str, tuple[str, str]] = {
 MAX_WARNINGS_PER_KIND = 3
 
 
-def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | None) -> int:
+# The three lines `python -m semianalytic --help` opens with.
+START_HERE = (
+    "start here: python -m semianalytic demo            (runs a bundled case, prints where its report is)",
+    "            python -m semianalytic penetrate CASE  (depth per striking velocity; cases/ holds examples)",
+    "            python -m semianalytic COMMAND --help  (options of one command; docs: make docs)",
+)
+
+
+def version_text(prog: str) -> str:
+    """``--version``: the program and the package version."""
+    from semianalytic import __version__
+
+    return f"{prog} (penetration-mechanics {__version__})"
+
+
+def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | None,
+             start_here: tuple[str, ...] = ()) -> int:
     """Shared by both packages' CLIs: pick the command, import it, run it, map errors."""
     argv = list(sys.argv[1:] if argv is None else argv)
+    if argv and argv[0] == "--version":
+        print(version_text(prog))
+        return 0
     if not argv or argv[0] in ("-h", "--help"):
         width = max(len(n) for n in commands)
-        lines = [f"usage: {prog} COMMAND [options]", "", "commands:"]
+        lines = [*start_here, *([""] if start_here else []), f"usage: {prog} [--version] COMMAND [options]", "", "commands:"]
         lines += [f"  {name:<{width}}  {help_}" for name, (_, help_) in commands.items()]
         print("\n".join(lines))
         return 0 if argv else 2
@@ -112,4 +131,4 @@ def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[
 
 
 def main(argv: list[str] | None = None) -> int:
-    return dispatch("python -m semianalytic", COMMANDS, argv)
+    return dispatch("python -m semianalytic", COMMANDS, argv, START_HERE)

@@ -9,6 +9,7 @@ never import them.
 from __future__ import annotations
 
 import math
+import re
 import types
 import typing
 from typing import Any
@@ -116,7 +117,9 @@ def validate_section(name: str, model: type[BaseModel], data: Any) -> Any:
     try:
         return model.model_validate(data)
     except ValidationError as exc:
-        err = exc.errors()[0]
+        errors = exc.errors()
+        # an unknown (misspelt) key first: the "missing" error it causes is only its consequence
+        err = next((e for e in errors if e.get("type") == "extra_forbidden"), errors[0])
         inner = (err.get("ctx") or {}).get("error")
         if isinstance(inner, InputError):  # a cross-field check that names its own field
             raise InputError(inner.field, inner.message) from None
@@ -126,7 +129,67 @@ def validate_section(name: str, model: type[BaseModel], data: Any) -> Any:
                 continue  # the tag of a discriminated union (e.g. [target.resistance] model), not a key
             parts.append(str(p))
             node = node.get(p) if isinstance(node, dict) else None
-        raise InputError(".".join(parts), pydantic_message(err)) from None
+        if err.get("type") in ("union_tag_invalid", "union_tag_not_found"):  # name the tag's key itself
+            parts.append(str((err.get("ctx") or {}).get("discriminator", "model")).strip("'"))
+        raise InputError(".".join(parts), _project_words(err, model) or pydantic_message(err)) from None
+
+
+def _models_in(annotation: Any) -> list[type[BaseModel]]:
+    """The pydantic models an annotation can hold (through Optional, unions, Annotated, lists)."""
+    if isinstance(annotation, type) and issubclass(annotation, BaseModel):
+        return [annotation]
+    return [m for a in typing.get_args(annotation) for m in _models_in(a)]
+
+
+def allowed_values(annotation: Any) -> list[Any]:
+    """The values of a ``Literal`` annotation (through Optional and Annotated), else []."""
+    if typing.get_origin(annotation) is typing.Literal:
+        return list(typing.get_args(annotation))
+    return [v for a in typing.get_args(annotation) for v in allowed_values(a)]
+
+
+def _keys_at(model: type[BaseModel], loc: tuple) -> list[str]:
+    """The valid keys of the table at ``loc`` (the last item of ``loc`` is the bad key)."""
+    classes = [model]
+    for p in loc[:-1]:
+        if isinstance(p, int):
+            continue
+        fields = [c.model_fields[p] for c in classes if p in c.model_fields]
+        if fields:
+            classes = [m for f in fields for m in _models_in(f.annotation)]
+        else:  # the tag of a discriminated union: the member whose `model` literal holds it
+            tagged = [c for c in classes if p in allowed_values(getattr(c.model_fields.get("model"), "annotation", None))]
+            classes = tagged or classes
+    return sorted({k for c in classes for k in c.model_fields})
+
+
+def did_you_mean(word: str, choices: list[str]) -> str:
+    """`` (did you mean 'x'?)`` for the closest of ``choices`` (difflib), else ``""``."""
+    import difflib
+
+    close = difflib.get_close_matches(str(word), [str(c) for c in choices], n=1, cutoff=0.6)
+    return f"; did you mean {close[0]!r}?" if close else ""
+
+
+def _project_words(err: dict, model: type[BaseModel]) -> str | None:
+    """An unknown key with its closest valid key, a wrong choice with the valid ones: the
+    project's words for pydantic's ``extra_forbidden``, ``literal_error`` and
+    ``union_tag_invalid`` errors (None for any other error)."""
+    typ, loc, ctx = err.get("type"), tuple(err.get("loc", ())), err.get("ctx") or {}
+    if typ == "extra_forbidden" and loc:
+        keys = _keys_at(model, loc)
+        return f"unknown key{did_you_mean(loc[-1], keys)} (valid keys: {', '.join(keys)})"
+    if typ == "literal_error":
+        choices = re.findall(r"'([^']*)'", str(ctx.get("expected", "")))
+        got = err.get("input")
+        return f"{got!r} is not one of {', '.join(choices)}{did_you_mean(got, choices)}"
+    if typ == "union_tag_invalid":
+        choices = re.findall(r"'([^']*)'", str(ctx.get("expected_tags", "")))
+        got = ctx.get("tag", err.get("input"))
+        return f"{got!r} is not one of {', '.join(choices)}{did_you_mean(got, choices)}"
+    if typ == "union_tag_not_found":
+        return f"missing {str(ctx.get('discriminator', 'model')).strip(chr(39))!r} (the kind of table this is)"
+    return None
 
 
 def read_toml_text(path: Any) -> dict:

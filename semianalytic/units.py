@@ -224,6 +224,8 @@ def _quantity_validator(kind: str, positive: bool = False, nonnegative: bool = F
             raise ValueError(f"must not be negative; got {value!r}")
         return out
 
+    validate.quantity_kind = kind  # read by the case-file reference of the docs (docs_hooks)
+    validate.sign = "positive" if positive else "non-negative" if nonnegative else ""
     return BeforeValidator(validate)
 
 

@@ -141,3 +141,18 @@ def test_fem_field_file(tmp_path):
     assert near.sum() > 20
     # fem_check's own BEM-FEM agreement target is 1e-3 (A, C); the coarse h = 0.16 d mesh here gives ~3e-4
     assert np.max(np.abs(diff[near])) < 1e-3 * np.max(np.abs(ref[near]))
+
+
+def test_every_array_and_the_coordinates_carry_their_unit(sphere_files):
+    """Field data ``units`` names the unit of the coordinates and of every point-data array
+    (written by hand here: velocity and speed in m/s, the potential at unit speed in m, Phi =
+    u phi in m^2/s); the striking speed of the field survives as field data."""
+    expected = {"coordinates": "m", "velocity": "m/s", "speed": "m/s", "Phi": "m^2/s"}
+    for f in sphere_files:
+        mesh = pv.read(f)
+        units = dict(u.split(": ", 1) for u in mesh.field_data["units"])
+        assert {k: units[k] for k in expected} == expected
+        assert units["phi"].startswith("m ")
+        assert set(mesh.point_data.keys()) <= set(units)
+        assert list(mesh.field_data["coordinates_unit"]) == ["m"]
+        assert float(mesh.field_data["speed_u_m_s"][0]) == U

@@ -51,8 +51,8 @@ def run(args) -> int:
     print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
     for m in result["settings"]["models"]:
         s = result["posterior"]["models"][m]["summary"]
-        line = f"  {m:<18} " + ", ".join(f"{k} median {s[k]['q50'] / 1e6:.1f} MPa [{s[k]['q05'] / 1e6:.1f}, {s[k]['q95'] / 1e6:.1f}]"
-                                         for k in result["settings"]["parameters"]) + f"  sigma {s['sigma']['q50']:.3f}"
+        line = f"  {m:<18} " + ", ".join(f"{k} median {s[k]['q50'] / 1e6:.1f} MPa, 90 % interval [{s[k]['q05'] / 1e6:.1f}, {s[k]['q95'] / 1e6:.1f}] MPa"
+                                         for k in result["settings"]["parameters"]) + f"  sigma {s['sigma']['q50']:.3f} (model discrepancy, dimensionless)"
         if result["cross_validation"] is not None:
             st = result["cross_validation"]["loo"][m]["statistics"]
             line += (f"  LOO: mean |e| {100 * st['mean_abs_error']:.1f} %, 50 % coverage {100 * st['coverage_50']:.0f} %, "

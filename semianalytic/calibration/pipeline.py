@@ -77,7 +77,7 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
         for name, data in figs.items():
             out.write_bytes(name, data)
         out.write_text(f"{args.report_name}.md", to_markdown(doc))
-        out.write_text(f"{args.report_name}.html", to_html(doc))
+        out.write_text(f"{args.report_name}.html", to_html(doc, images=figs.get))  # figures inline: self-contained
         if diag is not None:
             out.write_json("diagnosis.json", diag)
     if args.report is not None:
@@ -88,7 +88,7 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
         target.parent.mkdir(parents=True, exist_ok=True)
         for name, data in figs2.items():
             atomic_write_bytes(target.parent / name, data)
-        atomic_write_text(target.with_suffix(".html"), to_html(doc2))
+        atomic_write_text(target.with_suffix(".html"), to_html(doc2, images=figs2.get))
         atomic_write_text(target, to_markdown(doc2))
     result["cross_validation"] = cv
     return result

@@ -53,6 +53,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--json", action="store_true", help="print the optimum as JSON")
 
 
+# the printed objective's unit and meaning (optimize.model: depth_objective, deep_drag)
+OBJECTIVE_UNITS = {"depth": " m", "deep_drag": " (Bbar, dimensionless)"}
+OBJECTIVE_MEANING = {"depth": "minus the mean final depth, minimised", "deep_drag": "deep-penetration Bbar, minimised"}
+
+
 def run(args: argparse.Namespace) -> int:
     from semianalytic.optimize.pipeline import run_optimize
 
@@ -69,9 +74,11 @@ def run(args: argparse.Namespace) -> int:
         print(json.dumps(json_safe({k: v for k, v in result.items() if k != "history"}), indent=2))
     else:
         xs = ", ".join(f"{v['key']} = {x:.6g}" for v, x in zip(result["variables"], o["x"]))
-        print(f"optimum: {xs}; objective {o['objective']:.8g} ({result['objective']}); "
+        unit = OBJECTIVE_UNITS.get(result["objective"], "")
+        print(f"optimum: {xs}; objective {o['objective']:.8g}{unit} ({result['objective']}: "
+              f"{OBJECTIVE_MEANING.get(result['objective'], 'minimised')}); "
               f"{result['n_designs_total']} designs in {result['seconds_total']:.1f} s")
         g = result.get("confirmation")
         if g:
-            print(f"confirmation grid: best {g['best_objective']:.8g}, confirmed: {'yes' if g['confirmed'] else 'NO'}")
+            print(f"confirmation grid: best {g['best_objective']:.8g}{unit}, confirmed: {'yes' if g['confirmed'] else 'NO'}")
     return 0 if o["status"] == "ok" else 1

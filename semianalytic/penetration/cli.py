@@ -57,13 +57,15 @@ def add_arguments(parser) -> None:
     parser.add_argument("--contact", choices=("full", "separated"), default=None,
                         help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
     parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
-    parser.add_argument("--force", action="store_true", help="overwrite an existing report")
+    parser.add_argument("--force", action="store_true", help="overwrite an existing report (and --csv file)")
     parser.add_argument("--part1-model", choices=("rigid", "quasi_rigid", "elastic", "elastic_exact_rod"),
                         default="elastic_exact_rod", help="Part I model of the regime-aware depth_m below the erosion "
                         "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
     parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None, action="append",
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
                              "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding)")
+    parser.add_argument("--csv", metavar="FILE", default=None,
+                        help="also write FILE (CSV): one row per case, striking velocity and model (units in the header)")
 
 
 def _load(paths):
@@ -157,6 +159,19 @@ def _warn_separation(result: dict) -> None:
               "full contact is assumed (try --contact separated)", file=sys.stderr)
 
 
+def _shot_intervals(case, shots, args):
+    """The 90 % predictive interval of ``--posterior`` at the shots' velocities (None without it)."""
+    if not args.posterior:
+        return None
+    from semianalytic.cache import coefficients_for_case
+    from semianalytic.calibration.evaluate import predict_with_posterior
+
+    coefficients = coefficients_for_case(case, args.coefficients, args.cache_dir)[0]
+    q = predict_with_posterior(case, coefficients, args.posterior, [s["velocity_m_s"] for s in shots],
+                               part1_model=args.part1_model)["depth_quantiles_m"]
+    return q.get(args.part1_model)
+
+
 def run(args) -> int:
     from semianalytic.io import check_report_target
     from semianalytic.cache import coefficients_for_case
@@ -170,6 +185,10 @@ def run(args) -> int:
 
         for case in cases:
             check_coefficients(case)
+    if args.csv is not None:
+        from semianalytic.penetration.table_out import check_csv_target
+
+        check_csv_target(args.csv, args.force)
     if args.report is not None:
         from semianalytic.penetration.report import report_path
 
@@ -198,8 +217,20 @@ def run(args) -> int:
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
         print(json.dumps(json_safe(objs[0] if len(objs) == 1 else {"cases": objs}), indent=1, allow_nan=False))
     else:
-        for r, d in zip(results, descs):
+        from semianalytic.penetration.table_out import shot_table
+
+        for r, d, case in zip(results, descs, cases):
             _print_text(r, d)
+            shots = (r.get("validation") or {}).get("shots")
+            if shots:  # predicted against measured, shot by shot
+                print("\n".join(shot_table(shots, args.part1_model, _shot_intervals(case, shots, args))))
+    if args.csv is not None:
+        from semianalytic.io import atomic_write_text
+        from semianalytic.penetration.table_out import depth_csv
+
+        atomic_write_text(args.csv, depth_csv([(str(c.path.name) if c.path else c.title, r) for c, r in zip(cases, results)]))
+        if not args.json:
+            print(f"csv: {args.csv}")
     if args.report is not None:
         from semianalytic.penetration.report import write_report
 

@@ -241,7 +241,7 @@ def _validation_section(doc, ctx, w):
                   Series(U, res["depth_quasi_rigid_m"] * MM, "quasi-rigid", "--"),
                   Series(U, res["depth_elastic_m"] * MM, "2: elastic, paper's W2", "-."),
                   Series(U, res["depth_elastic_exact_rod_m"] * MM, "elastic, exact-rod W2", ":"),
-                  Series(U, pe["forrestal"] * MM, "Forrestal", "c-"),
+                  Series(U, pe["forrestal"] * MM, "Forrestal", "c-", {"lw": 4.0, "alpha": 0.45}),
                   Series(U, pe["chen_li"] * MM, "Chen & Li", "m--")]
         pts = []
         for mat, mk in (("VAR4340", "ko"), ("AerMet100", "ks")):
@@ -386,7 +386,7 @@ def _regimes_section(doc, ctx, w, part1_model):
             ax.text(0.5 * (lo + hi), 0.97, r, transform=ax.get_xaxis_transform(), ha="center", va="top", fontsize=8)
         top = max(float(np.nanmax([r["measured_m"] for r in res["rows"]] + [0.0])) * MM * 1.6, 200.0)
         ax.set_ylim(0, top)
-        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(0.0, 0.93))
+        ax.legend(fontsize=7, loc="upper left", bbox_to_anchor=(1.02, 1.0), borderaxespad=0.0)  # outside the data
         doc.image(w.figure(f"depth_velocity_{mat}", fig),
                   f"{case.title}: all shots (markers: recorded response), the regime-aware curve (solid) for the mean "
                   f"shot mass {res['mass_kg'] * 1e3:.2f} g, regimes shaded (U_sC = {Uy:.0f} m/s, U_e = {Ue:.0f} m/s), "
@@ -563,6 +563,22 @@ def _w2_only(res, setup, w2):
     return oscillation_energy(w2, setup.rod, res.sigma0, res.t_star)
 
 
+def _shot_points(case) -> list:
+    """The case's measured shots (its [data] file) as markers, or [] when it has none."""
+    from semianalytic.report.figures import Points
+
+    data = case.section("data")
+    if data is None or data.file is None:
+        return []
+    from semianalytic.penetration.validation import load_shots
+
+    shots = load_shots(case)
+    if not shots:
+        return []
+    return [Points(np.array([s.velocity for s in shots]), np.array([s.depth for s in shots]) * MM,
+                   f"measured ({data.name})", "ks")]
+
+
 def _curves_section(doc, ctx, w):
     from semianalytic.report.figures import Series, line_figure
 
@@ -578,10 +594,11 @@ def _curves_section(doc, ctx, w):
                   Series(U, res["depth_elastic_m"] * MM, "2: elastic, paper's W2", "-."),
                   Series(U, res["depth_quasi_rigid_m"] * MM, "quasi-rigid", "--"),
                   Series(U, res["depth_elastic_exact_rod_m"] * MM, "elastic, exact-rod W2", ":"),
-                  Series(U, pe["forrestal"] * MM, "Forrestal", "c-"),
+                  Series(U, pe["forrestal"] * MM, "Forrestal (wide, under Chen & Li)", "c-", {"lw": 5.0, "alpha": 0.45}),
                   Series(U, pe["chen_li"] * MM, "Chen & Li", "m--")]
         title = case.title.split(":")[0]
-        fig = line_figure(series, "striking velocity U_s [m/s]", "final depth P [mm]", f"{title}: {_target_label(case)}", points=[])
+        pts = _shot_points(case)
+        fig = line_figure(series, "striking velocity U_s [m/s]", "final depth P [mm]", f"{title}: {_target_label(case)}", points=pts)
         U_sC = float(res["critical_velocity_m_s"][0])
         if np.isfinite(U_sC) and U_sC < U.max():
             ax = fig.axes[0]
@@ -589,7 +606,11 @@ def _curves_section(doc, ctx, w):
         stem = Path(case.path).stem if case.path else title
         doc.image(w.figure(stem, fig), f"{case.title}. Shaded: U_s >= U_sC = {U_sC:.0f} m/s (the projectile yields; "
                   "outside the model). Without data constants Forrestal and Chen & Li both use A Y = R_t and B = 3/2 and "
-                  "coincide. No experimental points are bundled: add a [data] file to the case to plot them.")
+                  "coincide (Forrestal drawn wide beneath). "
+                  + ("Markers: the case's measured shots." if pts else
+                     "The paper's experimental points for this projectile and target are not bundled (no [data] in the "
+                     "case): the only bundled shots, Piekutowski et al. (1999), are of another projectile and are "
+                     "plotted with their own curves above."))
 
 
 def _appendix_section(doc, ctx):

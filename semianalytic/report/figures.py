@@ -16,7 +16,10 @@ from matplotlib.backends.backend_agg import FigureCanvasAgg
 from matplotlib.figure import Figure
 
 LAYOUT = "constrained"
-LEGEND_LOC = "best"
+LEGEND_LOC = "upper left"  # anchored outside the axes, right of the data (LEGEND_ANCHOR): it never covers a point
+LEGEND_ANCHOR = (1.02, 1.0)
+# Curves without a style of their own get these in turn: distinguishable in grey print too
+AUTO_STYLES = ("-", "--", "-.", ":", (0, (5, 1, 1, 1, 1, 1)), (0, (1, 1)), (0, (8, 2)))
 
 __all__ = [
     "Series",
@@ -38,7 +41,8 @@ class Series:
     x: np.ndarray
     y: np.ndarray
     label: str
-    style: str = "-"
+    style: str | None = None  # None: the next of AUTO_STYLES
+    kwargs: dict = field(default_factory=dict)  # e.g. {"lw": 4, "alpha": 0.4} under a coinciding curve
 
 
 @dataclass(frozen=True)
@@ -60,13 +64,19 @@ def png_bytes(fig: Figure, dpi: int = 110) -> bytes:
     return buf.getvalue()
 
 
-def _draw(ax, series: Sequence[Series], points: Sequence[Points] = ()):
+def _draw(ax, series: Sequence[Series], points: Sequence[Points] = (), legend: bool = True):
+    auto = 0
     for s in series:
-        ax.plot(np.asarray(s.x), np.asarray(s.y), s.style, label=s.label, lw=1.6)
+        kw = {"lw": 1.6, **s.kwargs}
+        if s.style is None:
+            ax.plot(np.asarray(s.x), np.asarray(s.y), ls=AUTO_STYLES[auto % len(AUTO_STYLES)], label=s.label, **kw)
+            auto += 1
+        else:
+            ax.plot(np.asarray(s.x), np.asarray(s.y), s.style, label=s.label, **kw)
     for p in points:
         ax.plot(np.asarray(p.x), np.asarray(p.y), p.marker, ls="none", label=p.label, ms=5, **p.kwargs)
-    if series or points:
-        ax.legend(fontsize=8, loc=LEGEND_LOC)
+    if (series or points) and legend:
+        ax.legend(fontsize=8, loc=LEGEND_LOC, bbox_to_anchor=LEGEND_ANCHOR, borderaxespad=0.0)
     ax.grid(True, alpha=0.3)
 
 
@@ -80,7 +90,7 @@ def line_figure(
     size=(6.4, 4.2),
 ) -> Figure:
     """A single-axes plot of curves (and points)."""
-    fig = Figure(figsize=size, layout=LAYOUT)
+    fig = Figure(figsize=(size[0] + 2.2, size[1]), layout=LAYOUT)  # room for the legend beside the axes
     ax = fig.add_subplot()
     _draw(ax, series, points)
     if logx:
@@ -101,7 +111,7 @@ def panels_figure(
 ) -> Figure:
     """Stacked panels sharing x: ``panels = [(ylabel, [Series, ...]), ...]``."""
     n = len(panels)
-    fig = Figure(figsize=size or (6.4, 2.2 * n + 0.6), layout=LAYOUT)
+    fig = Figure(figsize=size or (8.6, 2.2 * n + 0.6), layout=LAYOUT)
     axes = fig.subplots(n, 1, sharex=sharex, squeeze=False)[:, 0]
     for ax, (ylabel, series) in zip(axes, panels):
         _draw(ax, series)
@@ -120,10 +130,12 @@ def side_by_side_figure(
 ) -> Figure:
     """Panels in one row, each with its own axes: ``[(xlabel, ylabel, [Series, ...]), ...]``."""
     n = len(panels)
-    fig = Figure(figsize=size or (4.6 * n, 3.9), layout=LAYOUT)
+    fig = Figure(figsize=size or (4.6 * n + 2.2, 3.9), layout=LAYOUT)
     axes = fig.subplots(1, n, squeeze=False)[0]
-    for ax, (xlabel, ylabel, series) in zip(axes, panels):
-        _draw(ax, series)
+    labels = [[s.label for s in series] for _, _, series in panels]
+    shared = all(lab == labels[-1] for lab in labels)  # the same curves in every panel: one legend, at the right
+    for k, (ax, (xlabel, ylabel, series)) in enumerate(zip(axes, panels)):
+        _draw(ax, series, legend=not shared or k == n - 1)
         ax.set_xlabel(xlabel)
         ax.set_ylabel(ylabel)
     fig.suptitle(title, fontsize=10)
@@ -236,7 +248,11 @@ def velocity_field_figure(
     ax.set_ylim(-r1 * s, r1 * s)
     ax.set_xlabel(f"x, depth below the free surface [{unit}]")
     ax.set_ylabel(f"r, distance from the axis [{unit}]")
-    ax.set_title(title, fontsize=10)
+    import textwrap
+
+    # the figure's title, not the axes': an equal-aspect axes is shrunk after the layout placed an axes
+    # title, which then fell off the top edge; wrapped, it never runs past the sides either
+    fig.suptitle("\n".join(textwrap.wrap(title, 90)), fontsize=10)
     cb = fig.colorbar(pcm, ax=ax, extend=extend, shrink=0.9)
     cb.set_label("|v| [m/s]" + (" (log scale)" if type(norm).__name__ == "LogNorm" else ""))
     fig.legend(

@@ -16,20 +16,22 @@ _ROOT = Path(__file__).resolve().parent.parent.parent  # the checkout (or site-p
 
 @functools.lru_cache(maxsize=1)
 def version() -> str:
-    """``penetration-mechanics <package version>``, with ``git describe --always --dirty`` of the
-    checkout when there is one (a wheel install has none)."""
+    """``penetration-mechanics <package version>``, with ``git describe --always`` of the checkout
+    when there is one and it is clean (a wheel install has none).  A checkout with uncommitted
+    changes gives the package version only: a committed report never names a ``-dirty``
+    revision, which no one could check out."""
     from semianalytic import __version__
 
     text = f"penetration-mechanics {__version__}"
     if (_ROOT / ".git").exists():
         try:
             out = subprocess.run(
-                ["git", "-C", str(_ROOT), "describe", "--always", "--dirty", "--tags"],
+                ["git", "-C", str(_ROOT), "describe", "--always", "--dirty=-dirty", "--tags"],
                 capture_output=True, text=True, timeout=10, check=True,
             )
         except (OSError, subprocess.SubprocessError):
             return text
-        if out.stdout.strip():
+        if out.stdout.strip() and not out.stdout.strip().endswith("-dirty"):
             text += f" (git {out.stdout.strip()})"
     return text
 

@@ -183,8 +183,44 @@ def revolved_surface(profile: np.ndarray, segments: int = 48):
     return meshio.Mesh(pts, [("quad", quads)])
 
 
+# The unit of every array the writers here produce (point data and field data), and of the
+# coordinates; written into each .vtu as string field data (``units``, ``coordinates_unit``).
+UNITS = {
+    "coordinates": "m",
+    "velocity": "m/s",
+    "speed": "m/s",
+    "phi": "m (potential at unit striking speed)",
+    "Phi": "m^2/s",
+    "phi_bem": "m (potential at unit striking speed)",
+    "phi_difference": "m (potential at unit striking speed)",
+    "speed_u_m_s": "m/s",
+    "depth_m": "m",
+}
+
+
+def _field_data_xml(mesh) -> str:
+    """A VTK XML ``<FieldData>`` block: the mesh's field data (meshio's VTU writer drops it)
+    and, as strings, the unit of the coordinates and of every array (:data:`UNITS`)."""
+    from xml.sax.saxutils import quoteattr
+
+    def strings(name: str, values: list[str]) -> str:
+        codes = " ".join(" ".join(str(b) for b in v.encode("utf-8")) + " 0" for v in values)
+        return (f'<DataArray type="String" Name={quoteattr(name)} NumberOfTuples="{len(values)}" format="ascii">'
+                f"{codes}</DataArray>")
+
+    names = ["coordinates", *mesh.point_data, *(mesh.field_data or {})]
+    arrays = [strings("units", [f"{n}: {UNITS.get(n, 'dimensionless')}" for n in names]),
+              strings("coordinates_unit", [UNITS["coordinates"]])]
+    for name, value in (mesh.field_data or {}).items():
+        v = np.atleast_1d(np.asarray(value, float))
+        arrays.append(f'<DataArray type="Float64" Name={quoteattr(name)} NumberOfTuples="{v.size}" format="ascii">'
+                      + " ".join(repr(float(x)) for x in v) + "</DataArray>")
+    return "<FieldData>\n" + "\n".join(arrays) + "\n</FieldData>\n"
+
+
 def write_vtu(mesh, path: str | os.PathLike) -> Path:
-    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename)."""
+    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename),
+    with the units of its coordinates and arrays as field data (:data:`UNITS`)."""
     import meshio
 
     path = Path(path)
@@ -196,6 +232,9 @@ def write_vtu(mesh, path: str | os.PathLike) -> Path:
     os.chmod(tmp, 0o666 & ~_umask())
     try:
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
+        text = Path(tmp).read_text(encoding="ascii")
+        at = text.index("<UnstructuredGrid>") + len("<UnstructuredGrid>\n")
+        Path(tmp).write_text(text[:at] + _field_data_xml(mesh) + text[at:], encoding="ascii")
         os.replace(tmp, path)
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
@@ -298,11 +337,27 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
         # the whole projectile: in parallel projection it covers exactly its own cut section
         p.add_mesh(pv.read(str(surface_path)), color="lightgrey", smooth_shading=True)
     if title:
-        p.add_text(title, font_size=10, color="black")
+        import textwrap
+
+        p.add_text("\n".join(textwrap.wrap(title, 70)) + "\naxes: x, depth [m] (horizontal); r, radius [m] (vertical)",
+                   font_size=9, color="black")  # VTK drops the vertical axis title in a 2D view
+    # axes with their unit and a length scale (the coordinates are in metres; labelled in mm)
+    b = vol.bounds
+    x_lo = 0.0 if abs(b[0]) < 1e-12 else float(b[0])  # the free surface x = 0, not -3e-18
+    p.show_bounds(bounds=[x_lo, b[1], -b[3], b[3], 0.0, 0.0], xtitle="x, depth [m]", ytitle="r, radius [m]", ztitle="",
+                  location="outer", ticks="outside", font_size=9, color="black", fmt="%.3g", show_zaxis=False,
+                  show_zlabels=False)
+    span = float(b[1] - b[0])
+    bar_len = 10.0 ** math.floor(math.log10(max(span / 4.0, 1e-12)))  # 1, 10, 100 ... mm: about a quarter of the window
+    y0 = -0.92 * float(b[3])
+    x0 = float(b[1]) - 1.1 * bar_len
+    p.add_mesh(pv.Line((x0, y0, 0.02 * span), (x0 + bar_len, y0, 0.02 * span)), color="white", line_width=5)
+    p.add_point_labels([(x0 + 0.5 * bar_len, y0 + 0.09 * float(b[3]), 0.02 * span)], [f"{bar_len * 1e3:g} mm"], font_size=12,
+                       text_color="white", shape=None, show_points=False, always_visible=True)
     p.view_xy()
     p.enable_parallel_projection()
     p.reset_camera(bounds=vol.bounds)
-    p.camera.zoom(1.1)
+    p.camera.zoom(0.95)  # room for the axes' titles
     png_path = Path(png_path)
     png_path.parent.mkdir(parents=True, exist_ok=True)
     p.screenshot(str(png_path))

@@ -26,6 +26,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--contact", choices=("full", "separated"), default=None,
                         help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
     parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
+    parser.add_argument("--quiet", action="store_true", help="no progress bar on stderr (it is off anyway when stderr is not a terminal)")
+    parser.add_argument("--csv", metavar="FILE", default=None,
+                        help="also write FILE: one row per striking velocity and model of the penetration (units in the header)")
 
 
 def run(args: argparse.Namespace) -> int:
@@ -34,15 +37,27 @@ def run(args: argparse.Namespace) -> int:
     from semianalytic.run.pipeline import run_case
 
     check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
+    if args.csv is not None:
+        from semianalytic.penetration.table_out import check_csv_target
+
+        check_csv_target(args.csv, args.force)
     out = Path(args.out)
     results = run_case(
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir,
-        contact=args.contact, tolerance=args.tolerance,
+        contact=args.contact, tolerance=args.tolerance, quiet=args.quiet,
     )
+    if args.csv is not None:
+        from semianalytic.io import atomic_write_text
+        from semianalytic.penetration.table_out import depth_csv
+
+        pen = results["analyses"].get("penetration") or {}
+        atomic_write_text(args.csv, depth_csv([(Path(args.case).name, pen)] if pen else []))
     if args.json:
         print(json.dumps(results, indent=2, default=str))
     else:
         for name, why in results["skipped"].items():
             print(f"skipped {name}: {why}")
         print(f"report: {(out / 'report.html').resolve()}")
+        if args.csv is not None:
+            print(f"csv: {args.csv}" + ("" if results["analyses"].get("penetration") else " (header only: the case has no penetration)"))
     return 0

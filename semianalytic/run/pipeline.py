@@ -28,7 +28,7 @@ __all__ = ["run_case", "introduction"]
 
 
 def run_case(case_path, out, *, force: bool = False, only=None, render: bool = True, cache_dir=None,
-             contact=None, tolerance=None) -> dict:
+             contact=None, tolerance=None, quiet: bool = True, command: str | None = None) -> dict:
     """Run a case into ``out``; returns the results dict (also written to ``out/results.json``).
     ``contact`` / ``tolerance`` override ``[coefficients]`` (flags ``--contact``, ``--tolerance``)."""
     from semianalytic.case import load_case
@@ -41,6 +41,11 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     t0 = time.perf_counter()
     case = load_case(case_path)
     identity = case_identity(case_path)
+    if command is None:  # the command line that reproduces this folder, every flag that shaped it included
+        flags = [f"--only {a}" for a in (only or [])] + (["--no-render"] if not render else [])
+        flags += [f"--contact {contact}"] if contact is not None else []
+        flags += [f"--tolerance {tolerance}"] if tolerance is not None else []
+        command = " ".join([_command(identity, out, case_path), *flags, *(["--force"] if force else [])])
     if contact is not None or tolerance is not None:
         from semianalytic.cache import override_coefficients
 
@@ -53,11 +58,16 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
     with StagedDir(out, force) as staged:
         title = case.title or Path(case_path).stem
         ctx = Context(case, staged, run_section, Document(f"Report: {title}"), render=render, cache_dir=cache_dir)
-        introduction(ctx, identity, steps, skipped, _command(identity, out, case_path))
+        introduction(ctx, identity, steps, skipped, command)
+        from semianalytic.progress import stages
+
+        bar = stages(len(steps), "run", quiet=quiet)  # stderr only, and only on a terminal
         for step in steps:
+            bar.step(step.name)
             t = time.perf_counter()
             step.run(ctx)
             ctx.timings[step.name] = time.perf_counter() - t
+        bar.close()
         ctx.timings["total"] = time.perf_counter() - t0
         ctx.doc.heading("Run")
         ctx.doc.table(
@@ -69,7 +79,7 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
             # the case by file name and content hash: no output carries a machine path
             "case": {"path": identity["file"], "file": identity["file"], "sha256": identity["sha256"],
                      "title": case.title, "reproduces": case.reproduces},
-            "generated_by": {"command": _command(identity, out, case_path), "version": version()},
+            "generated_by": {"command": command, "version": version()},
             "analyses": ctx.results,
             "skipped": skipped,
             "timings_s": ctx.timings,
