@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from semianalytic.penetration import rod as rodmod
-from semianalytic.penetration.motion import MotionResult, deep_coefficients, solve_motion
+from semianalytic.penetration.motion import MotionResult, deep_coefficients, eq11_acceleration, solve_motion
 
 __all__ = [
     "W2_MODELS",
@@ -240,7 +240,7 @@ def solve_elastic(
         ts = np.linspace(0.0, qr.penetration_time, 201)
         Ps, us = qr.at(ts)
         A, B, C = (np.asarray(f(Ps), float) for f in (coefficients.A, coefficients.B, coefficients.C))
-        dus = -(0.5 * target_density * B * us**2 + C * resistance_pa) / (mass + target_density * A)
+        dus = eq11_acceleration(A, B, C, mass, target_density, resistance_pa, us**2)
         W1s = np.array([
             lateral_energy_from_profile(*coefficients.pressure_profile(P, target_density, u, du, resistance_pa), P, rod, poisson_ratio)
             for P, u, du in zip(Ps, us, dus)
