@@ -770,7 +770,9 @@ def separation_onset(table, mass: float, target_density: float, resistance_pa: f
     eq. (9) would turn negative somewhere on the nose (eq. (15)), or None.
 
     All knots and velocities at once: the nodes' pressure terms do not depend on the velocity,
-    so they are gathered once and p_c is evaluated on a (velocities x nodes) array."""
+    and p_c (eq. (9) with du/dt of eq. (11)) is linear in u^2 at each node, so each knot
+    separates for u^2 in a union of two intervals found once; the velocities are compared with
+    those bounds on a (velocities x knots) array."""
     from semianalytic.coefficients.contact import contact_pressure, pressure_terms
 
     reading = getattr(table, "reading", "body")
@@ -794,14 +796,24 @@ def separation_onset(table, mass: float, target_density: float, resistance_pa: f
     A = np.asarray(table.A(P_k[inside]), float)[owner]
     B = np.asarray(table.B(P_k[inside]), float)[owner]
     C = np.asarray(table.C(P_k[inside]), float)[owner]
+    # p_c of eq. (9) with du/dt of eq. (11) is linear in w = u^2 at each node: p_c = slope w + icpt
+    a_w = eq11_acceleration(A, B, 0.0, m, rho, R, 1.0)  # du/dt per unit u^2 (the velocity term)
+    a_0 = eq11_acceleration(A, 0.0, C, m, rho, R, 0.0)  # du/dt at u = 0 (the strength term)
+    slope = contact_pressure(phi, q, rho, a_w, 1.0, 0.0)
+    icpt = contact_pressure(phi, q, rho, a_0, 0.0, R)
+    # the w >= 0 where p_c <= 0: [0, x] (slope >= 0, icpt <= 0) or [y, inf) (slope < 0); per knot the union
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = -icpt / slope
+    x = np.where((slope > 0) & (icpt <= 0), ratio, np.where((slope == 0) & (icpt <= 0), np.inf, -np.inf))
+    y = np.where(slope < 0, np.maximum(ratio, 0.0), np.inf)
+    X, Y = np.full(len(inside), -np.inf), np.full(len(inside), np.inf)
+    has = np.diff(np.append(starts, len(owner))) > 0  # a knot without such nodes never separates
+    X[has] = np.maximum.reduceat(x, starts[has])
+    Y[has] = np.minimum.reduceat(y, starts[has])
     out = []
-    for lo in range(0, U.size, 64):  # blocks of velocities bound the (velocities x nodes) arrays
-        u2 = np.maximum(profile.speed2(U[lo:lo + 64, None], P_k[None, inside]), 0.0)
-        w = u2[:, owner]
-        a = eq11_acceleration(A, B, C, m, rho, R, w)  # du/dt of eq. (11), full contact
-        p = contact_pressure(phi, q, rho, a, w, R)  # p_c of eq. (9) at every node
-        sep = np.logical_or.reduceat(p <= 0, starts, axis=1) & (P_k[None, inside] < P_f[lo:lo + 64, None])
-        sep &= np.diff(np.append(starts, len(owner)))[None, :] > 0  # a knot without such nodes never separates
+    for lo in range(0, U.size, 256):  # blocks of velocities bound the (velocities x knots) arrays
+        u2 = np.maximum(profile.speed2(U[lo:lo + 256, None], P_k[None, inside]), 0.0)
+        sep = ((u2 <= X[None, :]) | (u2 >= Y[None, :])) & (P_k[None, inside] < P_f[lo:lo + 256, None])
         first = np.argmax(sep, axis=1)
         out.extend(float(P_k[inside[f]]) if sep[i, f] else None for i, f in enumerate(first))
     return out
