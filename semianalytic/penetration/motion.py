@@ -492,7 +492,7 @@ class DepthProfile:
                 Pn_ = P - r / dG
             bad = ~np.isfinite(Pn_) | (Pn_ < lo) | (Pn_ > hi)
             Pn_ = np.where(bad, 0.5 * (lo + hi), Pn_)
-            done = done | (np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
+            done = done | (((np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)) & np.isfinite(r))
             P = np.where(g == 0, P, Pn_)
             if np.all(done):
                 break
@@ -575,6 +575,9 @@ def reduced_profiles(coefficients, ratios, g_max: float, *, panel_scale: float =
         if np.all(G0 > g_max * (1.0 + 1e-9)):
             break
         P_to = edges[-1] * 2.0
+        if P_to > 1e3 * P_scale:  # a thousand deep-limit stopping depths: it does not stop
+            raise ConvergenceError(f"eq. (11) in P: G did not reach U_max^2 by P = {edges[-1]:.3g} m "
+                                   "(does the projectile stop?)")
     else:
         raise ConvergenceError("eq. (11) in P: G did not reach U_max^2 (does the projectile stop?)")
     F, G, dF, dG = (np.concatenate([p[i] for p in parts], axis=1) for i in range(4))
