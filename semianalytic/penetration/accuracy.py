@@ -16,7 +16,9 @@ whole curve again per coefficient.
   up to the stop (:meth:`~semianalytic.penetration.motion.DepthProfile.integration_error`),
   plus the root's tolerance; for the elastic depths (time grid and quadrature of eq. (30)) the
   change from the grid of 512 to 1024 cells with panels halved, extrapolated with the observed
-  order of convergence (from 256, 512, 1024 cells; between 1 and 4), at the same velocities.
+  order of convergence (from 256, 512, 1024 cells; between 1 and 4), and at least the change
+  from 256 to 512 cells (this project's own rule: the W2 kinks make the order erratic), at the
+  same velocities.
 - Velocities beyond the ``N_SUBSET`` solved again (this project's own rule): each gets twice
   the larger relative estimate of its two neighbours among them, times its own depth.
 
@@ -122,7 +124,7 @@ def _observed(U_sub, curve, setup, w1, base, profile) -> dict:
         d0 = np.abs(np.asarray(coarse[key]) - np.asarray(base[key]))
         with np.errstate(divide="ignore", invalid="ignore"):
             p = np.clip(np.nan_to_num(np.log2(d0 / d1), nan=1.0, posinf=4.0, neginf=1.0), 1.0, 4.0)
-        out[k] = d1 * 2.0**p / (2.0**p - 1.0)
+        out[k] = np.maximum(d1 * 2.0**p / (2.0**p - 1.0), d0)  # the coarser change bounds it for any order >= 1
     return out
 
 
