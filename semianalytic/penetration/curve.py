@@ -161,7 +161,7 @@ def _cumulative_simpson(f: np.ndarray, h: float) -> np.ndarray:
 _GX, _GW = np.polynomial.legendre.leggauss(32)
 _GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW  # on [0, 1]
 _WINDOW = 16  # grid cells before the elastic stop integrated by the mapped Gauss rule (see _elastic)
-_BLOCK = 128  # striking velocities per block (bounds the (velocities x grid) arrays)
+_BLOCK = 256  # striking velocities per block (bounds the (velocities x grid) arrays)
 
 
 @dataclass(frozen=True, eq=False)
@@ -234,10 +234,12 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
         fx = g(x[:, None])[0][:, 0]
         flip = fx * fb < 0
         upd = ~done
+        step = np.abs(x - b)
         a = np.where(upd & flip, b, a)
         fa = np.where(upd, np.where(flip, fb, 0.5 * fa), fa)
         b, fb = np.where(upd, x, b), np.where(upd, fx, fb)
-        done |= (np.abs(b - a) <= 4e-16) | (fb == 0)
+        # converged: the bracket collapsed, an exact zero, or a step below 1e-15 (of s in [0, 1])
+        done |= (np.abs(b - a) <= 4e-16) | (fb == 0) | (upd & (step <= 1e-15))
         if np.all(done):
             break
     s_star = b
