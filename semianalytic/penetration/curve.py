@@ -124,14 +124,14 @@ class PenetrationSetup:
 # --------------------------------------------------------------------------------------
 
 
-def _rows_hermite(s: np.ndarray, t: np.ndarray, dt: np.ndarray, S: np.ndarray) -> np.ndarray:
-    """t at row-wise points S (n, K) by cubic Hermite interpolation of the rows t (n, J+1) with
-    slopes dt on the uniform grid s (values and exact slopes: 4th order)."""
+def _rows_hermite(s: np.ndarray, t: np.ndarray, dt: np.ndarray, S: np.ndarray, rows=slice(None)) -> np.ndarray:
+    """t at row-wise points S (n, K) by cubic Hermite interpolation of the rows ``rows`` of t
+    (., J+1) with slopes dt on the uniform grid s (values and exact slopes: 4th order)."""
     J = s.size - 1
     x = np.clip(S, 0.0, 1.0) * J
     j = np.clip(np.floor(x).astype(np.intp), 0, J - 1)
     u = x - j
-    rows = np.arange(S.shape[0])[:, None]
+    rows = np.arange(t.shape[0])[rows][:, None]
     h = 1.0 / J
     u2 = u * u
     u3 = u2 * u
@@ -158,8 +158,11 @@ def _cumulative_simpson(f: np.ndarray, h: float) -> np.ndarray:
     return np.concatenate([np.zeros((f.shape[0], 1)), np.cumsum(piece, axis=1)], axis=1)
 
 
-_GX, _GW = np.polynomial.legendre.leggauss(32)
+_GX, _GW = np.polynomial.legendre.leggauss(16)
 _GX, _GW = 0.5 * (_GX + 1.0), 0.5 * _GW  # on [0, 1]
+_KX, _KW = np.polynomial.legendre.leggauss(6)
+_KX, _KW = 0.5 * (_KX + 1.0), 0.5 * _KW  # on [0, 1]
+_KINKS = 3  # kinks of the exact-rod energy split off inside the window (16 cells hold at most 3 on grids >= 128)
 _WINDOW = 16  # grid cells before the elastic stop integrated by the mapped Gauss rule (see _elastic)
 _BLOCK = 256  # striking velocities per block (bounds the (velocities x grid) arrays)
 
@@ -180,8 +183,8 @@ class _Stops:
     def stop_time(self) -> np.ndarray:
         return self.t[:, -1]
 
-    def time(self, S: np.ndarray) -> np.ndarray:
-        return _rows_hermite(self.s, self.t, self.dt, S)
+    def time(self, S: np.ndarray, rows=slice(None)) -> np.ndarray:
+        return _rows_hermite(self.s, self.t, self.dt, S, rows)
 
 
 def _stops(prof: DepthProfile, U0: np.ndarray, n_grid: int) -> _Stops:
@@ -208,13 +211,13 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     sig = np.asarray(sigma0, float)[:, None]
     Pf = st.P_f[:, None]
 
-    def g(S, T=None, ub2=None):  # (ubar^2 - 2W/m, ubar^2) at mapped coordinate S (rows)
-        P = Pf * S * (2.0 - S)
-        T = st.time(S) if T is None else T
-        W = oscillation_energy(w2, rod, sig, T) + lateral_energy(
-            w1, P, sigma0=sig, resistance_pa=setup.resistance_pa, rod=rod, poisson_ratio=nu
+    def g(S, T=None, ub2=None, r=slice(None)):  # (ubar^2 - 2W/m, ubar^2) at mapped coordinate S (rows r)
+        P = Pf[r] * S * (2.0 - S)
+        T = st.time(S, r) if T is None else T
+        W = oscillation_energy(w2, rod, sig[r], T) + lateral_energy(
+            w1, P, sigma0=sig[r], resistance_pa=setup.resistance_pa, rod=rod, poisson_ratio=nu
         )
-        ub2 = prof.speed2(st.U0[:, None], P) if ub2 is None else ub2
+        ub2 = prof.speed2(st.U0[r, None], P) if ub2 is None else ub2
         return ub2 - 2.0 * W / m, ub2
 
     vals, _ = g(np.broadcast_to(st.s, st.t.shape), st.t, st.u2)  # on the time grid: u^2 known already
@@ -249,18 +252,86 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     with np.errstate(divide="ignore", invalid="ignore"):
         f = np.where(vals > 0, np.sqrt(np.maximum(vals, 0.0) / st.u2), 0.0) * (2.0 * Pf * (1.0 - st.s)[None, :])
     i0 = np.maximum(j - 1 - _WINDOW, 0)
+    i0 -= i0 % 2  # an even node: whole Simpson pairs
     bulk = _cumulative_simpson(f, st.s[1] - st.s[0])[rows, i0]
+    if w2 == "exact-rod":  # the energy's kinks (multiples of L/c0, as elastic.solve_elastic's panels)
+        bulk = bulk + _kink_correction(st, f, i0, rod.length / rod.c0, lambda S, r: g(S, r=r))
     a0 = st.s[i0]
-    S = s_star[:, None] - (s_star - a0)[:, None] * (1.0 - _GX[None, :]) ** 2
-    dS = 2.0 * (s_star - a0)[:, None] * (1.0 - _GX[None, :])
+    # the window in tau, split at the kinks of the exact-rod energy inside it (up to _KINKS)
+    cuts = np.ones((n, _KINKS))
+    if w2 == "exact-rod":
+        period = rod.length / rod.c0
+        t0, t1 = st.t[rows, i0], st.time(s_star[:, None])[:, 0]
+        for c in range(_KINKS):
+            tk = (np.floor(t0 / period) + 1.0 + c) * period
+            inside = (tk < t1) & (t1 > t0)
+            if not inside.any():
+                break
+            r = rows[inside]
+            lo, hi = a0[inside], s_star[inside]
+            x = 0.5 * (lo + hi)
+            for _ in range(45):  # bisection on the monotone t(s) (Hermite): 1e-13 of the window
+                T = st.time(x[:, None], r)[:, 0]
+                lo, hi = np.where(T < tk[inside], x, lo), np.where(T < tk[inside], hi, x)
+                x = 0.5 * (lo + hi)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                cuts[inside, c] = np.clip(1.0 - np.sqrt((s_star[inside] - x) / (s_star[inside] - a0[inside])), 0.0, 1.0)
+    ends = np.concatenate([np.zeros((n, 1)), np.sort(np.nan_to_num(cuts, nan=1.0), axis=1), np.ones((n, 1))], axis=1)
+    width = np.diff(ends, axis=1)  # (n, _KINKS + 1) segments of [0, 1] in tau
+    tau = (ends[:, :-1, None] + width[:, :, None] * _GX[None, None, :]).reshape(n, -1)
+    wts = (width[:, :, None] * _GW[None, None, :]).reshape(n, -1)
+    S = s_star[:, None] - (s_star - a0)[:, None] * (1.0 - tau) ** 2
+    dS = 2.0 * (s_star - a0)[:, None] * (1.0 - tau) * wts
     gv, ub2 = g(S)
     with np.errstate(divide="ignore", invalid="ignore"):
         ratio = np.where(gv > 0, np.sqrt(np.maximum(gv, 0.0) / ub2), 0.0)  # u / ubar, eq. (30)
-    depth = bulk + np.sum(_GW[None, :] * ratio * (2.0 * Pf * (1.0 - S)) * dS, axis=1)
+    depth = bulk + np.sum(ratio * (2.0 * Pf * (1.0 - S)) * dS, axis=1)
     t_star = st.time(s_star[:, None])[:, 0]
     zero = st.P_f == 0
     depth[zero], t_star[zero] = 0.0, 0.0
     return depth, t_star, done
+
+
+def _kink_correction(st: _Stops, f: np.ndarray, i0: np.ndarray, period: float, g) -> np.ndarray:
+    """Per row: Gauss on the two sides of each kink of the integrand at t = k ``period`` minus the
+    Simpson pair that holds it (a kink costs Simpson O(h^2); the split rule is exact to O(h^8) on
+    the smooth sides), for the pairs below node ``i0``; ``g(S, rows)`` -> (ubar^2 - 2W/m, ubar^2)."""
+    n, J1 = st.t.shape
+    rows = np.arange(n)
+    h = st.s[1] - st.s[0]
+    out = np.zeros(n)
+    t_end = st.t[rows, i0]
+    k_max = int(np.max(t_end) / period) if np.max(t_end) > 0 else 0
+    for k in range(1, k_max + 1):
+        tk = k * period
+        use = t_end > tk
+        if not use.any():
+            continue
+        r = rows[use]
+        idx = np.clip(np.sum(st.t[r] < tk, axis=1), 1, J1 - 1)  # t[idx - 1] < tk <= t[idx]
+        lo, hi = st.s[idx - 1], st.s[idx]
+        x = lo + (tk - st.t[r, idx - 1]) / (st.t[r, idx] - st.t[r, idx - 1]) * (hi - lo)
+        for _ in range(6):  # Newton on the Hermite interpolant of t(s) (slope dt/ds, linear in the cell)
+            T = st.time(x[:, None], r)[:, 0]
+            slope = st.dt[r, idx - 1] + (st.dt[r, idx] - st.dt[r, idx - 1]) * (x - lo) / h
+            with np.errstate(divide="ignore", invalid="ignore"):
+                x = np.clip(np.where(slope > 0, x - (T - tk) / slope, x), lo, hi)
+        p = (idx - 1) // 2 * 2  # the pair [s_p, s_p+2] holding the kink
+        ok = p + 2 <= i0[r]
+        if not ok.any():
+            continue
+        r, p, x = r[ok], p[ok], x[ok]
+        x0, x2 = st.s[p], st.s[p + 2]
+        simpson = h / 3.0 * (f[r, p] + 4.0 * f[r, p + 1] + f[r, p + 2])
+        left = x0[:, None] + (x - x0)[:, None] * _KX[None, :]
+        right = x[:, None] + (x2 - x)[:, None] * _KX[None, :]
+        S = np.concatenate([left, right], axis=1)
+        gv, ub2 = g(S, r)
+        with np.errstate(divide="ignore", invalid="ignore"):
+            val = np.where(gv > 0, np.sqrt(np.maximum(gv, 0.0) / ub2), 0.0) * 2.0 * st.P_f[r, None] * (1.0 - S)
+        w = np.concatenate([(x - x0)[:, None] * _KW[None, :], (x2 - x)[:, None] * _KW[None, :]], axis=1)
+        out[r] += np.sum(w * val, axis=1) - simpson
+    return out
 
 
 def penetration_curve(
