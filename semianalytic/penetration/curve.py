@@ -255,27 +255,20 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     i0 -= i0 % 2  # an even node: whole Simpson pairs
     bulk = _cumulative_simpson(f, st.s[1] - st.s[0])[rows, i0]
     if w2 == "exact-rod":  # the energy's kinks (multiples of L/c0, as elastic.solve_elastic's panels)
-        bulk = bulk + _kink_correction(st, f, i0, rod.length / rod.c0, lambda S, r: g(S, r=r))
+        bulk = bulk + _kink_correction(st, f, i0, rod.length / rod.c0, g)
     a0 = st.s[i0]
     # the window in tau, split at the kinks of the exact-rod energy inside it (up to _KINKS)
     cuts = np.ones((n, _KINKS))
     if w2 == "exact-rod":
         period = rod.length / rod.c0
         t0, t1 = st.t[rows, i0], st.time(s_star[:, None])[:, 0]
-        for c in range(_KINKS):
-            tk = (np.floor(t0 / period) + 1.0 + c) * period
-            inside = (tk < t1) & (t1 > t0)
-            if not inside.any():
-                break
-            r = rows[inside]
-            lo, hi = a0[inside], s_star[inside]
-            x = 0.5 * (lo + hi)
-            for _ in range(45):  # bisection on the monotone t(s) (Hermite): 1e-13 of the window
-                T = st.time(x[:, None], r)[:, 0]
-                lo, hi = np.where(T < tk[inside], x, lo), np.where(T < tk[inside], hi, x)
-                x = 0.5 * (lo + hi)
+        tk = (np.floor(t0 / period) + 1.0)[:, None] * period + period * np.arange(_KINKS)[None, :]
+        inside = (tk < t1[:, None]) & (t1 > t0)[:, None]
+        if inside.any():
+            x = _invert_time(st, np.where(inside, tk, 0.0))
             with np.errstate(divide="ignore", invalid="ignore"):
-                cuts[inside, c] = np.clip(1.0 - np.sqrt((s_star[inside] - x) / (s_star[inside] - a0[inside])), 0.0, 1.0)
+                tau = 1.0 - np.sqrt(np.maximum(s_star[:, None] - x, 0.0) / (s_star - a0)[:, None])
+            cuts = np.where(inside, np.clip(np.nan_to_num(tau, nan=1.0), 0.0, 1.0), 1.0)
     ends = np.concatenate([np.zeros((n, 1)), np.sort(np.nan_to_num(cuts, nan=1.0), axis=1), np.ones((n, 1))], axis=1)
     width = np.diff(ends, axis=1)  # (n, _KINKS + 1) segments of [0, 1] in tau
     tau = (ends[:, :-1, None] + width[:, :, None] * _GX[None, None, :]).reshape(n, -1)
@@ -292,46 +285,63 @@ def _elastic(prof: DepthProfile, st: _Stops, sigma0, setup: PenetrationSetup, w2
     return depth, t_star, done
 
 
+def _invert_time(st: _Stops, tk: np.ndarray, rows=slice(None)) -> np.ndarray:
+    """s with t(s) = tk (rows x K, tk <= the row's stop time): the bracketing grid cell by one
+    search on the row-offset grid, then Newton on the Hermite interpolant of t(s) (the slope
+    dt/ds taken linear in the cell)."""
+    t = st.t[rows]
+    n, J1 = t.shape
+    span = float(np.max(t[:, -1])) + 1.0
+    offs = span * np.arange(n)[:, None]
+    flat = (t + offs).ravel()
+    idx = np.searchsorted(flat, (tk + offs).ravel()).reshape(tk.shape) - (J1 * np.arange(n))[:, None]
+    idx = np.clip(idx, 1, J1 - 1)
+    r = np.arange(n)[:, None]
+    h = st.s[1] - st.s[0]
+    lo, hi = st.s[idx - 1], st.s[idx]
+    t0, t1 = t[r, idx - 1], t[r, idx]
+    with np.errstate(divide="ignore", invalid="ignore"):
+        x = np.clip(lo + np.nan_to_num((tk - t0) / (t1 - t0)) * h, lo, hi)
+    d0, d1 = st.dt[rows][r, idx - 1], st.dt[rows][r, idx]
+    for _ in range(5):
+        T = _rows_hermite(st.s, t, st.dt[rows], x)
+        slope = d0 + (d1 - d0) * (x - lo) / h
+        with np.errstate(divide="ignore", invalid="ignore"):
+            x = np.clip(np.where(slope > 0, x - (T - tk) / slope, x), lo, hi)
+    return x
+
+
 def _kink_correction(st: _Stops, f: np.ndarray, i0: np.ndarray, period: float, g) -> np.ndarray:
     """Per row: Gauss on the two sides of each kink of the integrand at t = k ``period`` minus the
     Simpson pair that holds it (a kink costs Simpson O(h^2); the split rule is exact to O(h^8) on
-    the smooth sides), for the pairs below node ``i0``; ``g(S, rows)`` -> (ubar^2 - 2W/m, ubar^2)."""
-    n, J1 = st.t.shape
+    the smooth sides), for the pairs below node ``i0``; ``g(S)`` -> (ubar^2 - 2W/m, ubar^2)."""
+    n = st.t.shape[0]
     rows = np.arange(n)
     h = st.s[1] - st.s[0]
-    out = np.zeros(n)
     t_end = st.t[rows, i0]
-    k_max = int(np.max(t_end) / period) if np.max(t_end) > 0 else 0
-    for k in range(1, k_max + 1):
-        tk = k * period
-        use = t_end > tk
-        if not use.any():
-            continue
-        r = rows[use]
-        idx = np.clip(np.sum(st.t[r] < tk, axis=1), 1, J1 - 1)  # t[idx - 1] < tk <= t[idx]
-        lo, hi = st.s[idx - 1], st.s[idx]
-        x = lo + (tk - st.t[r, idx - 1]) / (st.t[r, idx] - st.t[r, idx - 1]) * (hi - lo)
-        for _ in range(6):  # Newton on the Hermite interpolant of t(s) (slope dt/ds, linear in the cell)
-            T = st.time(x[:, None], r)[:, 0]
-            slope = st.dt[r, idx - 1] + (st.dt[r, idx] - st.dt[r, idx - 1]) * (x - lo) / h
-            with np.errstate(divide="ignore", invalid="ignore"):
-                x = np.clip(np.where(slope > 0, x - (T - tk) / slope, x), lo, hi)
-        p = (idx - 1) // 2 * 2  # the pair [s_p, s_p+2] holding the kink
-        ok = p + 2 <= i0[r]
-        if not ok.any():
-            continue
-        r, p, x = r[ok], p[ok], x[ok]
-        x0, x2 = st.s[p], st.s[p + 2]
-        simpson = h / 3.0 * (f[r, p] + 4.0 * f[r, p + 1] + f[r, p + 2])
-        left = x0[:, None] + (x - x0)[:, None] * _KX[None, :]
-        right = x[:, None] + (x2 - x)[:, None] * _KX[None, :]
-        S = np.concatenate([left, right], axis=1)
-        gv, ub2 = g(S, r)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            val = np.where(gv > 0, np.sqrt(np.maximum(gv, 0.0) / ub2), 0.0) * 2.0 * st.P_f[r, None] * (1.0 - S)
-        w = np.concatenate([(x - x0)[:, None] * _KW[None, :], (x2 - x)[:, None] * _KW[None, :]], axis=1)
-        out[r] += np.sum(w * val, axis=1) - simpson
-    return out
+    K = int(np.max(t_end) / period) if np.max(t_end) > 0 else 0
+    if K == 0:
+        return np.zeros(n)
+    tk = period * np.arange(1, K + 1)[None, :] * np.ones((n, 1))
+    use = tk < t_end[:, None]
+    x = _invert_time(st, np.where(use, tk, 0.0))
+    cell = np.clip(np.floor(x / h).astype(np.intp), 0, st.s.size - 2)
+    p = cell // 2 * 2  # the pair [s_p, s_p+2] holding the kink
+    use &= p + 2 <= i0[:, None]
+    p = np.where(use, p, 0)
+    x0, x2 = st.s[p], st.s[p + 2]
+    x = np.where(use, np.clip(x, x0, x2), x0)
+    r = rows[:, None]
+    simpson = h / 3.0 * (f[r, p] + 4.0 * f[r, p + 1] + f[r, p + 2])
+    left = x0[:, :, None] + (x - x0)[:, :, None] * _KX
+    right = x[:, :, None] + (x2 - x)[:, :, None] * _KX
+    S = np.concatenate([left, right], axis=2).reshape(n, -1)
+    w = np.concatenate([(x - x0)[:, :, None] * _KW, (x2 - x)[:, :, None] * _KW], axis=2).reshape(n, -1)
+    gv, ub2 = g(S)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        val = np.where(gv > 0, np.sqrt(np.maximum(gv, 0.0) / ub2), 0.0) * 2.0 * st.P_f[:, None] * (1.0 - S)
+    split = np.sum((w * val).reshape(n, K, -1), axis=2)
+    return np.sum(np.where(use, split - simpson, 0.0), axis=1)
 
 
 def penetration_curve(
