@@ -23,7 +23,8 @@ import json
 import os
 from pathlib import Path
 
-__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case"]
+__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case",
+           "case_table_request", "case_table_key"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 
@@ -110,25 +111,41 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
             "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",
             True,
         )
-    from semianalytic.geometry import nose_from_section
-
     cs = case.coefficients
     tolerance = cs.tolerance if tolerance is None else tolerance
-    kwargs = dict(order=case.bem.order, max_depth_nose_lengths=cs.max_depth_nose_lengths, progress=progress)
-    if cs.depths is not None:  # a fixed grid
-        kwargs["n_depths"] = cs.depths
-    else:
-        kwargs["tolerance"] = tolerance
-    refinement = getattr(case.bem, "refinement", None)
-    if refinement is not None:  # else the table's own default
-        kwargs["refinement"] = refinement
-    table = cached_coefficient_table(nose_from_section(psec), cache_dir, **kwargs).with_reading(cs.reading)
+    nose, kwargs = case_table_request(case, tolerance)
+    refinement = kwargs.get("refinement")
+    table = cached_coefficient_table(nose, cache_dir, progress=progress, **kwargs).with_reading(cs.reading)
     ref = f"refinement {refinement:g}" if refinement is not None else "default refinement"
     grid = f"{cs.depths} fixed depths" if cs.depths is not None else f"{len(table.depth)} adaptive knots, tolerance {tolerance:g}"
     desc = (
         f"BEM table (order {case.bem.order}, {ref}, {grid}, to the deep limit; B reading '{cs.reading}')"
     )
     return table, desc, False
+
+
+def case_table_request(case, tolerance=None):
+    """(nose, options) of the case's coefficient table: what :func:`cached_coefficient_table`
+    is called with (the one place that reads them from the case; ``case_table_key`` hashes them)."""
+    from semianalytic.geometry import nose_from_section
+
+    cs = case.coefficients
+    kwargs = dict(order=case.bem.order, max_depth_nose_lengths=cs.max_depth_nose_lengths)
+    if cs.depths is not None:  # a fixed grid
+        kwargs["n_depths"] = cs.depths
+    else:
+        kwargs["tolerance"] = cs.tolerance if tolerance is None else tolerance
+    refinement = getattr(case.bem, "refinement", None)
+    if refinement is not None:  # else the table's own default
+        kwargs["refinement"] = refinement
+    return nose_from_section(case.require("projectile")), kwargs
+
+
+def case_table_key(case, tolerance=None) -> str:
+    """The cache key (:func:`table_key`) of the case's coefficient table and its B reading:
+    every nose parameter and numerical option, whatever the nose kind (the sweeps' resource key)."""
+    nose, kwargs = case_table_request(case, tolerance)
+    return f"{table_key(nose, **kwargs)}:{case.coefficients.reading}"
 
 
 def override_coefficients(case, *, contact: str | None = None, tolerance=None):

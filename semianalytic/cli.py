@@ -14,7 +14,7 @@ import traceback
 import warnings
 
 from semianalytic.cli_types import OneLineParser, memory_size
-from semianalytic.errors import InputError
+from semianalytic.errors import InputError, ModelError
 from semianalytic.guards import set_memory_limit
 
 # name -> (module, one-line help)
@@ -111,7 +111,7 @@ def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[
         return int(module.run(args) or 0)
     except SystemExit as exc:  # argparse: --help (0) or bad arguments (2)
         return int(exc.code or 0)
-    except InputError as exc:
+    except (InputError, ModelError) as exc:  # bad input, or inputs a model cannot compute with
         print(f"error: {exc}", file=sys.stderr)
         return 2
     except RecursionError:

@@ -1,8 +1,11 @@
 """Errors that map onto the command-line exit statuses.
 
 ``InputError`` is bad input (exit status 2): it names the offending field, e.g.
-``projectile.diameter``, and says what was expected.  Anything else escaping a command is
-an internal failure (exit status 1).
+``projectile.diameter``, and says what was expected.  ``ModelError`` is raised by the models
+(pure functions of SI values, which know no case fields) when their inputs lie outside what
+they can compute; the CLI dispatcher turns it into exit status 2 with one line, as bad input.
+``ConvergenceError`` is the ModelError of an iterative solve that did not converge (never a
+silent result).  Anything else escaping a command is an internal failure (exit status 1).
 """
 
 
@@ -24,6 +27,21 @@ class InputError(ValueError):
         super().__init__(f"{field}: {message}" if field else message)
 
 
+class ModelError(ValueError):
+    """A model cannot compute with these inputs (exit status 2 through the CLI dispatcher, one
+    line ``error: <field>: <message>``; ``field`` defaults to "model")."""
+
+    def __init__(self, message: str, field: str = "model"):
+        self.field = one_line(str(field))
+        self.message = one_line(str(message))
+        super().__init__(f"{self.field}: {self.message}")
+
+
+class ConvergenceError(ModelError):
+    """An iterative solve did not converge (the status of every iterative solve is either
+    returned, e.g. :class:`semianalytic.penetration.motion.RootResult`, or raised as this)."""
+
+
 class ModelValidityWarning(UserWarning):
     """An input the model accepts but that lies outside its stated validity."""
 
@@ -35,6 +53,6 @@ def exit_status(main) -> int:
 
     try:
         return int(main() or 0)
-    except InputError as exc:
+    except (InputError, ModelError) as exc:
         print(f"error: {exc}", file=sys.stderr)
         return 2

@@ -25,6 +25,7 @@ from semianalytic.errors import InputError
 __all__ = [
     "CASES",
     "read_rows",
+    "load_rows",
     "load_shots",
     "shot_from_row",
     "Table1Row",
@@ -155,13 +156,20 @@ def shot_from_row(cells: _Cells) -> Shot:
     )
 
 
-def load_shots(path: str | Path) -> list[Shot]:
-    """All rows of a shot table (Table 2 or 3 format, or any table with the generic columns)."""
+def load_rows(path: str | Path, make, require: str | None = None, what: str = "") -> list:
+    """``make(cells, row)`` for every row of a ``#``-commented CSV (the one table loader of the
+    package: every reader below is a row builder passed to it); ``require``: a column the file
+    must have (else one ``InputError`` naming the file and ``what`` it is not)."""
     path = Path(path)
     rows = read_rows(path)
-    if rows and "L_p_mm" not in rows[0][1]:
-        raise InputError(f"{path.name}", "is not a shot table: it has no 'L_p_mm' column")
-    return [shot_from_row(_Cells(path, n, row)) for n, row in rows]
+    if require is not None and rows and require not in rows[0][1]:
+        raise InputError(f"{path.name}", f"is not {what}: it has no {require!r} column")
+    return [make(_Cells(path, n, row), row) for n, row in rows]
+
+
+def load_shots(path: str | Path) -> list[Shot]:
+    """All rows of a shot table (Table 2 or 3 format, or any table with the generic columns)."""
+    return load_rows(path, lambda c, row: shot_from_row(c), require="L_p_mm", what="a shot table")
 
 
 # ------------------------------------------------------------------------------- paper tables
@@ -232,76 +240,56 @@ class Table4Cell:
 
 
 def load_table1(path: str | Path = CASES / "part4_table1.csv") -> list[Table1Row]:
-    path = Path(path)
-    out = []
-    for n, row in read_rows(path):
-        c = _Cells(path, n, row)
-        out.append(Table1Row(c.text("group"), c.text("marking"), c.number("HV_GPa", GPa, required=True),
-                             c.fraction("delta_H", required=True), c.number("E_GPa_assumed", GPa, required=True),
-                             c.number("nu_assumed", required=True), row["HV_GPa"], row["delta_H"]))
-    return out
+    return load_rows(path, lambda c, row: Table1Row(
+        c.text("group"), c.text("marking"), c.number("HV_GPa", GPa, required=True), c.fraction("delta_H", required=True),
+        c.number("E_GPa_assumed", GPa, required=True), c.number("nu_assumed", required=True), row["HV_GPa"], row["delta_H"]))
 
 
 def load_table2(path: str | Path = CASES / "part4_table2.csv") -> list[Table2Row]:
-    path = Path(path)
-    out = []
-    for n, row in read_rows(path):
-        c = _Cells(path, n, row)
-        out.append(Table2Row(
-            material=c.text("material"),
-            shot=shot_from_row(c),
-            R_column=c.number("R_column_GPa", GPa, required=True),
-            printed=tuple(c.number(f"printed_V_{k}_m_s", required=True) for k in ("R1", "R2", "R3")),
-            column_holds=c.text("column_holds"),
-            hardness_in_R1=c.text("hardness_in_R1"),
-            E_assumed=c.number("E_GPa_assumed", GPa, required=True),
-            note=c.text("note"),
-        ))
-    return out
+    return load_rows(path, lambda c, row: Table2Row(
+        material=c.text("material"),
+        shot=shot_from_row(c),
+        R_column=c.number("R_column_GPa", GPa, required=True),
+        printed=tuple(c.number(f"printed_V_{k}_m_s", required=True) for k in ("R1", "R2", "R3")),
+        column_holds=c.text("column_holds"),
+        hardness_in_R1=c.text("hardness_in_R1"),
+        E_assumed=c.number("E_GPa_assumed", GPa, required=True),
+        note=c.text("note"),
+    ))
 
 
 def load_table3(path: str | Path = CASES / "part4_table3.csv") -> list[Table3Row]:
-    path = Path(path)
-    out = []
-    for n, row in read_rows(path):
-        c = _Cells(path, n, row)
-        out.append(Table3Row(
-            id=c.text("id"),
-            material_class=c.text("material_class"),
-            shot=shot_from_row(c),
-            printed=tuple(c.number(f"printed_V_eq{k}_m_s", required=True) for k in (7, 8, 9)),
-            paper_rule=c.text("paper_rule"),
-            note=c.text("note"),
-        ))
-    return out
+    return load_rows(path, lambda c, row: Table3Row(
+        id=c.text("id"),
+        material_class=c.text("material_class"),
+        shot=shot_from_row(c),
+        printed=tuple(c.number(f"printed_V_eq{k}_m_s", required=True) for k in (7, 8, 9)),
+        paper_rule=c.text("paper_rule"),
+        note=c.text("note"),
+    ))
 
 
 def load_table4(path: str | Path = CASES / "part4_table4.csv") -> list[Table4Cell]:
-    path = Path(path)
-    out = []
-    for n, row in read_rows(path):
-        c = _Cells(path, n, row)
-        out.append(Table4Cell(
-            block=c.text("block"),
-            projectile=c.text("projectile"),
-            HVdelta_p=c.number("HVdelta_p_GPa", GPa, required=True),
-            rho_p=c.number("rho_p_g_cm3", g_cm3, required=True),
-            L_p=c.number("L_p_mm", mm, required=True),
-            target=c.text("target"),
-            HV_t=c.number("HV_t_GPa", GPa, required=True),
-            delta_t=c.fraction("delta_Ht", required=True),
-            rho_t=c.number("rho_t_g_cm3", g_cm3, required=True),
-            V=c.number("V_p_m_s", required=True),
-            rhoh=c.number("rhoh_cr_g_cm2", 10.0, required=True),  # g/cm^2 -> kg/m^2
-            h=c.number("h_cr_mm", mm, required=True),
-            rhoh_composite=c.number("rhoh_cr_composite_g_cm2", 10.0),
-            rhoh_text=row["rhoh_cr_g_cm2"],
-            h_text=row["h_cr_mm"],
-            composite_text=row.get("rhoh_cr_composite_g_cm2", ""),
-            rho_t_text=row["rho_t_g_cm3"],
-            note=c.text("note"),
-        ))
-    return out
+    return load_rows(path, lambda c, row: Table4Cell(
+        block=c.text("block"),
+        projectile=c.text("projectile"),
+        HVdelta_p=c.number("HVdelta_p_GPa", GPa, required=True),
+        rho_p=c.number("rho_p_g_cm3", g_cm3, required=True),
+        L_p=c.number("L_p_mm", mm, required=True),
+        target=c.text("target"),
+        HV_t=c.number("HV_t_GPa", GPa, required=True),
+        delta_t=c.fraction("delta_Ht", required=True),
+        rho_t=c.number("rho_t_g_cm3", g_cm3, required=True),
+        V=c.number("V_p_m_s", required=True),
+        rhoh=c.number("rhoh_cr_g_cm2", 10.0, required=True),  # g/cm^2 -> kg/m^2
+        h=c.number("h_cr_mm", mm, required=True),
+        rhoh_composite=c.number("rhoh_cr_composite_g_cm2", 10.0),
+        rhoh_text=row["rhoh_cr_g_cm2"],
+        h_text=row["h_cr_mm"],
+        composite_text=row.get("rhoh_cr_composite_g_cm2", ""),
+        rho_t_text=row["rho_t_g_cm3"],
+        note=c.text("note"),
+    ))
 
 
 def load_table5(path: str | Path = CASES / "part4_table5.csv") -> tuple[dict, list[dict]]:
@@ -309,8 +297,7 @@ def load_table5(path: str | Path = CASES / "part4_table5.csv") -> tuple[dict, li
     regions (``{"region", "HV_min", "HV_max", "eps_min", "eps_max", "eps_qualifier", ...}``)."""
     path = Path(path)
     table5, regions = None, []
-    for n, row in read_rows(path):
-        c = _Cells(path, n, row)
+    for c, row in load_rows(path, lambda c, row: (c, row)):
         if row["kind"] == "table5":
             table5 = {"material": row["name"], "V": c.number("V_m_s", required=True),
                       "w_k": c.number("w_k_J", required=True), "w_p": c.number("w_p_J", required=True),
@@ -324,7 +311,7 @@ def load_table5(path: str | Path = CASES / "part4_table5.csv") -> tuple[dict, li
                 "delta_a": c.fraction("delta_H_a", required=True), "delta_b": c.fraction("delta_H_b", required=True),
             })
         else:
-            raise InputError(f"{path.name}:{n}:kind", f"must be table5 or fig2; got {row['kind']!r}")
+            raise InputError(c.where("kind"), f"must be table5 or fig2; got {row['kind']!r}")
     if table5 is None:
         raise InputError(path.name, "has no table5 line")
     return table5, regions

@@ -37,7 +37,7 @@ import scipy.linalg
 
 from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_split
 from semianalytic.bem.panels import PanelSet
-from semianalytic.errors import InputError
+from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
     differentiation_matrix,
     dyadic_rule,
@@ -600,5 +600,5 @@ def raise_non_finite(ps: PanelSet, depth: float | None, what: str = "potential")
     the depth named (exit status 2: the geometry is the input the solver could not handle)."""
     where = f" at depth P = {depth * 1e3:.6g} mm" if depth is not None else ""
     field = "projectile" if ps.label.endswith("nose") else "body"
-    raise InputError(field, f"the BEM solve of the {ps.label}{where} gave a non-finite {what}; "
-                     "check the shape (points, radii) or the [bem] options")
+    raise ModelError(f"the BEM solve of the {ps.label}{where} gave a non-finite {what}; "
+                     "check the shape (points, radii) or the [bem] options", field)

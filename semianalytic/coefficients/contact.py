@@ -12,7 +12,8 @@ takes
     A_w = int_wet phi n_x dS,  B_w = int_wet q n_x dS,  C_w = int_wet n_x dS,
 
 which depend on u and du/dt as well as on P.  du/dt itself follows from eq. (11) with these
-coefficients: the wetted set is found by a fixed-point iteration started from full contact.
+coefficients: the wetted set is found by a fixed-point iteration started from full contact
+(:func:`semianalytic.penetration.motion.separated_acceleration`, beside eq. (11)).
 Everything comes from the surface solution stored with each table knot (no solve per time
 step); between knots the wetted coefficients are interpolated linearly in P.
 """
@@ -21,7 +22,7 @@ from __future__ import annotations
 
 import numpy as np
 
-__all__ = ["pressure_terms", "separated_acceleration"]
+__all__ = ["pressure_terms", "contact_pressure", "wetted_coefficients"]
 
 
 def pressure_terms(nodes: dict, reading: str):
@@ -35,21 +36,17 @@ def pressure_terms(nodes: dict, reading: str):
     return nodes["phi"], q
 
 
-def separated_acceleration(nodes: dict, reading: str, mass: float, rho: float, u: float, R_t: float, iterations: int = 20):
-    """du/dt of Part I, eq. (11) with the coefficients of the wetted part (eq. (15)), and
-    (A_w, B_w, C_w): fixed point from full contact (the wetted set usually settles in 2-3 steps)."""
+def contact_pressure(phi, q, rho: float, du_dt, u2, R_t: float):
+    """p_c = rho phi du/dt + q rho u^2/2 + R_t [Pa] of Part I, eq. (9) (u2 = u^2; broadcasting)."""
+    return rho * phi * du_dt + q * rho * u2 / 2 + R_t
+
+
+def wetted_coefficients(nodes: dict, reading: str, wet=None) -> tuple[float, float, float]:
+    """(A_w, B_w, C_w) = int_wet (phi, q, 1) n_x dS over the wetted nodes (all by default), Part I,
+    eqs. (11), (15).  The fixed point of the wetted set, which needs eq. (11), is
+    :func:`semianalytic.penetration.motion.separated_acceleration`."""
     phi, q = pressure_terms(nodes, reading)
-    wn_all = nodes["weight"] * nodes["nx"]
-    wet = np.ones(len(phi), bool)
-    a = 0.0
-    coef = (0.0, 0.0, 0.0)
-    for _ in range(iterations):
-        wn = wn_all * wet
-        A, B, C = float(np.sum(wn * phi)), float(np.sum(wn * q)), float(np.sum(wn))
-        a = -(0.5 * rho * B * u * u + C * R_t) / (mass + rho * A)
-        coef = (A, B, C)
-        new = (rho * phi * a + q * rho * u * u / 2 + R_t) > 0
-        if np.array_equal(new, wet):
-            break
-        wet = new
-    return a, coef
+    wn = nodes["weight"] * nodes["nx"]
+    if wet is not None:
+        wn = wn * wet
+    return float(np.sum(wn * phi)), float(np.sum(wn * q)), float(np.sum(wn))

@@ -34,10 +34,11 @@ def separation_velocity(table, mass: float, rho: float, R_t: float, reading: str
     """Lowest velocity (of VELOCITIES) at which p_c <= 0 somewhere on the nose (eq. (15)),
     with du/dt from eq. (11) at that depth and velocity; None if the contact stays full.
     Returns (velocity, depth, separated interval in target-frame x)."""
+    from semianalytic.penetration.motion import eq11_acceleration
+
     for u in VELOCITIES:
         for P in depths:
-            A, B, C = table.A(P), table.B(P, reading), table.C(P)
-            du_dt = -(B * rho * u * u / 2 + C * R_t) / (mass + rho * A)  # Part I, eq. (11)
+            du_dt = eq11_acceleration(table.A(P), table.B(P, reading), table.C(P), mass, rho, R_t, u * u)
             sep = table.contact_intervals(P, rho, u, du_dt, R_t, reading)
             if sep:
                 return float(u), float(P), sep[0]

@@ -29,7 +29,7 @@ from dataclasses import dataclass, field
 import numpy as np
 
 from semianalytic.penetration import rod as rodmod
-from semianalytic.penetration.motion import MotionResult, deep_coefficients, solve_motion
+from semianalytic.penetration.motion import MotionResult, deep_coefficients, eq11_acceleration, solve_motion
 
 __all__ = [
     "W2_MODELS",
@@ -61,8 +61,9 @@ def start_force_coefficients(coefficients, mass, target_density, resistance_pa) 
     braking force N(u) = m (rho B u^2/2 + C R_t)/(m + rho A) (eq. (11)), over pi d^2/4."""
     A, B, C = deep_coefficients(coefficients)
     area = math.pi * float(coefficients.diameter) ** 2 / 4.0
-    f = mass / (mass + target_density * A) / area
-    return f * 0.5 * target_density * B, f * C * resistance_pa
+    # N = -m du/dt of eq. (11): its velocity term per unit u^2 and its strength term
+    return (-mass * eq11_acceleration(A, B, 0.0, mass, target_density, resistance_pa, 1.0) / area,
+            -mass * eq11_acceleration(A, 0.0, C, mass, target_density, resistance_pa, 0.0) / area)
 
 
 def quasi_rigid_start(U_s, c0: float, youngs_modulus: float, alpha: float, beta: float):
@@ -240,7 +241,7 @@ def solve_elastic(
         ts = np.linspace(0.0, qr.penetration_time, 201)
         Ps, us = qr.at(ts)
         A, B, C = (np.asarray(f(Ps), float) for f in (coefficients.A, coefficients.B, coefficients.C))
-        dus = -(0.5 * target_density * B * us**2 + C * resistance_pa) / (mass + target_density * A)
+        dus = eq11_acceleration(A, B, C, mass, target_density, resistance_pa, us**2)
         W1s = np.array([
             lateral_energy_from_profile(*coefficients.pressure_profile(P, target_density, u, du, resistance_pa), P, rod, poisson_ratio)
             for P, u, du in zip(Ps, us, dus)

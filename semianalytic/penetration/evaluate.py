@@ -16,15 +16,17 @@ from semianalytic.errors import InputError
 __all__ = ["evaluate_case", "contact_summary"]
 
 
-def contact_summary(setup, U) -> dict:
+def contact_summary(setup, U, profile=None) -> dict:
     """``contact`` (the mode) and ``separation_onset_m``: per striking velocity, the first depth
-    at which the full-contact pressure of eq. (9) would separate (eq. (15)), or None."""
-    from semianalytic.penetration.motion import depth_profile, separation_onset
+    at which the full-contact pressure of eq. (9) would separate (eq. (15)), or None.
+    ``profile``: the full-contact depth profile covering U, if at hand."""
+    from semianalytic.penetration.motion import DepthProfile, depth_profile, separation_onset
 
     coef = setup.coefficients
     if not hasattr(coef, "nodes"):
         return {"contact": setup.contact, "separation_onset_m": [None] * len(U)}
-    prof = depth_profile(coef, setup.mass, setup.target_density, setup.resistance_pa, float(np.max(U)))
+    prof = profile if isinstance(profile, DepthProfile) else depth_profile(
+        coef, setup.mass, setup.target_density, setup.resistance_pa, float(np.max(U)))
     return {"contact": setup.contact,
             "separation_onset_m": separation_onset(coef, setup.mass, setup.target_density, setup.resistance_pa, prof, U)}
 
@@ -61,7 +63,10 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
         raise InputError("projectile.yield_stress", "missing: U_sC needs the dynamic yield stress (e.g. '1.5 GPa') "
                          "or a measured [data] critical_velocity")
     U = np.asarray(case.impact.striking_velocities if velocities is None else velocities, float)
-    res = penetration_curve(setup, U, w1=w1)
+    from semianalytic.penetration.curve import curve_profile
+
+    prof = curve_profile(setup, float(np.max(U)))  # one integration of eq. (11) in P for the curve and its estimate
+    res = penetration_curve(setup, U, w1=w1, profile=prof)
     A, B, C = deep_coefficients(coefficients)
     area = math.pi * setup.rod.diameter**2 / 4
     resistance = resistance_from_case(case)
@@ -84,14 +89,18 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
         out[key] = np.asarray(val).tolist()
     from semianalytic.penetration.accuracy import depth_error_estimate
 
-    out["depth_error_estimate_m"] = depth_error_estimate(setup, U, res, w1=w1)
-    out.update(contact_summary(setup, U))
+    out["depth_error_estimate_m"] = depth_error_estimate(setup, U, res, w1=w1, profile=prof)
+    out.update(contact_summary(setup, U, prof))
     pe = peer_depths(case, setup, U)
     out["depth_forrestal_m"] = pe["forrestal"].tolist()
     out["depth_chen_li_m"] = pe["chen_li"].tolist()
     from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, regime_prediction
 
     out.update(regime_prediction(case, setup, U, res, pe, part1_model=part1_model or DEFAULT_PART1_MODEL))
+    if not np.all(res["converged"]):  # never silent: the CLI prints every warning line on stderr
+        bad = [f"{u:g}" for u, ok in zip(U, res["converged"]) if not ok]
+        out["warnings"] = [*out.get("warnings", []), f"eq. (11): an iterative solve did not converge at "
+                           f"{len(bad)} striking velocities ({', '.join(bad[:3])} m/s ...); see 'converged'"]
     if data is not None and data.file is not None:
         rows = predict_shots(case, coefficients, rigid_regime_shots(case, load_shots(case)), w1=w1)
         out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}

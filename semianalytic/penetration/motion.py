@@ -23,12 +23,18 @@ Three evaluations, each a check on the others:
 
 from __future__ import annotations
 
+import functools
 import math
 from dataclasses import dataclass, field
 
 import numpy as np
 
+from semianalytic.errors import ConvergenceError, ModelError
+
 __all__ = [
+    "eq11_acceleration",
+    "RootResult",
+    "reduced_profiles",
     "MotionResult",
     "solve_motion",
     "braking_force",
@@ -43,7 +49,17 @@ __all__ = [
 def _check_inputs(mass, target_density, resistance_pa):
     for name, value in (("mass", mass), ("target_density", target_density), ("resistance_pa", resistance_pa)):
         if not (np.isfinite(value) and value > 0):
-            raise ValueError(f"{name} must be positive and finite; got {value!r}")
+            raise ModelError(f"{name} must be positive and finite; got {value!r}")
+
+
+def eq11_acceleration(A, B, C, mass, target_density, resistance_pa, u2):
+    """du/dt [m/s^2] of Part I, eq. (11): -(B rho u^2/2 + C R_t) / (m + rho A), with u2 = u^2;
+    vectorised (complex values pass through: the sensitivities' complex step).
+
+    The one home of eq. (11)'s right-hand side: the time histories, the braking force, the
+    w = u^2 form in P (:func:`_w_rates`), the wetted coefficients of eq. (15) and the
+    separation check all call it (``tests/test_one_home.py`` greps for copies)."""
+    return -(0.5 * target_density * B * u2 + C * resistance_pa) / (mass + target_density * A)
 
 
 def deep_coefficients(coefficients) -> tuple[float, float, float]:
@@ -63,8 +79,7 @@ def braking_force(coefficients, mass, target_density, resistance_pa, P, u):
     P = np.asarray(P, float)
     u = np.asarray(u, float)
     A, B, C = coefficients.A(P), coefficients.B(P), coefficients.C(P)
-    rho = target_density
-    return mass * (0.5 * rho * B * u * u + C * resistance_pa) / (mass + rho * A)
+    return -mass * eq11_acceleration(A, B, C, mass, target_density, resistance_pa, u * u)
 
 
 # --------------------------------------------------------------------------------------
@@ -206,22 +221,19 @@ def solve_motion(
     """
     _check_inputs(mass, target_density, resistance_pa)
     if not (np.isfinite(U0) and U0 >= 0):
-        raise ValueError(f"U0 must be finite and non-negative; got {U0!r}")
+        raise ModelError(f"U0 must be finite and non-negative; got {U0!r}")
     rho, R, m = float(target_density), float(resistance_pa), float(mass)
     d = float(coefficients.diameter)
     if U0 == 0:
         z = np.zeros(1)
-        C0 = float(coefficients.C(0.0))
-        A0 = float(coefficients.A(0.0))
-        dec = C0 * R / (m + rho * A0)
+        dec = -eq11_acceleration(float(coefficients.A(0.0)), 0.0, float(coefficients.C(0.0)), m, rho, R, 0.0)
         return MotionResult(z, z, z, -dec * np.ones(1), m * dec * np.ones(1), 0.0, 0.0, m, 0.0)
 
     cA, cB, cC = coefficients.A, coefficients.B, coefficients.C
 
     def rhs(t, y):
         P, u = max(y[0], 0.0), y[1]  # RK stages may step a hair below the surface at t = 0
-        A, B, C = float(cA(P)), float(cB(P)), float(cC(P))
-        return (u, -(0.5 * rho * B * u * u + C * R) / (m + rho * A))
+        return (u, eq11_acceleration(float(cA(P)), float(cB(P)), float(cC(P)), m, rho, R, u * u))
 
     def stop(t, y):
         return y[1]
@@ -238,13 +250,12 @@ def solve_motion(
 
     sol = solve_ivp(rhs, (0.0, t_max), [0.0, U0], method=method, rtol=rtol, atol=atol, events=stop, dense_output=True)
     if sol.status != 1 or not len(sol.t_events[0]):
-        raise RuntimeError(f"eq. (11) did not reach u = 0 before t = {t_max:g} s ({sol.message})")
+        raise ConvergenceError(f"eq. (11) did not reach u = 0 before t = {t_max:g} s ({sol.message})")
     t_end = float(sol.t_events[0][0])
     t = sol.t.copy()
     P, u = sol.y[0].copy(), sol.y[1].copy()
     t[-1], P[-1], u[-1] = t_end, float(sol.y_events[0][0][0]), 0.0
-    A, B, C = cA(P), cB(P), cC(P)
-    du_dt = -(0.5 * rho * B * u * u + C * R) / (m + rho * A)
+    du_dt = eq11_acceleration(cA(P), cB(P), cC(P), m, rho, R, u * u)
     return MotionResult(
         t=t, P=P, u=u, du_dt=du_dt, force=-m * du_dt, final_depth=float(P[-1]), penetration_time=t_end,
         mass=m, U0=float(U0), _dense=sol.sol,
@@ -256,8 +267,9 @@ def solve_motion(
 
 
 def _chebyshev_panel_rule(n: int):
-    """Chebyshev-Lobatto nodes x (n, on [-1, 1], ascending), barycentric weights, and the
-    spectral integration matrix Q with (Q f)_i = int_{-1}^{x_i} p_f, p_f the interpolant of f."""
+    """Chebyshev-Lobatto nodes x (n, on [-1, 1], ascending), barycentric weights, the
+    spectral integration matrix Q with (Q f)_i = int_{-1}^{x_i} p_f (p_f the interpolant of f),
+    and the matrix of values -> Chebyshev coefficients."""
     from numpy.polynomial import chebyshev as ch
 
     x = -np.cos(np.pi * np.arange(n) / (n - 1))
@@ -268,11 +280,69 @@ def _chebyshev_panel_rule(n: int):
     bw = (-1.0) ** np.arange(n)
     bw[0] *= 0.5
     bw[-1] *= 0.5
-    return x, bw, W @ coef_of_values
+    return x, bw, W @ coef_of_values, coef_of_values
 
 
 _NODES = 16
-_X, _BW, _Q = _chebyshev_panel_rule(_NODES)
+_X, _BW, _Q, _COEF = _chebyshev_panel_rule(_NODES)
+_CHUNK = 1 << 15  # points per block of an interpolation (bounds the (points x nodes) temporaries)
+_STEP = 1e-20  # complex step of the sensitivities (relative to the coefficients' errors)
+
+
+def _w_rates(A, B, C, r):
+    """(F', G_1' e^-F) of the w = u^2 form of Part I, eq. (11) in reduced units (r = m/rho,
+    rho = 1, R_t = 1): F' = B/(r + A) and 2 C/(r + A), both from :func:`eq11_acceleration`
+    (its velocity term alone at u^2 = 1, its strength term alone at u^2 = 0)."""
+    return -2.0 * eq11_acceleration(A, B, 0.0, r, 1.0, 1.0, 1.0), -2.0 * eq11_acceleration(A, 0.0, C, r, 1.0, 1.0, 0.0)
+
+
+def _integrate_panels(coefficients, a, b, r, F0, G0, shift=None):
+    """F, G_1 = int 2 C e^F/(r + A) dP and their derivatives at the Chebyshev nodes of the
+    panels [a_k, b_k] (arrays (rows, panels, nodes)), one row per ratio r (rows,), continuing
+    from F0, G0 (rows,) at a_0.  With ``shift`` (P -> (dA, dB, dC)), three complex rows: A, B
+    and C shifted in turn by i _STEP dX (their imaginary parts / _STEP are the first-order
+    changes of F and G_1 when that coefficient is off by dX; complex step, exact to round-off).
+    Also the spectral tail of each panel's integrands (the embedded error estimate)."""
+    h = 0.5 * (b - a)
+    nodes = a[:, None] + h[:, None] * (_X + 1.0)[None, :]  # (panels, nodes)
+    A = np.asarray(coefficients.A(nodes), float)
+    B = np.asarray(coefficients.B(nodes), float)
+    C = np.asarray(coefficients.C(nodes), float)
+    if shift is not None:
+        dA, dB, dC = (np.broadcast_to(np.asarray(v, float), nodes.shape) for v in shift(nodes))
+        z = 1j * _STEP
+        A = np.stack([A + z * dA, A + 0j, A + 0j])
+        B = np.stack([B + 0j, B + z * dB, B + 0j])
+        C = np.stack([C + 0j, C + 0j, C + z * dC])
+        r = np.broadcast_to(np.asarray(r, float), (3,))
+    r = np.asarray(r)[:, None, None]
+    n = r.shape[0]
+    dF, g = _w_rates(A, B, C, r)
+    dF = np.broadcast_to(dF, (n,) + nodes.shape)
+    Floc = h[None, :, None] * (dF @ _Q.T)
+    F = F0[:, None, None] + np.concatenate([np.zeros((n, 1)), np.cumsum(Floc[:, :, -1], axis=1)[:, :-1]], axis=1)[:, :, None] + Floc
+    dG = g * np.exp(F)
+    Gloc = h[None, :, None] * (dG @ _Q.T)
+    G = G0[:, None, None] + np.concatenate([np.zeros((n, 1)), np.cumsum(Gloc[:, :, -1], axis=1)[:, :-1]], axis=1)[:, :, None] + Gloc
+    # embedded error: the last two Chebyshev coefficients of each integrand, times the panel length
+    tail = lambda f: 2.0 * h * np.abs(np.real(f) @ _COEF[-2:].T).sum(axis=-1)  # noqa: E731
+    return nodes, F, G, dF, dG, tail(dF), tail(dG)
+
+
+@dataclass(frozen=True)
+class RootResult:
+    """Status of an iterative solve (as scipy's ``OptimizeResult``): the solution ``x``, per
+    element whether it ``converged``, the ``iterations`` used, and ``rate`` = -dw/dP at the stop
+    (w = u^2; for the time at the stop)."""
+
+    x: np.ndarray
+    converged: np.ndarray
+    iterations: int
+    rate: np.ndarray
+
+    @property
+    def success(self) -> bool:
+        return bool(np.all(self.converged))
 
 
 @dataclass(frozen=True, eq=False)
@@ -283,10 +353,13 @@ class DepthProfile:
     F and G are computed by spectral (Chebyshev) integration on panels whose ends include
     the breakpoints of piecewise-smooth coefficients (a ``depth`` attribute, as the BEM
     table's interpolation knots), so that every panel sees a smooth integrand; between the
-    nodes they are evaluated by barycentric interpolation.
+    nodes they are evaluated by barycentric interpolation (``F``, ``G``, the root) or, on
+    large arrays (``speed2``), by cubic Hermite interpolation between neighbouring nodes with
+    the exact derivatives F', G' there (this project's own; 1e-11 relative, see the tests).
 
     ``speed2(U0, P)`` = u^2 at depth P for start velocity U0 (broadcasting);
-    ``final_depth(U0)`` solves G(P_f) = U0^2; ``dG(P)`` = G'(P) exactly from the coefficients.
+    ``final_depth(U0)`` solves G(P_f) = U0^2 (``stop(U0)``: with its convergence status);
+    ``dG(P)`` = G'(P) exactly from the coefficients.
     """
 
     coefficients: object
@@ -298,27 +371,61 @@ class DepthProfile:
     _edges: np.ndarray = field(repr=False)  # panel ends (n_panels + 1)
     _F: np.ndarray = field(repr=False)  # (n_panels, nodes) values at the Chebyshev nodes
     _G: np.ndarray = field(repr=False)
+    _dF: np.ndarray | None = field(default=None, repr=False)  # F', G' at the nodes
+    _dG: np.ndarray | None = field(default=None, repr=False)
+    _tail: np.ndarray | None = field(default=None, repr=False)  # (2, n_panels + 1): embedded error of F, G at the edges
 
     def M(self, P):
         return self.mass + self.target_density * np.asarray(self.coefficients.A(P), float)
 
-    def _eval(self, P):
-        """(F, G) at P of any shape, 0 <= P <= P_end (barycentric interpolation per panel)."""
-        P = np.asarray(P, float)
-        flat = P.ravel()
+    def _locate(self, flat):
         e = self._edges
         k = np.clip(np.searchsorted(e, flat, side="right") - 1, 0, len(e) - 2)
-        x = 2.0 * (flat - e[k]) / (e[k + 1] - e[k]) - 1.0
-        d = x[:, None] - _X[None, :]
-        exact = d == 0.0
-        with np.errstate(divide="ignore", invalid="ignore"):
+        return k, 2.0 * (flat - e[k]) / (e[k + 1] - e[k]) - 1.0
+
+    def _eval(self, P, arrays=None):
+        """Barycentric interpolation of the node ``arrays`` (default F, G) at P (any shape)."""
+        arrays = (self._F, self._G) if arrays is None else arrays
+        P = np.asarray(P, float)
+        flat = P.ravel()
+        out = [np.empty(flat.shape, np.result_type(a, float)) for a in arrays]
+        for lo in range(0, flat.size, _CHUNK):
+            k, x = self._locate(flat[lo:lo + _CHUNK])
+            d = x[:, None] - _X[None, :]
+            d[d == 0.0] = 1e-300  # on a node: its weight dominates (exact to round-off)
             c = _BW[None, :] / d
-        hit = exact.any(axis=1)
-        c[hit] = exact[hit].astype(float)
-        c /= c.sum(axis=1, keepdims=True)
-        F = np.einsum("ij,ij->i", c, self._F[k])
-        G = np.einsum("ij,ij->i", c, self._G[k])
-        return F.reshape(P.shape), G.reshape(P.shape)
+            c /= c.sum(axis=1, keepdims=True)
+            for o, a in zip(out, arrays):
+                o[lo:lo + _CHUNK] = np.einsum("ij,ij->i", c, a[k])
+        return tuple(o.reshape(P.shape) for o in out)
+
+    def _hermite(self, P):
+        """(F, G) at P by cubic Hermite interpolation between the neighbouring Chebyshev nodes
+        (values and exact slopes F', G' there); cheap on large arrays."""
+        P = np.asarray(P, float)
+        flat = P.ravel()
+        Fo, Go = np.empty(flat.shape), np.empty(flat.shape)
+        n = _NODES
+        e = self._edges
+        for lo in range(0, flat.size, 1 << 16):
+            p = flat[lo:lo + (1 << 16)]
+            k, x = self._locate(p)
+            j = np.clip(np.floor((n - 1) / np.pi * np.arccos(np.clip(-x, -1.0, 1.0))).astype(np.intp), 0, n - 2)
+            half = 0.5 * (e[k + 1] - e[k])
+            p0 = e[k] + half * (_X[j] + 1.0)
+            hc = half * (_X[j + 1] - _X[j])
+            s = (p - p0) / hc
+            s2 = s * s
+            s3 = s2 * s
+            h01 = 3.0 * s2 - 2.0 * s3
+            h00 = 1.0 - h01
+            h10 = (s3 - 2.0 * s2 + s) * hc
+            h11 = (s3 - s2) * hc
+            i0 = k * n + j
+            for out, v, dv in ((Fo, self._F, self._dF), (Go, self._G, self._dG)):
+                v, dv = v.ravel(), dv.ravel()
+                out[lo:lo + (1 << 16)] = h00 * v[i0] + h01 * v[i0 + 1] + h10 * dv[i0] + h11 * dv[i0 + 1]
+        return Fo.reshape(P.shape), Go.reshape(P.shape)
 
     def F(self, P):
         return self._eval(P)[0]
@@ -329,47 +436,106 @@ class DepthProfile:
     def dG(self, P):
         """G'(P) = 2 C R_t exp(F) / (m + rho A)."""
         P = np.asarray(P, float)
-        return 2.0 * np.asarray(self.coefficients.C(P), float) * self.resistance_pa * np.exp(self.F(P)) / self.M(P)
+        A, C = np.asarray(self.coefficients.A(P), float), np.asarray(self.coefficients.C(P), float)
+        r = self.mass / self.target_density
+        return self.resistance_pa / self.target_density * _w_rates(A, 0.0, C, r)[1] * np.exp(self.F(P))
 
     def speed2(self, U0, P):
-        """u^2 = exp(-F(P)) (U0^2 - G(P)) (>= 0 before the stop)."""
-        F, G = self._eval(P)
-        return np.exp(-F) * (np.asarray(U0, float) ** 2 - G)
+        """u^2 = exp(-F(P)) (U0^2 - G(P)) (>= 0 before the stop); broadcasting."""
+        U0, P = np.broadcast_arrays(np.asarray(U0, float), np.asarray(P, float))
+        F, G = self._hermite(P)
+        return np.exp(-F) * (U0**2 - G)
 
-    def final_depth(self, U0):
-        """P_f with G(P_f) = U0^2, vectorised (safeguarded Newton inside the bracketing panel node pair)."""
+    def speed2_to_stop(self, U0, P_f, P):
+        """u^2 = exp(-F(P)) (G(P_f) - G(P)) at P <= P_f (the stop of U0): :meth:`speed2` with U0^2
+        replaced by G(P_f) of the same interpolant, so that u^2 -> 0 at the stop without the
+        cancellation of U0^2 - G(P) (the Hermite interpolant's 1e-13 offset)."""
+        P_f, P = np.broadcast_arrays(np.asarray(P_f, float), np.asarray(P, float))
+        F, G = self._hermite(P)
+        return np.exp(-F) * (self._hermite(P_f[..., -1:])[1] - G)
+
+    def stop(self, U0) -> RootResult:
+        """P_f with G(P_f) = U0^2 for every U0 (vectorised), with its status: a cubic Hermite
+        start inside the bracketing pair of nodes (values and exact slopes), then Newton on the
+        spectral interpolant safeguarded by bisection of the bracket, at most 50 passes.  The
+        one root finder of eq. (11) in P (the array path of the sweeps uses it too)."""
         U0 = np.asarray(U0, float)
         if np.any(U0 > self.U_max * (1 + 1e-12)) or np.any(U0 < 0):
-            raise ValueError("U0 must lie in [0, U_max] of the profile")
+            raise ModelError(f"U0 must lie in [0, U_max = {self.U_max:g}] of the profile")
         g = U0.ravel() ** 2
-        e = self._edges
-        Pn = (e[:-1, None] + 0.5 * (e[1:] - e[:-1])[:, None] * (_X + 1.0)[None, :]).ravel()
+        Pn = (self._edges[:-1, None] + 0.5 * np.diff(self._edges)[:, None] * (_X + 1.0)[None, :]).ravel()
         Gn = np.maximum.accumulate(self._G.ravel())
+        dGn = self._dG.ravel()
         k = np.clip(np.searchsorted(Gn, g, side="left"), 1, len(Gn) - 1)
         lo, hi = Pn[k - 1].copy(), Pn[k].copy()
-        Glo, Ghi = Gn[k - 1], Gn[k]
+        h = hi - lo
+        y0, y1, d0, d1 = Gn[k - 1], Gn[k], dGn[k - 1] * h, dGn[k] * h
         with np.errstate(invalid="ignore", divide="ignore"):
-            frac = np.where(Ghi > Glo, (g - Glo) / (Ghi - Glo), 0.5)
-        P = lo + np.clip(frac, 0.0, 1.0) * (hi - lo)
-        C, A = self.coefficients.C, self.coefficients.A
-        for _ in range(50):
-            F, G = self._eval(P)
+            s = np.clip(np.where(y1 > y0, (g - y0) / (y1 - y0), 0.5), 0.0, 1.0)
+        for _ in range(6):  # Newton on the Hermite cubic (a start within ~1e-10 relative)
+            s2, s3 = s * s, s * s * s
+            y = y0 * (2 * s3 - 3 * s2 + 1) + d0 * (s3 - 2 * s2 + s) + y1 * (3 * s2 - 2 * s3) + d1 * (s3 - s2)
+            dy = 6 * (y0 - y1) * (s2 - s) + d0 * (3 * s2 - 4 * s + 1) + d1 * (3 * s2 - 2 * s)
+            with np.errstate(invalid="ignore", divide="ignore"):
+                s = np.clip(s - np.where(dy > 0, (y - g) / dy, 0.0), 0.0, 1.0)
+        P = lo + s * h
+        done = g == 0
+        it = 0
+        rate = np.zeros_like(P)
+        for it in range(1, 51):
+            F, G, dG = self._eval(P, (self._F, self._G, self._dG))
             r = G - g
             lo = np.where(r < 0, P, lo)
             hi = np.where(r >= 0, P, hi)
-            dG = 2.0 * np.asarray(C(P), float) * self.resistance_pa * np.exp(F) / (
-                self.mass + self.target_density * np.asarray(A(P), float)
-            )
+            rate = np.exp(-F) * dG
             with np.errstate(invalid="ignore", divide="ignore"):
                 Pn_ = P - r / dG
             bad = ~np.isfinite(Pn_) | (Pn_ < lo) | (Pn_ > hi)
             Pn_ = np.where(bad, 0.5 * (lo + hi), Pn_)
-            done = (np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
-            P = Pn_
+            done = done | (((np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)) & np.isfinite(r))
+            P = np.where(g == 0, P, Pn_)
             if np.all(done):
                 break
         P = np.where(g == 0, 0.0, P)
-        return P.reshape(U0.shape)[()]
+        shape = U0.shape
+        return RootResult(P.reshape(shape)[()], done.reshape(shape)[()], it, rate.reshape(shape)[()])
+
+    def final_depth(self, U0):
+        """P_f with G(P_f) = U0^2, vectorised (see :meth:`stop`); raises :class:`ConvergenceError`
+        if the root finder did not converge (never a silent result)."""
+        res = self.stop(U0)
+        if not res.success:
+            raise ConvergenceError(f"eq. (11) in P: the final depth did not converge in {res.iterations} Newton passes "
+                                   f"for {int(np.size(res.converged) - np.count_nonzero(res.converged))} velocities")
+        return res.x
+
+    def integration_error(self, P):
+        """Embedded error estimate of (F, G) at P: the spectral tails of the integrands of the
+        panels up to P (accumulated), G's including the effect of F's through e^F."""
+        if self._tail is None:
+            return np.zeros_like(np.asarray(P, float)), np.zeros_like(np.asarray(P, float))
+        P = np.asarray(P, float)
+        k = np.clip(np.searchsorted(self._edges, P, side="right"), 1, len(self._edges) - 1)
+        eF, eG = self._tail[0][k], self._tail[1][k]  # through the end of P's panel (an upper bound)
+        return eF, eG + np.abs(self.G(P)) * eF
+
+    def shifted(self, dF, dG, ddF, ddG) -> "DepthProfile":
+        """The profile with F, G and their slopes changed by the given node arrays (first-order
+        perturbed profiles of the error estimate: no coefficient evaluation, no integration)."""
+        import dataclasses
+
+        return dataclasses.replace(self, _F=self._F + dF, _G=self._G + dG, _dF=self._dF + ddF, _dG=self._dG + ddG)
+
+    def sensitivities(self, shift):
+        """First-order changes (dF, dG, dF', dG') at the nodes (each (3, panels, nodes), rows: A,
+        B, C) when the coefficients are off by ``shift(P) -> (dA, dB, dC)``: the same panels and
+        quadrature, complex-step rows (see :func:`_integrate_panels`)."""
+        e = self._edges
+        r = self.mass / self.target_density
+        _, F, G, dF, dG, _, _ = _integrate_panels(self.coefficients, e[:-1], e[1:], r, np.zeros(3), np.zeros(3), shift)
+        s = self.resistance_pa / self.target_density
+        im = lambda z, f=1.0: f * np.imag(z) / _STEP  # noqa: E731
+        return im(F), im(G, s), im(dF), im(dG, s)
 
 
 def _panels(breaks: np.ndarray, P_to: float, max_len: float, start: float = 0.0) -> np.ndarray:
@@ -382,53 +548,63 @@ def _panels(breaks: np.ndarray, P_to: float, max_len: float, start: float = 0.0)
     return np.concatenate(out)
 
 
-def depth_profile(
-    coefficients, mass: float, target_density: float, resistance_pa: float, U_max: float, *, panel_scale: float = 1.0
-) -> DepthProfile:
-    """F and G of the w = u^2 form of Part I, eq. (11), integrated in P until G > U_max^2.
+def reduced_profiles(coefficients, ratios, g_max: float, *, panel_scale: float = 1.0) -> list[DepthProfile]:
+    """The :class:`DepthProfile` of eq. (11) in reduced units (mass r = m/rho, rho = 1, R_t = 1)
+    for each ratio r in ``ratios``, on one set of panels and nodes (the coefficients evaluated
+    once), integrated until every G_1 > ``g_max`` (G = (R_t/rho) G_1, F unchanged).
 
     Panels: the coefficients' breakpoints (``coefficients.depth`` if present) plus pieces no
-    longer than a fortieth of the deep-limit stopping depth of U_max (times ``panel_scale``),
-    16 Chebyshev nodes each.
-    """
-    _check_inputs(mass, target_density, resistance_pa)
-    if not (np.isfinite(U_max) and U_max > 0):
-        raise ValueError(f"U_max must be positive; got {U_max!r}")
-    rho, R, m = float(target_density), float(resistance_pa), float(mass)
+    longer than a fortieth of the deep-limit stopping depth of the largest ratio (times
+    ``panel_scale``), 16 Chebyshev nodes each."""
+    r = np.atleast_1d(np.asarray(ratios, float))
     d = float(coefficients.diameter)
     breaks = np.asarray(getattr(coefficients, "depth", np.empty(0)), float).ravel()
     A8, B8, C8 = deep_coefficients(coefficients)
-    P_scale = ConstantCoefficientSolution(A8, B8, C8, m, rho, R, U_max).final_depth + 2.0 * d
+    P_scale = ConstantCoefficientSolution(A8, B8, C8, float(r.max()), 1.0, 1.0, math.sqrt(g_max)).final_depth + 2.0 * d
     max_len = panel_scale * P_scale / 40.0
-    g_end = U_max**2 * (1.0 + 1e-9)
     edges = np.array([0.0])
-    Fs, Gs = np.empty((0, _NODES)), np.empty((0, _NODES))
-    F0 = G0 = 0.0
+    parts = []
+    F0, G0 = np.zeros(r.size), np.zeros(r.size)
     P_to = 1.5 * P_scale
     for _ in range(60):
         new = _panels(breaks, P_to, max_len, start=edges[-1])
-        a, b = new[:-1], new[1:]
-        h = 0.5 * (b - a)
-        nodes = a[:, None] + h[:, None] * (_X + 1.0)[None, :]
-        A = np.asarray(coefficients.A(nodes), float)
-        B = np.asarray(coefficients.B(nodes), float)
-        C = np.asarray(coefficients.C(nodes), float)
-        M = m + rho * A
-        fF = rho * B / M
-        Floc = h[:, None] * (fF @ _Q.T)
-        F = F0 + np.concatenate([[0.0], np.cumsum(Floc[:, -1])[:-1]])[:, None] + Floc
-        fG = 2.0 * C * R * np.exp(F) / M
-        Gloc = h[:, None] * (fG @ _Q.T)
-        G = G0 + np.concatenate([[0.0], np.cumsum(Gloc[:, -1])[:-1]])[:, None] + Gloc
+        _, F, G, dF, dG, tF, tG = _integrate_panels(coefficients, new[:-1], new[1:], r, F0, G0)
+        parts.append((F, G, dF, dG, tF, tG))
         edges = np.concatenate([edges, new[1:]])
-        Fs, Gs = np.vstack([Fs, F]), np.vstack([Gs, G])
-        F0, G0 = F[-1, -1], G[-1, -1]
-        if G0 > g_end:
+        F0, G0 = F[:, -1, -1], G[:, -1, -1]
+        if np.all(G0 > g_max * (1.0 + 1e-9)):
             break
         P_to = edges[-1] * 2.0
+        if P_to > 1e3 * P_scale:  # a thousand deep-limit stopping depths: it does not stop
+            raise ConvergenceError(f"eq. (11) in P: G did not reach U_max^2 by P = {edges[-1]:.3g} m "
+                                   "(does the projectile stop?)")
     else:
-        raise RuntimeError("eq. (11) in P: G did not reach U_max^2 (does the projectile stop?)")
-    return DepthProfile(coefficients, m, rho, R, float(U_max), float(edges[-1]), edges, Fs, Gs)
+        raise ConvergenceError("eq. (11) in P: G did not reach U_max^2 (does the projectile stop?)")
+    F, G, dF, dG = (np.concatenate([p[i] for p in parts], axis=1) for i in range(4))
+    tails = [np.cumsum(np.concatenate([np.zeros((r.size, 1))] + [p[i] for p in parts], axis=1), axis=1) for i in (4, 5)]
+    out = []
+    for j, rj in enumerate(r):
+        tail = np.stack([tails[0][j], tails[1][j]])  # accumulated to each panel end
+        out.append(DepthProfile(coefficients, float(rj), 1.0, 1.0, math.sqrt(g_max), float(edges[-1]), edges, F[j], G[j],
+                                np.ascontiguousarray(np.broadcast_to(dF[j], F[j].shape)), dG[j], tail))
+    return out
+
+
+def depth_profile(
+    coefficients, mass: float, target_density: float, resistance_pa: float, U_max: float, *, panel_scale: float = 1.0
+) -> DepthProfile:
+    """F and G of the w = u^2 form of Part I, eq. (11), integrated in P until G > U_max^2
+    (the one integration of :func:`reduced_profiles` with r = m/rho; G = (R_t/rho) G_1)."""
+    _check_inputs(mass, target_density, resistance_pa)
+    if not (np.isfinite(U_max) and U_max > 0):
+        raise ModelError(f"U_max must be positive; got {U_max!r}")
+    rho, R, m = float(target_density), float(resistance_pa), float(mass)
+    s = R / rho
+    (p,) = reduced_profiles(coefficients, [m / rho], U_max**2 / s, panel_scale=panel_scale)
+    import dataclasses
+
+    return dataclasses.replace(p, mass=m, target_density=rho, resistance_pa=R, U_max=float(U_max), _G=p._G * s,
+                               _dG=p._dG * s, _tail=p._tail * np.array([[1.0], [s]]))
 
 
 def final_depth(coefficients, mass: float, target_density: float, resistance_pa: float, U0):
@@ -436,7 +612,7 @@ def final_depth(coefficients, mass: float, target_density: float, resistance_pa:
     integration in P (see the module docstring).  U0 = 0 gives 0."""
     U0 = np.asarray(U0, float)
     if np.any(~np.isfinite(U0)) or np.any(U0 < 0):
-        raise ValueError("U0 must be finite and non-negative")
+        raise ModelError("U0 must be finite and non-negative")
     if U0.size == 0 or np.max(U0) == 0:
         return np.zeros_like(U0)[()]
     prof = depth_profile(coefficients, mass, target_density, resistance_pa, float(np.max(U0)))
@@ -462,17 +638,11 @@ class WettedCorrection:
         self.mass, self.rho, self.R = float(mass), float(target_density), float(resistance_pa)
         self.reading = reading or getattr(table, "reading", "body")
         self.depth = np.asarray(table.depth, float)
-        self._full = []
-        from semianalytic.coefficients.contact import pressure_terms
+        from semianalytic.coefficients.contact import wetted_coefficients
 
-        for nodes in table.nodes:
-            phi, q = pressure_terms(nodes, self.reading)
-            wn = nodes["weight"] * nodes["nx"]
-            self._full.append((float(np.sum(wn * phi)), float(np.sum(wn * q)), float(np.sum(wn))))
+        self._full = [wetted_coefficients(nodes, self.reading) for nodes in table.nodes]
 
     def _delta(self, k: int, u: float) -> np.ndarray:
-        from semianalytic.coefficients.contact import separated_acceleration
-
         _, wet = separated_acceleration(self.table.nodes[k], self.reading, self.mass, self.rho, u, self.R)
         return np.subtract(wet, self._full[k])
 
@@ -495,52 +665,81 @@ class WettedCorrection:
     def acceleration(self, P: float, u: float) -> float:
         """du/dt of Part I, eq. (11) with the wetted coefficients."""
         A, B, C = self.coefficients(P, u)
-        return -(0.5 * self.rho * B * u * u + C * self.R) / (self.mass + self.rho * A)
+        return eq11_acceleration(A, B, C, self.mass, self.rho, self.R, u * u)
+
+
+def separated_acceleration(nodes: dict, reading: str, mass: float, rho: float, u: float, R_t: float, iterations: int = 20):
+    """du/dt of Part I, eq. (11) with the coefficients of the wetted part (eq. (15)), and
+    (A_w, B_w, C_w): fixed point from full contact (the wetted set usually settles in 2-3
+    steps).  Raises :class:`ConvergenceError` if the wetted set still changes after
+    ``iterations`` passes."""
+    from semianalytic.coefficients.contact import contact_pressure, pressure_terms, wetted_coefficients
+
+    phi, q = pressure_terms(nodes, reading)
+    wet = np.ones(len(phi), bool)
+    for _ in range(iterations):
+        coef = wetted_coefficients(nodes, reading, wet)
+        a = eq11_acceleration(*coef, mass, rho, R_t, u * u)
+        new = contact_pressure(phi, q, rho, a, u * u, R_t) > 0
+        if np.array_equal(new, wet):
+            return a, coef
+        wet = new
+    raise ConvergenceError(f"the wetted part of eq. (15) did not settle in {iterations} fixed-point passes (u = {u:g} m/s)")
+
+
+@functools.lru_cache(maxsize=1024)
+def _separated_run(wetted: "WettedCorrection", rtol: float, U0: float):
+    """(P_f, dense output of w(P), -dw/dP at the stop) of one start velocity with the contact
+    region of eq. (15) (DOP853 in P with an event at w = 0).  Cached here, outside the frozen
+    :class:`SeparatedProfile`, keyed by the (identity of the) wetted correction, rtol and U0."""
+    if U0 == 0.0:
+        return 0.0, None, 0.0
+    wc = wetted
+    d = float(wc.table.diameter)
+
+    def rhs(P, y):
+        return [2.0 * wc.acceleration(max(P, 0.0), math.sqrt(max(y[0], 0.0)))]
+
+    def stop(P, y):
+        return y[0]
+
+    stop.terminal, stop.direction = True, -1
+    A8, B8, C8 = deep_coefficients(wc.table)
+    P_end = 10.0 * ConstantCoefficientSolution(A8, B8, C8, wc.mass, wc.rho, wc.R, U0).final_depth + 100.0 * d
+    from scipy.integrate import solve_ivp  # separated contact only (start-up time)
+
+    sol = solve_ivp(rhs, (0.0, P_end), [U0 * U0], method="DOP853", rtol=rtol, atol=rtol * U0 * U0, events=stop,
+                    dense_output=True)
+    if sol.status != 1 or not len(sol.t_events[0]):
+        raise ConvergenceError(f"eq. (11) with separation did not stop before P = {P_end:g} m ({sol.message})")
+    P_f = float(sol.t_events[0][0])
+    return P_f, sol.sol, -2.0 * wc.acceleration(P_f, 0.0)  # -dw/dP at the stop
 
 
 @dataclass(frozen=True, eq=False)
 class SeparatedProfile:
     """u^2(P) of Part I, eq. (11) with the contact region of eq. (15) for each start velocity
     (one integration in P per velocity, w = u^2, dw/dP = 2 du/dt; DOP853 with an event at
-    w = 0).  Offers the methods of :class:`DepthProfile` that the models use."""
+    w = 0).  Offers the methods of :class:`DepthProfile` that the models use.  Frozen: the runs
+    are cached by :func:`_separated_run`, not in the instance."""
 
     wetted: WettedCorrection
     rtol: float = 1e-10
-    _runs: dict = field(default_factory=dict, repr=False)
 
     def _run(self, U0: float):
-        U0 = float(U0)
-        if U0 not in self._runs:
-            wc = self.wetted
-            d = float(wc.table.diameter)
+        return _separated_run(self.wetted, float(self.rtol), float(U0))
 
-            def rhs(P, y):
-                w = max(y[0], 0.0)
-                return [2.0 * wc.acceleration(max(P, 0.0), math.sqrt(w))]
-
-            def stop(P, y):
-                return y[0]
-
-            stop.terminal, stop.direction = True, -1
-            A8, B8, C8 = deep_coefficients(wc.table)
-            P_end = 10.0 * ConstantCoefficientSolution(A8, B8, C8, wc.mass, wc.rho, wc.R, U0).final_depth + 100.0 * d
-            from scipy.integrate import solve_ivp  # separated contact only (start-up time)
-
-            sol = solve_ivp(rhs, (0.0, P_end), [U0 * U0], method="DOP853", rtol=self.rtol, atol=self.rtol * U0 * U0,
-                            events=stop, dense_output=True)
-            if U0 == 0.0:
-                self._runs[U0] = (0.0, None, 0.0)
-            else:
-                if sol.status != 1 or not len(sol.t_events[0]):
-                    raise RuntimeError(f"eq. (11) with separation did not stop before P = {P_end:g} m")
-                P_f = float(sol.t_events[0][0])
-                slope = -2.0 * wc.acceleration(P_f, 0.0)  # -dw/dP at the stop
-                self._runs[U0] = (P_f, sol.sol, slope)
-        return self._runs[U0]
+    def stop(self, U0) -> RootResult:
+        """P_f for each U0 with its status (an integrator that does not stop raises
+        :class:`ConvergenceError`); ``rate`` = -dw/dP at the stop."""
+        U0 = np.asarray(U0, float)
+        runs = [self._run(u) for u in U0.ravel()]
+        x = np.array([r[0] for r in runs]).reshape(U0.shape)[()]
+        rate = np.array([r[2] for r in runs]).reshape(U0.shape)[()]
+        return RootResult(x, np.ones(U0.shape, bool)[()], 1, rate)
 
     def final_depth(self, U0):
-        U0 = np.asarray(U0, float)
-        return np.array([self._run(u)[0] for u in U0.ravel()]).reshape(U0.shape)[()]
+        return self.stop(U0).x
 
     def speed2(self, U0, P):
         U0 = np.asarray(U0, float)
@@ -560,11 +759,8 @@ class SeparatedProfile:
     def F(self, P):
         return np.zeros_like(np.asarray(P, float))
 
-    def dG(self, P):
-        """-dw/dP at the stop of the run whose final depth is P (used for the time at the stop)."""
-        P = np.asarray(P, float)
-        lookup = {run[0]: run[2] for run in self._runs.values()}
-        return np.array([lookup.get(float(p), np.nan) for p in P.ravel()]).reshape(P.shape)
+    def speed2_to_stop(self, U0, P_f, P):
+        return self.speed2(U0, P)
 
 
 def separated_profile(table, mass: float, target_density: float, resistance_pa: float, rtol: float = 1e-10):
@@ -577,8 +773,10 @@ def separation_onset(table, mass: float, target_density: float, resistance_pa: f
     eq. (9) would turn negative somewhere on the nose (eq. (15)), or None.
 
     All knots and velocities at once: the nodes' pressure terms do not depend on the velocity,
-    so they are gathered once and p_c is evaluated on a (velocities x nodes) array."""
-    from semianalytic.coefficients.contact import pressure_terms
+    and p_c (eq. (9) with du/dt of eq. (11)) is linear in u^2 at each node, so each knot
+    separates for u^2 in a union of two intervals found once; the velocities are compared with
+    those bounds on a (velocities x knots) array."""
+    from semianalytic.coefficients.contact import contact_pressure, pressure_terms
 
     reading = getattr(table, "reading", "body")
     rho, R, m = float(target_density), float(resistance_pa), float(mass)
@@ -601,14 +799,24 @@ def separation_onset(table, mass: float, target_density: float, resistance_pa: f
     A = np.asarray(table.A(P_k[inside]), float)[owner]
     B = np.asarray(table.B(P_k[inside]), float)[owner]
     C = np.asarray(table.C(P_k[inside]), float)[owner]
+    # p_c of eq. (9) with du/dt of eq. (11) is linear in w = u^2 at each node: p_c = slope w + icpt
+    a_w = eq11_acceleration(A, B, 0.0, m, rho, R, 1.0)  # du/dt per unit u^2 (the velocity term)
+    a_0 = eq11_acceleration(A, 0.0, C, m, rho, R, 0.0)  # du/dt at u = 0 (the strength term)
+    slope = contact_pressure(phi, q, rho, a_w, 1.0, 0.0)
+    icpt = contact_pressure(phi, q, rho, a_0, 0.0, R)
+    # the w >= 0 where p_c <= 0: [0, x] (slope >= 0, icpt <= 0) or [y, inf) (slope < 0); per knot the union
+    with np.errstate(divide="ignore", invalid="ignore"):
+        ratio = -icpt / slope
+    x = np.where((slope > 0) & (icpt <= 0), ratio, np.where((slope == 0) & (icpt <= 0), np.inf, -np.inf))
+    y = np.where(slope < 0, np.maximum(ratio, 0.0), np.inf)
+    X, Y = np.full(len(inside), -np.inf), np.full(len(inside), np.inf)
+    has = np.diff(np.append(starts, len(owner))) > 0  # a knot without such nodes never separates
+    X[has] = np.maximum.reduceat(x, starts[has])
+    Y[has] = np.minimum.reduceat(y, starts[has])
     out = []
-    for lo in range(0, U.size, 64):  # blocks of velocities bound the (velocities x nodes) arrays
-        u2 = np.maximum(profile.speed2(U[lo:lo + 64, None], P_k[None, inside]), 0.0)
-        w = u2[:, owner]
-        a = -(0.5 * rho * B * w + C * R) / (m + rho * A)  # du/dt of eq. (11), full contact
-        p = rho * phi * a + q * rho * w / 2 + R  # p_c of eq. (9) at every node
-        sep = np.logical_or.reduceat(p <= 0, starts, axis=1) & (P_k[None, inside] < P_f[lo:lo + 64, None])
-        sep &= np.diff(np.append(starts, len(owner)))[None, :] > 0  # a knot without such nodes never separates
+    for lo in range(0, U.size, 256):  # blocks of velocities bound the (velocities x knots) arrays
+        u2 = np.maximum(profile.speed2(U[lo:lo + 256, None], P_k[None, inside]), 0.0)
+        sep = ((u2 <= X[None, :]) | (u2 >= Y[None, :])) & (P_k[None, inside] < P_f[lo:lo + 256, None])
         first = np.argmax(sep, axis=1)
         out.extend(float(P_k[inside[f]]) if sep[i, f] else None for i, f in enumerate(first))
     return out

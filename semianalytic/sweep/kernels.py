@@ -15,31 +15,24 @@ geometry and the BEM options).
 
 from __future__ import annotations
 
-import json
+import contextlib
 from dataclasses import dataclass, field
 from typing import Any, Mapping
 
 import numpy as np
 
 from semianalytic.case import Case
-from semianalytic.errors import InputError
+from semianalytic.errors import InputError, ModelError
 from semianalytic.sweep.spec import VELOCITY_KEY, Axis, SweepSpec
 
-# keys whose value changes the coefficient table (the nose geometry and the numerics)
-_GEOMETRY_PREFIXES = (
-    "projectile.nose",
-    "projectile.crh",
-    "projectile.diameter",
-    "projectile.half_angle",
-    "projectile.corner_radius",
-    "projectile.meplat_diameter",
-    "projectile.tip_radius",
-    "projectile.points",
-    "bem.",
-    "coefficients.depths",
-    "coefficients.max_depth_nose_lengths",
-    "coefficients.tolerance",
-)
+# [projectile] keys that do NOT change the coefficient table of the nose (the material, the mass
+# and the shank); every other projectile key, and every [bem] and [coefficients] key, is taken to
+# change it (a new nose parameter is never missed: at worst a table is looked up once more)
+_NOT_GEOMETRY = frozenset({
+    "projectile.shank_length", "projectile.length", "projectile.density", "projectile.mass",
+    "projectile.youngs_modulus", "projectile.poisson_ratio", "projectile.yield_stress",
+    "projectile.dynamic_yield_stress", "projectile.buckling", "projectile.buckling_table",
+})
 
 
 # keys a penetration kernel evaluates on arrays (Monte Carlo): the resistance fields, the densities, the mass
@@ -47,19 +40,11 @@ _ARRAY_PREFIXES = ("target.resistance.", "target.density", "projectile.density",
 
 
 def geometry_key(case: Case) -> str:
-    """A content key of everything the coefficient table depends on."""
-    p = case.require("projectile")
-    nose = {k: getattr(p, k, None) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius", "meplat_diameter",
-                                             "tip_radius")}
-    nose["points"] = p.points_si() if p.points else None
-    opts = {
-        "order": case.bem.order,
-        "refinement": case.bem.refinement,
-        "depths": case.coefficients.depths,
-        "max_depth_nose_lengths": case.coefficients.max_depth_nose_lengths,
-        "tolerance": case.coefficients.tolerance,
-    }
-    return json.dumps({"nose": nose, "options": opts}, sort_keys=True, default=repr)
+    """The content key of everything the coefficient table depends on: the cache's own key
+    (:func:`semianalytic.cache.case_table_key`, every nose parameter) with the B reading."""
+    from semianalytic.cache import case_table_key
+
+    return case_table_key(case)
 
 
 def coefficient_table_for(case: Case, cache_dir=None, progress: bool = False):
@@ -208,7 +193,8 @@ class PenetrationKernel:
         depth = np.full(n, np.nan)
         Usc = np.full(n, np.nan)
         if ok.any():
-            depth[ok] = final_depths(coefficients, m[ok], rho[ok], R[ok], U[ok])
+            with _model_errors_as_input():
+                depth[ok] = final_depths(coefficients, m[ok], rho[ok], R[ok], U[ok])
             ci = d["critical"]
             if ci is not None:
                 dens = np.full(n, ci.density) if rho_p is None else rho_p
@@ -223,7 +209,11 @@ class PenetrationKernel:
         }
 
     def affects_resource(self, key: str) -> bool:
-        return self.coefficients is None and key.startswith(_GEOMETRY_PREFIXES)
+        if self.coefficients is not None:
+            return False
+        if key.startswith(("bem.", "coefficients.")):
+            return True
+        return key.startswith("projectile.") and key not in _NOT_GEOMETRY
 
     def resource_key(self, case: Case):
         return "fixed" if self.coefficients is not None else geometry_key(case)
@@ -236,7 +226,8 @@ class PenetrationKernel:
         if table is None:  # kept per worker: the batches of a geometry sweep ask again for their table
             if len(self._tables) >= 8:
                 self._tables.pop(next(iter(self._tables)))
-            table = self._tables[key] = coefficient_table_for(case, self.cache_dir)
+            with _model_errors_as_input():
+                table = self._tables[key] = coefficient_table_for(case, self.cache_dir)
         return table
 
     def evaluate(self, case: Case, coefficients, fast: Mapping[str, np.ndarray]) -> dict[str, np.ndarray]:
@@ -290,6 +281,16 @@ class PenetrationKernel:
             "critical_velocity_m_s": np.full(U.shape, U_sC),
             "yields": (U >= U_sC) if np.isfinite(U_sC) else np.zeros(U.shape, bool),
         }
+
+
+@contextlib.contextmanager
+def _model_errors_as_input():
+    """A model's error (a shape the BEM cannot solve, a solve that did not converge) marks the
+    sweep's cases invalid, as bad input does (the engine's per-case status)."""
+    try:
+        yield
+    except ModelError as exc:
+        raise InputError(exc.field, exc.message) from exc
 
 
 def _fields_owner(model):
