@@ -247,6 +247,11 @@ def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = Tr
         out["ballistic_limit_estimate"] = {"bracket_m_s": bl.bracket, "integration_m_s": bl.integration,
                                            "coefficients_m_s": bl.coefficients, "tolerance_m_s": bl.tolerance,
                                            "iterations": bl.iterations}
+    V_ref = out["ballistic_limit_m_s"] or curve.ballistic_limit_estimate
+    grid = np.linspace(0.5 * V_ref, max(float(U.max()), 2.0 * V_ref), 49)  # the figure's curve: 50 velocities
+    grid = np.sort(np.append(grid, V_ref * (1 + 1e-9)))  # with the limit itself (V_r rises like a square root)
+    dense = perforation_curve(setup.coefficients, setup.mass, grid)
+    out["curve"] = {"striking_velocity_m_s": grid.tolist(), "residual_velocity_m_s": dense.residual_velocity.tolist()}
     lj = lambert_jonas_fit(U, curve.residual_velocity, out["ballistic_limit_m_s"])
     out["lambert_jonas"] = None if lj is None else {k: lj[k] for k in ("a", "p", "V_bl_m_s")}
     out["part4_v_cr_m_s"] = part4_limits(case, setup)
