@@ -230,3 +230,24 @@ def test_layered_target_runs_and_a_gap_changes_nothing_but_time(tmp_path):
         assert Va == pytest.approx(Vt, rel=0.02, abs=1.0)
     i = len(apart["exit_time_s"]) - 1
     assert apart["exit_time_s"][i] > touching["exit_time_s"][i]
+
+
+def test_flat_nose_plug_against_recht_ipson_closed_form(tmp_path):
+    """A flat nose on a 3 mm plate: the braking force C R_t exceeds the ligament's shear capacity
+    pi d H tau at first contact (d R_t / 4 > H tau), so the plug forms at the impact face and the
+    Recht-Ipson balance (momentum, then the shear work pi d tau H^2 / 2) gives V_r in closed form:
+    V_r^2 = (m V_s / (m + m_p))^2 - pi d tau H^2 / (m + m_p).  The model forms the plug at the first
+    grid point (H/800) after eq. (11) has braked it there: 0.2 % covers that."""
+    text = (ROOT / "cases" / "flat_nose.toml").read_text().replace("[target]\n", '[target]\nthickness = "3 mm"\n', 1)
+    r = _cli("perforate", _case(tmp_path, text), "--json")
+    assert r.returncode == 0, r.stderr
+    out = json.loads(r.stdout)
+    assert out["failure"] == "plug" and out["plug_layer"] == [0, 0]
+    m, d, H, tau = out["mass_kg"], 7.11e-3, 3e-3, 400e6 / math.sqrt(3)
+    mp = 2710 * math.pi * d * d / 4 * H
+    for Vs, Vr in zip(out["striking_velocity_m_s"], out["residual_velocity_m_s"]):
+        expect = math.sqrt((m * Vs / (m + mp)) ** 2 - math.pi * d * tau * H * H / (m + mp))
+        assert Vr == pytest.approx(expect, rel=2e-3)
+    # the ballistic limit: v0 just enough for the shear work
+    V_bl = (m + mp) / m * math.sqrt(math.pi * d * tau * H * H / (m + mp))
+    assert out["ballistic_limit_m_s"] == pytest.approx(V_bl, rel=2e-2)

@@ -104,7 +104,7 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
             raise InputError(where, f"the resistance must be positive; got {R:g} Pa")
         Y, E = getattr(res, "yield_stress", None), getattr(res, "youngs_modulus", None)
         ratio = None
-        if opts.back_face == "finite-sphere":
+        if opts.back_face == "finite-sphere" and failure != "plug":  # a plug is the back face's failure itself
             if Y is None or E is None or np.ndim(Y) or not (2 * E / (3 * Y)) > 1:
                 raise InputError("perforation.back_face", f"'finite-sphere' needs the yield stress and Young's modulus of "
                                  f"{where} (models elastic-plastic, hardening, part4); use back_face = 'constant'")

@@ -42,12 +42,15 @@ Back face (the resistance falls as the plastic zone reaches it), ``back_face``:
 Failure mode of the last ligament, ``failure``:
 
 * ``"hole-growth"``: the nose pushes through (ductile hole growth; the back-face factor only);
-* ``"plug"``: a shear plug of the nose diameter is pushed out once the braking force N of
-  eq. (11) exceeds the shear force the ligament can carry, pi d (H - P) tau (the plugging
+* ``"plug"``: a shear plug of the nose diameter forms once the braking force N of eq. (11)
+  exceeds the shear force the ligament h = H - P can carry, pi d h tau (the plugging
   criterion of Chen & Li 2003, Int. J. Impact Eng. 28:743-759, with tau = Y / sqrt(3),
-  von Mises).  At that instant projectile and plug move on together (momentum conservation,
-  Recht & Ipson 1963, J. Appl. Mech. 30:384-390, eq. (2)): V_r = m u / (m + m_plug),
-  m_plug = rho pi d^2 (H - P) / 4; no further resistance from that layer.
+  von Mises).  Projectile and plug then move on together (momentum conservation, Recht &
+  Ipson 1963, J. Appl. Mech. 30:384-390): v_0 = m u / (m + m_plug), m_plug = rho pi d^2 h / 4,
+  and push the plug out against the shear force pi d tau (h - x), which takes the work
+  pi d tau h^2 / 2 (their energy balance): V_r^2 = v_0^2 - pi d tau h^2 / (m + m_plug), or a
+  stop inside the ligament.  With a plug the back-face factor is not applied (the resistance is
+  R_t until the plug forms: the plug is the back face's failure, as in Chen & Li 2003).
 * ``"auto"`` (default): plug for a flat (blunt) nose, hole growth for the others (this
   project's own rule; the literature above reports plugging for blunt and ductile hole
   growth for sharp noses in ductile plates).
@@ -312,16 +315,24 @@ def perforation_curve(coefficients: LayeredCoefficients, mass: float, velocities
         hit = np.isfinite(Pp) & (np.isnan(depth) | (Pp < depth)) & (plug < 0)
         if not np.any(hit):
             continue
-        m_plug = ly.density * math.pi * coefficients.diameter**2 / 4.0 * (ly.back - Pp[hit])
-        v_after = m * up[hit] / (m + m_plug)
+        h = ly.back - Pp[hit]
+        m_plug = ly.density * math.pi * coefficients.diameter**2 / 4.0 * h
+        v0 = m * up[hit] / (m + m_plug)  # momentum conservation at plug formation (Recht & Ipson 1963)
+        # shear work of pushing the plug out: the shear force pi d (h - x) tau falls linearly with the
+        # remaining ligament, W = pi d tau h^2 / 2 (the energy balance of Recht & Ipson 1963)
+        k_sh = math.pi * coefficients.diameter * ly.shear_strength
+        v2 = v0 * v0 - k_sh * h * h / (m + m_plug)
+        v_after = np.sqrt(np.maximum(v2, 0.0))
+        stuck = v2 <= 0
+        x_stop = h - np.sqrt(np.maximum(h * h - (m + m_plug) * v0 * v0 / k_sh, 0.0))
         # this project's own continuation: after the plug the projectile (with its plug) moves on
         # through the remaining layers; with a single layer it leaves at v_after
-        Vr_h, t_h = _continue_after_plug(coefficients, m, ly, Pp[hit], v_after, prof, U[hit])
+        Vr_h, t_h = _continue_after_plug(coefficients, m, ly, Pp[hit], v0, k_sh, h, m_plug, v_after, prof, U[hit])
         plug[hit] = k
         perforated = perforated.copy()
         perforated[hit] = Vr_h > 0
         Vr[hit] = Vr_h
-        depth[hit] = np.where(Vr_h > 0, np.nan, ly.back)
+        depth[hit] = np.where(Vr_h > 0, np.nan, np.where(stuck, Pp[hit] + x_stop, ly.back))
         texit[hit] = t_h
     ok = perforated & (plug < 0)
     if np.any(ok):
@@ -378,30 +389,38 @@ def _plug_onset(coef: LayeredCoefficients, prof, m, k, U):
     return Pp, up
 
 
-def _continue_after_plug(coef: LayeredCoefficients, m, layer, P_plug, v_after, prof, U):
-    """Residual velocity and exit time after a plug: the projectile leaves ``layer`` at
-    ``v_after``; later layers (if any) brake it by eq. (11) from their front face on (this
-    project's own continuation; the plug's mass is not carried into the next layer)."""
+def _continue_after_plug(coef: LayeredCoefficients, m, layer, P_plug, v0, k_sh, h, m_plug, v_after, prof, U):
+    """Residual velocity and exit time after a plug formed at ``P_plug``: the time to the plug
+    (eq. (11) in P, Gauss), the push-out over the ligament h with v^2 = v0^2 - k_sh (2 h x - x^2)
+    / (m + m_plug) (Gauss), then free flight until the nose has left (single layer) or eq. (11)
+    in the later layers from their front face on (this project's own continuation; the plug is
+    not carried into the next layer)."""
     later = [ly for ly in coef.layers if ly.front > layer.front]
     x, w = _gauss()
     t = np.zeros(U.shape)
-    for i in range(U.size):  # time to the plug: Gauss on [0, P_plug]
-        a, b = 0.0, float(P_plug[i])
-        Ps = a + 0.5 * (b - a) * (x + 1.0)
-        t[i] = 0.5 * (b - a) * float(np.sum(w / np.sqrt(np.maximum(prof.speed2(U[i], Ps), 1e-300))))
+    for i in range(U.size):
+        b = float(P_plug[i])  # time to the plug
+        Ps = 0.5 * b * (x + 1.0)
+        t[i] = 0.5 * b * float(np.sum(w / np.sqrt(np.maximum(prof.speed2(U[i], Ps), 1e-300))))
+        if v_after[i] > 0:  # push-out time
+            xs = 0.5 * h[i] * (x + 1.0)
+            v2 = v0[i] ** 2 - k_sh * (2.0 * h[i] * xs - xs * xs) / (m + m_plug[i])
+            t[i] += 0.5 * h[i] * float(np.sum(w / np.sqrt(np.maximum(v2, 1e-300))))
+    v_after = np.asarray(v_after, float)
+    pos = v_after > 0
     if not later:
-        return np.asarray(v_after, float), t
+        tt = np.where(pos, t + coef.nose_length / np.where(pos, v_after, 1.0), np.nan)
+        return v_after, tt
     sub = LayeredCoefficients([PlateLayer(ly.front - later[0].front, ly.thickness, ly.density, ly.resistance,
                                           ly.coefficients, ly.plastic_ratio, ly.shear_strength) for ly in later],
                               coef.nose_length, coef.diameter)
-    gap = later[0].front - np.asarray(P_plug, float)
-    pos = np.asarray(v_after, float) > 0
+    gap = later[0].front - layer.back
     Vr = np.zeros(U.shape)
     tt = np.full(U.shape, np.nan)
     if np.any(pos):
-        res = perforation_curve(sub, m, np.asarray(v_after, float)[pos])
+        res = perforation_curve(sub, m, v_after[pos])
         Vr[pos] = res.residual_velocity
-        tt[pos] = t[pos] + gap[pos] / np.asarray(v_after)[pos] + res.exit_time
+        tt[pos] = t[pos] + gap / v_after[pos] + res.exit_time
     return Vr, tt
 
 
