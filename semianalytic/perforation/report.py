@@ -114,6 +114,17 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
         atomic_write_bytes(out / f"{stem}.png", png_bytes(perforation_figure(r)))
         atomic_write_text(out / f"{stem}.csv", figure_csv(r))
         lines += [f"![V_r against V_s]({stem}.png)", "", f"The figure's data: `{stem}.csv`.", ""]
+    if not any(r.get("data") for r in results):
+        lines += ["## Data", "",
+                  "No measured residual velocities are bundled yet: no public table of striking and residual "
+                  "velocities (Piekutowski, Forrestal, Poormon & Warren 1996, Int. J. Impact Eng. 18:877, 6061-T651 "
+                  "plates and ogive rods; Forrestal et al. 1987/1990/1992; Borvik et al. on AA5083-H116 and AA7075-T651 "
+                  "plates) could be read from the sources reachable when this feature was built, and numbers read "
+                  "from memory are not data. The secondary V50 of about 514 m/s (20 mm 6082-T651, 7.62 mm AP) is a "
+                  "lead only and is not used. A case adds a data set with `[perforation] data = \"file.csv\"` "
+                  "(columns Vs_m_s, Vr_m_s; '#' header lines with the full source and how each number was checked); "
+                  "this report then gives, per data set, the mean absolute error of V_bl and of V_r of the model "
+                  "beside Part IV's formulas and the Lambert-Jonas fit of the data itself.", ""]
     path = out / "validation_perforation.md"
     atomic_write_text(path, "\n".join(lines))
     return path
