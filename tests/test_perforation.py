@@ -251,3 +251,18 @@ def test_flat_nose_plug_against_recht_ipson_closed_form(tmp_path):
     # the ballistic limit: v0 just enough for the shear work
     V_bl = (m + mp) / m * math.sqrt(math.pi * d * tau * H * H / (m + mp))
     assert out["ballistic_limit_m_s"] == pytest.approx(V_bl, rel=2e-2)
+
+
+def test_run_gains_a_perforation_section(tmp_path):
+    """`run --only perforation`: the section, the V_r figure and its data as CSV (the CSV's
+    computed rows are the command's curve; the limit rows its ballistic limit and Part IV's V_cr)."""
+    out = tmp_path / "out"
+    r = _cli("run", DEMO, "--out", out, "--only", "perforation")
+    assert r.returncode == 0, r.stderr
+    text = (out / "report.md").read_text()
+    assert "## Perforation" in text and "perforation_residual_velocity.png" in text
+    rows = (out / "figures" / "perforation_residual_velocity.csv").read_text().splitlines()
+    assert rows[0] == "kind,name,Vs_m_s,Vr_m_s"
+    kinds = {row.split(",")[0] for row in rows[1:]}
+    assert kinds == {"computed", "limit"}
+    assert any(row.startswith("limit,part4_eq5_R3,") for row in rows)
