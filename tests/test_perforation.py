@@ -24,14 +24,37 @@ def _cli(*args, cwd=ROOT):
                           cwd=cwd, env=env, timeout=300)
 
 
+class _Result:
+    def __init__(self, returncode, stdout, stderr):
+        self.returncode, self.stdout, self.stderr = returncode, stdout, stderr
+
+
+def _main(*args):
+    """The command in-process (the dispatcher's exit status and streams; no interpreter start-up)."""
+    import contextlib
+    import io
+
+    from semianalytic.cli import main
+
+    out, err = io.StringIO(), io.StringIO()
+    with contextlib.redirect_stdout(out), contextlib.redirect_stderr(err):
+        rc = main([str(a) for a in args])
+    return _Result(rc, out.getvalue(), err.getvalue())
+
+
 def _case(tmp_path, text: str, name="case.toml") -> Path:
     p = tmp_path / name
     p.write_text(text)
     return p
 
 
-def _demo_text(**replace) -> str:
+def _demo_text(fast: bool = True, **replace) -> str:
+    """The demo case; ``fast``: with the half-space stand-in coefficients ([perforation]
+    coefficients = "half-space"), so that no plate table (minutes of BEM solves) is built: the
+    tests of the dynamics, the CLI and bad input do not depend on which table it is."""
     text = DEMO.read_text()
+    if fast:
+        text = text.replace("[perforation]\n", '[perforation]\ncoefficients = "half-space"\n', 1)
     for old, new in replace.items():
         text = text.replace(old, new)
     return text
@@ -41,8 +64,8 @@ def _demo_text(**replace) -> str:
 # the command
 
 
-def test_perforate_json_keys_and_curve():
-    r = _cli("perforate", DEMO, "--json")
+def test_perforate_json_keys_and_curve(tmp_path):
+    r = _cli("perforate", _case(tmp_path, _demo_text()), "--json")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
     n = len(out["striking_velocity_m_s"])
@@ -80,7 +103,7 @@ def test_perforate_json_keys_and_curve():
     ({'back_face = "finite-sphere"': 'back_face = "round"'}, "perforation.back_face"),
 ])
 def test_bad_input_exit_2_naming_the_key(tmp_path, edit, field):
-    r = _cli("perforate", _case(tmp_path, _demo_text(**edit)), "--json")
+    r = _main("perforate", _case(tmp_path, _demo_text(**edit)), "--json")
     assert r.returncode == 2, r.stderr
     assert r.stderr.startswith(f"error: {field}:"), r.stderr
     assert "Traceback" not in r.stderr and len(r.stderr.strip().splitlines()) == 1
@@ -92,11 +115,11 @@ def test_bad_input_exit_2_naming_the_key(tmp_path, edit, field):
 
 def test_no_perforation_when_a_ballistic_limit_is_asked(tmp_path):
     text = _demo_text(**{'striking_velocities = [': 'striking_velocities = ["100 m/s", "150 m/s"] #'})
-    r = _cli("perforate", _case(tmp_path, text), "--json")
+    r = _main("perforate", _case(tmp_path, text), "--json")
     assert r.returncode == 2
     assert r.stderr.startswith("error: impact.striking_velocities:")
     assert "150 m/s" in r.stderr and "mm" in r.stderr  # the largest velocity tried and the depth it reached
-    ok = _cli("perforate", _case(tmp_path, text), "--json", "--no-ballistic-limit")
+    ok = _main("perforate", _case(tmp_path, text), "--json", "--no-ballistic-limit")
     assert ok.returncode == 0 and json.loads(ok.stdout)["ballistic_limit_m_s"] is None
 
 
@@ -112,11 +135,11 @@ def test_older_cases_keep_their_meaning():
 
 
 @pytest.fixture(scope="module")
-def demo_setup():
+def demo_setup(tmp_path_factory):
     from semianalytic.case import load_case
     from semianalytic.perforation.evaluate import perforation_setup
 
-    case = load_case(DEMO)
+    case = load_case(_case(tmp_path_factory.mktemp("demo"), _demo_text()))
     return case, perforation_setup(case)
 
 
@@ -154,7 +177,7 @@ def test_residual_velocity_and_exit_time_against_time_integration(demo_setup):
     assert cur.residual_velocity[0] == pytest.approx(float(np.interp(Pe, P, u)), rel=1e-5)
 
 
-@pytest.mark.parametrize("back_face", ["constant", "finite-sphere"])
+@pytest.mark.parametrize("back_face", ["constant", pytest.param("finite-sphere", marks=pytest.mark.slow)])
 def test_thick_plate_gives_the_penetrate_depth(tmp_path, back_face):
     """H = 20 rod lengths (1658 mm): the stopping depths equal the half-space depths of
     ``penetrate`` (rigid) within its depth error estimate.  The finite-sphere back face lowers the
@@ -222,7 +245,7 @@ def test_layered_target_runs_and_a_gap_changes_nothing_but_time(tmp_path):
     outs = []
     for gap in ("", 'gap = "200 mm"\n'):
         text = _demo_text(**{'thickness = "26.3 mm"\n': base.format(gap=gap)})
-        r = _cli("perforate", _case(tmp_path, text), "--json", "--no-ballistic-limit")
+        r = _main("perforate", _case(tmp_path, text), "--json", "--no-ballistic-limit")
         assert r.returncode == 0, r.stderr
         outs.append(json.loads(r.stdout))
     touching, apart = outs
@@ -242,6 +265,7 @@ def test_flat_nose_plug_against_recht_ipson_closed_form(tmp_path):
     V_r^2 = (m V_s / (m + m_p))^2 - pi d tau H^2 / (m + m_p).  The model forms the plug at the first
     grid point (H/800) after eq. (11) has braked it there: 0.2 % covers that."""
     text = (ROOT / "cases" / "flat_nose.toml").read_text().replace("[target]\n", '[target]\nthickness = "3 mm"\n', 1)
+    text += '\n[perforation]\ncoefficients = "half-space"\n'  # a flat nose: C is the full area from first contact either way
     r = _cli("perforate", _case(tmp_path, text), "--json")
     assert r.returncode == 0, r.stderr
     out = json.loads(r.stdout)
@@ -260,7 +284,7 @@ def test_run_gains_a_perforation_section(tmp_path):
     """`run --only perforation`: the section, the V_r figure and its data as CSV (the CSV's
     computed rows are the command's curve; the limit rows its ballistic limit and Part IV's V_cr)."""
     out = tmp_path / "out"
-    r = _cli("run", DEMO, "--out", out, "--only", "perforation")
+    r = _cli("run", _case(tmp_path, _demo_text()), "--out", out, "--only", "perforation")
     assert r.returncode == 0, r.stderr
     text = (out / "report.md").read_text()
     assert "## Perforation" in text and "perforation_residual_velocity.png" in text

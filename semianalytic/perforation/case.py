@@ -20,6 +20,8 @@ youngs_modulus = "200 GPa"
 poisson_ratio = 0.29
 
 [perforation]                  # all optional
+coefficients = "plate"         # the plate BEM table; "half-space": X(P) - X(P - H) of the half-space
+                               # table (an approximation, no plate table to build)
 back_face = "finite-sphere"    # or "constant": R_t of eq. (16) up to the exit
 failure = "auto"               # "hole-growth", "plug" (auto: plug for a flat nose)
 shear_strength = "230 MPa"     # tau of the plug criterion (default Y/sqrt(3) of the resistance)
@@ -92,6 +94,7 @@ def check_target_layers(thickness: float | None, layers) -> None:
 class PerforationSection(Section):
     """``[perforation]``: options of the ``perforate`` command (module docstring)."""
 
+    coefficients: Literal["plate", "half-space"] = "plate"  # "half-space": the stand-in approximation (fast)
     back_face: Literal["finite-sphere", "constant"] = "finite-sphere"
     failure: Literal["auto", "hole-growth", "plug"] = "auto"
     shear_strength: Pressure | None = None

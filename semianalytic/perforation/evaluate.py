@@ -34,8 +34,36 @@ def plate_coefficients(case, thickness: float, cache_dir=None, shift: str | None
     the one place that picks the table.  ``shift`` = "A", "B" or "C": that coefficient shifted by
     its error estimate (:class:`semianalytic.penetration.accuracy.ShiftedCoefficients`).
 
-    Without a plate table (Part I with phi = 0 on both faces) the half-space table stands in
-    through :class:`semianalytic.perforation.model.HalfSpaceDifference` (``approximate`` True)."""
+    The plate table of Part I with the back face (:func:`semianalytic.cache.cached_plate_table`,
+    :mod:`semianalytic.coefficients.plate`: phi = 0 on x = H), cached per nose and thickness.
+    With ``[perforation] coefficients = "half-space"`` (or a version lacking the plate module)
+    the half-space table stands in through
+    :class:`semianalytic.perforation.model.HalfSpaceDifference` (``approximate`` True)."""
+    from semianalytic.perforation.case import PerforationSection
+
+    opts = case.section("perforation") or PerforationSection()
+    try:
+        from semianalytic.cache import cached_plate_table
+        from semianalytic.geometry import nose_from_section
+    except ImportError:
+        return _half_space_stand_in(case, thickness, cache_dir, shift)
+    if opts.coefficients == "half-space":
+        return _half_space_stand_in(case, thickness, cache_dir, shift)
+    cs = case.coefficients
+    kwargs = dict(order=case.bem.order, tolerance=cs.tolerance, reading=cs.reading)
+    if case.bem.refinement is not None:
+        kwargs["refinement"] = case.bem.refinement
+    table = cached_plate_table(nose_from_section(case.require("projectile")), float(thickness), cache_dir, **kwargs)
+    desc = (f"plate BEM table (phi = 0 on the back face; order {case.bem.order}, {len(table.depth)} knots, tolerance "
+            f"{cs.tolerance:g}, 0 <= P <= H + L_h; B reading '{cs.reading}')")
+    if shift is not None:
+        from semianalytic.penetration.accuracy import ShiftedCoefficients
+
+        table = ShiftedCoefficients(table, shift)
+    return table, desc, False
+
+
+def _half_space_stand_in(case, thickness: float, cache_dir=None, shift: str | None = None):
     from semianalytic.cache import coefficients_for_case
     from semianalytic.perforation.model import HalfSpaceDifference
 
