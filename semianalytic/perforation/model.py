@@ -447,12 +447,26 @@ class BallisticLimit:
 
 
 def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
-    """Bisection on 'perforates' (w(P_exit) > 0 by eq. (11) in P) between lo (stops) and hi."""
+    """Bisection on 'perforates' between lo (stops) and hi: w(P_exit) = exp(-F) (V^2 - G(P_exit)) > 0
+    of eq. (11) in P, integrated once (the integration does not depend on V below ``hi``); with a
+    plug criterion, the full :func:`perforation_curve` at every step."""
+    if any(ly.shear_strength is not None for ly in coef.layers):
+        n = 0
+        while hi - lo > tol and n < 200:
+            mid = 0.5 * (lo + hi)
+            if perforation_curve(coef, mass, [mid], panel_scale=panel_scale).perforated[0]:
+                hi = mid
+            else:
+                lo = mid
+            n += 1
+        return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+    prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
+    Pe = coef.exit_depth
+    G_e = float(prof.G(Pe))
     n = 0
     while hi - lo > tol and n < 200:
         mid = 0.5 * (lo + hi)
-        c = perforation_curve(coef, mass, [mid], panel_scale=panel_scale)
-        if c.perforated[0]:
+        if np.exp(-float(prof.F(Pe))) * (mid * mid - G_e) > 0:
             hi = mid
         else:
             lo = mid
