@@ -20,7 +20,7 @@ import numpy as np
 from semianalytic.errors import InputError, ModelValidityWarning
 
 __all__ = ["PerforationSetup", "plate_coefficients", "perforation_setup", "evaluate_case", "part4_limits",
-           "load_perforation_data", "JSON_KEYS"]
+           "load_perforation_data", "shot_table_validation", "JSON_KEYS"]
 
 JSON_KEYS = ("striking_velocity_m_s", "perforated", "residual_velocity_m_s", "depth_m", "exit_time_s",
              "ballistic_limit_m_s", "ballistic_limit_error_m_s", "lambert_jonas", "part4_v_cr_m_s")
@@ -286,6 +286,9 @@ def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = Tr
     data = load_perforation_data(case)
     if data is not None:
         out["data"] = _compare_data(setup, data, opts)
+    shots = shot_table_validation(case, cache_dir)
+    if shots is not None:
+        out["shot_table"] = shots
     return out
 
 
@@ -306,3 +309,65 @@ def _compare_data(setup: PerforationSetup, rows: list[dict], opts) -> dict:
         "mean_abs_error_residual_lambert_jonas_data_m_s": None if fit is None else float(
             np.mean(np.abs(lambert_jonas(Vs, fit["a"], fit["p"], fit["V_bl_m_s"]) - Vr))),
     }
+
+
+def shot_table_validation(case, cache_dir=None) -> dict | None:
+    """Measured ballistic limits of a Part IV shot table (the case's ``[ballistic_limit] table``,
+    e.g. Table 3) against eq. (11) through the plate, beside Part IV's formulas.
+
+    Per single-plate shot with an exactly measured V_cr: the case's nose shape (the tables give no
+    nose: an ASSUMPTION stated in the output) scaled to the shot's diameter, its length and mass,
+    the shot's target density and thickness, the resistance R(1) = HM delta_H of Part IV
+    (constant up to the exit: the tables give no Y and E for the finite-sphere back face), the
+    half-space stand-in coefficients (one table per diameter; ``coefficients = "half-space"``).
+    Part IV's values come from :func:`semianalytic.ballistic_limit.evaluate.evaluate_case` (its
+    constants C1-C3 were fitted on Table 3 itself: in-sample)."""
+    import copy
+
+    from semianalytic.ballistic_limit.evaluate import evaluate_case as part4_evaluate
+    from semianalytic.ballistic_limit.tables import load_shots
+    from semianalytic.ballistic_limit.theory import resistance_R1
+    from semianalytic.case import parse_case
+    from semianalytic.perforation.model import ballistic_limit
+
+    sec = case.section("ballistic_limit")
+    if sec is None or sec.table is None:
+        return None
+    base = case.path.parent if case.path is not None else Path.cwd()
+    shots = load_shots((base / sec.table).resolve())
+    part4 = part4_evaluate(case)["rows"][: len(shots)]
+    rows = []
+    for shot, p4 in zip(shots, part4):
+        if (shot.is_composite or shot.measured is None or shot.measured_qualifier or shot.projectile_mass is None
+                or shot.projectile_diameter is None or shot.HVdelta_t is None):
+            continue
+        raw = copy.deepcopy(dict(case.raw))
+        raw.pop("ballistic_limit", None)
+        proj = raw["projectile"]
+        for key in ("shank_length", "length", "density", "mass"):
+            proj.pop(key, None)
+        proj.update(diameter=f"{shot.projectile_diameter!r} m", length=f"{shot.projectile_length!r} m",
+                    mass=f"{shot.projectile_mass!r} kg")
+        R1 = float(resistance_R1(shot.target_hardness, shot.target_delta_H, sec.hardness))
+        raw["target"] = {"density": f"{shot.target_density!r} kg/m^3", "thickness": f"{shot.thickness!r} m",
+                         "resistance": {"model": "constant", "value": f"{R1!r} Pa"}}
+        raw["perforation"] = {"coefficients": "half-space", "back_face": "constant", "failure": "hole-growth"}
+        try:
+            setup = perforation_setup(parse_case(raw, case.path), cache_dir)
+        except InputError as exc:
+            rows.append({"name": shot.name, "skipped": exc.message})
+            continue
+        bl = ballistic_limit(setup.coefficients, setup.mass, 5000.0, tolerance=0.05)
+        row = {"name": shot.name, "measured_V_m_s": shot.measured, "model_V_m_s": bl.value, "R1_Pa": R1}
+        row.update({PART4_NAMES[k]: p4[k] for k in PART4_NAMES if p4.get(k) is not None})
+        rows.append(row)
+    used = [r for r in rows if "model_V_m_s" in r]
+    names = ["model_V_m_s", *PART4_NAMES.values()]
+    stats = {}
+    for n in names:
+        errs = [abs(r[n] - r["measured_V_m_s"]) for r in used if r.get(n) is not None]
+        if errs:
+            stats[n] = {"n": len(errs), "mean_abs_error_m_s": float(np.mean(errs)),
+                        "mean_abs_relative_error": float(np.mean([abs(r[n] / r["measured_V_m_s"] - 1) for r in used
+                                                                  if r.get(n) is not None]))}
+    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats}

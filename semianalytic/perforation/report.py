@@ -111,11 +111,35 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
             lines.append("")
         else:
             lines += ["No measured residual velocities for this case (no `[perforation] data`).", ""]
+        st = r.get("shot_table")
+        if st:
+            f0 = lambda v: "-" if v is None else f"{v:.0f}"  # noqa: E731
+            cols = ["model_V_m_s", "eq5_R1", "eq5_R2", "eq5_R3", "eq7", "eq8", "eq9"]
+            cols = [c for c in cols if c in st["statistics"]]
+            label = {"model_V_m_s": "eq. (11) through the plate"}
+            lines += [f"### Measured ballistic limits of `{st['table']}` (V_bl only: no residual velocities)", "",
+                      f"Nose ASSUMED ({st['nose']}, scaled to each core's diameter: the table gives none); resistance "
+                      "R(1) = HM delta_H of Part IV, constant to the exit; half-space stand-in coefficients. Part IV's "
+                      "constants C1-C3 were fitted on this table (in-sample); eq. (5) uses the same R(1).", "",
+                      "| shot | measured V_bl [m/s] | " + " | ".join(label.get(c, f"Part IV {c}") + " [m/s]" for c in cols) + " |",
+                      "|---|---|" + "---|" * len(cols)]
+            for row in st["rows"]:
+                if "skipped" in row:
+                    lines.append(f"| {row['name']} | skipped: {row['skipped']} |" + " |" * len(cols))
+                else:
+                    lines.append(f"| {row['name']} | {f0(row['measured_V_m_s'])} | " + " | ".join(f0(row.get(c)) for c in cols) + " |")
+            lines += ["", "| predictor | shots | mean abs. error of V_bl [m/s] | mean abs. relative error |", "|---|---|---|---|"]
+            for c in cols:
+                v = st["statistics"][c]
+                lines.append(f"| {label.get(c, 'Part IV ' + c)} | {v['n']} | {v['mean_abs_error_m_s']:.0f} | "
+                             f"{v['mean_abs_relative_error']:.1%} |")
+            lines.append("")
         atomic_write_bytes(out / f"{stem}.png", png_bytes(perforation_figure(r)))
         atomic_write_text(out / f"{stem}.csv", figure_csv(r))
         lines += [f"![V_r against V_s]({stem}.png)", "", f"The figure's data: `{stem}.csv`.", ""]
     if not any(r.get("data") for r in results):
         lines += ["## Data", "",
+                  "Measured ballistic limits (V_bl only) are those of Part IV, Table 3 (section above). "
                   "No measured residual velocities are bundled yet: no public table of striking and residual "
                   "velocities (Piekutowski, Forrestal, Poormon & Warren 1996, Int. J. Impact Eng. 18:877, 6061-T651 "
                   "plates and ogive rods; Forrestal et al. 1987/1990/1992; Borvik et al. on AA5083-H116 and AA7075-T651 "
