@@ -120,7 +120,8 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
             lines += [f"### Measured ballistic limits of `{st['table']}` (V_bl only: no residual velocities)", "",
                       f"Nose ASSUMED ({st['nose']}, scaled to each core's diameter: the table gives none); resistance "
                       "R(1) = HM delta_H of Part IV, constant to the exit; half-space stand-in coefficients. Part IV's "
-                      "constants C1-C3 were fitted on this table (in-sample); eq. (5) uses the same R(1).", "",
+                      "constants C1-C3 were fitted on this table (in-sample); eq. (5) uses the same R(1); eqs. (7)-(9) take "
+                      "P = m_p / (pi d_p^2 / 4) for every row (errata 26: the printed values follow three rules).", "",
                       "| shot | measured V_bl [m/s] | " + " | ".join(label.get(c, f"Part IV {c}") + " [m/s]" for c in cols) + " |",
                       "|---|---|" + "---|" * len(cols)]
             for row in st["rows"]:
