@@ -316,3 +316,23 @@ def test_thick_plate_with_the_plate_table_gives_the_penetrate_depth(tmp_path):
     C, rho, m = math.pi * 0.00711**2 / 4, 2710.0, a["mass_kg"]
     allow = np.array(b["depth_error_estimate_m"]["rigid"]) + P0 * rho * C * C * math.log(2) / (math.pi * H * m)
     assert np.all(np.abs(P1 - P0) <= allow), (P1 - P0, allow)
+
+
+def test_part4_table3_shots_beside_the_ballistic_limit_command():
+    """The Table 3 comparison: Part IV's values per shot are those of the `ballistic-limit`
+    command on the same case (reused, not recomputed), and the shots the assumed nose cannot fit
+    are named, not dropped silently."""
+    case = ROOT / "cases" / "perforation_part4_table3.toml"
+    r = _main("perforate", case, "--json", "--no-ballistic-limit")
+    assert r.returncode == 0, r.stderr
+    st = json.loads(r.stdout)["shot_table"]
+    bl = _main("ballistic-limit", case, "--json")
+    assert bl.returncode == 0, bl.stderr
+    part4 = {row["name"]: row for row in json.loads(bl.stdout)["rows"]}
+    used = [row for row in st["rows"] if "model_V_m_s" in row]
+    assert len(used) == st["statistics"]["model_V_m_s"]["n"] >= 5
+    for row in used:
+        assert row["eq5_R1"] == pytest.approx(part4[row["name"]]["V_R1_m_s"], rel=1e-12)
+        assert row["measured_V_m_s"] == part4[row["name"]]["measured_V_m_s"]
+        assert 0 < row["model_V_m_s"] < 5000
+    assert any("skipped" in row and "longer than the body" in row["skipped"] for row in st["rows"])
