@@ -198,29 +198,19 @@ def slab_layout(nose: Nose, depth: float, thickness: float, options: LayoutOptio
         raise ValueError("the back face does not cut the nose")
     t_cut = param_at_x(piece.segment, x_cut)
     p_cut = (x_cut, float(piece.segment.point(t_cut)[1]))
-    span_old = piece.t1 - piece.t0
-    # keep the panel rows behind the cut (re-expressed on the shorter span), graded at the cut
+    # re-grade the piece from the cut: panels no longer than the piece's uniform ones, graded
+    # geometrically towards the cut (phi'_P at the moving cut goes like s^(lambda - 1): graded as
+    # a tip; clipping the old rows instead left a sliver beside a long panel, and B off by 2e-4
+    # of pi R^2), and as before towards the far end
     rows = piece.panels
-    frac_cut = (t_cut - piece.t0) / span_old
-    keep = []
-    for anchor, a, b in rows:
-        lo, hi = (a, b) if anchor == 0 else (1.0 + a, 1.0 + b)
-        if hi <= frac_cut + 1e-12:
-            continue
-        lo = max(lo, frac_cut)
-        keep.append((lo - frac_cut, hi - frac_cut, anchor))
-    scale = 1.0 - frac_cut
-    new_rows = []
-    for lo, hi, anchor in keep:
-        lo, hi = lo / scale, hi / scale
-        new_rows.append((0, lo, hi) if anchor == 0 else (1, lo - 1.0, hi - 1.0))
-    new_rows[0] = (0, 0.0, new_rows[0][2] if new_rows[0][0] == 0 else 1.0 + new_rows[0][2])
-    arr = np.array(new_rows, float)
-    # phi'_P at the moving cut goes like s^(lambda - 1): graded as a tip (measured on the
-    # 3-CRH ogive at P = 2.5 L_h, H = 2 L_h: the residual of B_bernoulli = dA/dP falls from
-    # 8e-6 to 1e-6 of pi R^2 with levels//3 + 2 -> levels + 2 levels)
+    frac_cut = (t_cut - piece.t0) / (piece.t1 - piece.t0)
+    sizes = rows[:, 2] - rows[:, 1]
+    h_u = float(np.max(sizes))
+    g1 = int(np.sum((rows[:, 0] == 1) & (sizes < 0.99 * h_u)))
+    g1 = max(g1 - 1, 0)
+    n = max(2, int(math.ceil((1.0 - frac_cut) / h_u - 1e-9)))
     lev = options.levels + 2 if options.levels else 0
-    arr = _split_first(arr, lev)
+    arr = graded_panels(n, lev, g1)
     cut = Piece(piece.segment, t_cut, piece.t1, p_cut, piece.p1, arr, (1.0, piece.powers[1]))
     return SlabLayout(half, thickness, (cut, *pieces[k + 1:]))
 
