@@ -32,22 +32,6 @@ from semianalytic.geometry import Nose
 FAR_MODES = 20.0  # exp(-20) = 2e-9: the Dirichlet cut-off of the slab's exponentially decaying field
 
 
-def _cut_param(seg, x: float) -> float:
-    """Parameter of the nose segment at body-frame abscissa x (x monotone along it)."""
-    lo, hi = seg.t0, seg.t1
-    flo = float(seg.point(lo)[0]) - x
-    for _ in range(200):
-        mid = 0.5 * (lo + hi)
-        fm = float(seg.point(mid)[0]) - x
-        if (fm > 0) == (flo > 0):
-            lo, flo = mid, fm
-        else:
-            hi = mid
-        if abs(hi - lo) < 1e-15 * max(1.0, abs(hi)):
-            break
-    return 0.5 * (lo + hi)
-
-
 def plate_domain(nose: Nose, depth: float, thickness: float, options: MeshOptions) -> Domain:
     """The plate 0 <= x <= H minus the nose at depth P (0 < P < H + L_h), cut at R_far."""
     H, d, Rb, Lh = thickness, nose.diameter, nose.radius, nose.length
@@ -62,9 +46,7 @@ def plate_domain(nose: Nose, depth: float, thickness: float, options: MeshOption
     segs = nose.segments
     # the back end of the wetted nose: the tip, or the cut at body x = H - P
     if through:
-        x_cut = H - depth
-        j = next(i for i, s in enumerate(segs) if float(s.point(s.t1)[0]) < x_cut)
-        t_cut = _cut_param(segs[j], x_cut)
+        j, t_cut = _nose_waterline(nose, depth - H)  # the nose point at body x = H - P
         rc = float(segs[j].point(t_cut)[1])
         pieces.append(("back", _line((H, rc), (H, Rf))))
         refine.append((H, rc))

@@ -7,7 +7,6 @@ import math
 
 import numpy as np
 import pytest
-from scipy.special import digamma, k0e, k1e
 
 from semianalytic.bem.panels import LayoutOptions
 from semianalytic.bem.slab import slab_layout, solve_slab
@@ -19,52 +18,10 @@ D = 7.11e-3
 NOSES = {"ogive": ogive_nose(D, 3.0), "cone": cone_nose(D, math.radians(30))}
 
 
-# --------------------------------------------------------------------------------------
-# exact reference: the Green's function of the slab (dphi/dx = 0 at x = 0, phi = 0 at x = H)
-# for a point source on the axis, by two independent series
-
-
-def _modes(x, r, xs, H, n_modes):
-    """Eigenfunction series: sum_n (1/(pi H)) cos(k x) cos(k xs) K0(k r), k = (n + 1/2) pi / H
-    (the 2-D Green's function K0/(2 pi) of each mode times the normalised cos^2 / (H/2))."""
-    k = ((np.arange(n_modes) + 0.5) * math.pi / H)[:, None]
-    e = np.exp(-k * r)
-    c = np.cos(k * xs) / (math.pi * H)
-    u = np.sum(np.cos(k * x) * c * k0e(k * r) * e, axis=0)
-    ux = np.sum(-k * np.sin(k * x) * c * k0e(k * r) * e, axis=0)
-    ur = np.sum(-k * np.cos(k * x) * c * k1e(k * r) * e, axis=0)
-    return u, ux, ur
-
-
-def _images(x, r, xs, H, K=400):
-    """Image series of point sources at 2kH +- xs, sign (-1)^k, summed directly to |k| = K; the
-    rest of the (alternating) monopole sum in closed form (digamma), the next term ~ (H/(K H))^2/K."""
-    u = np.zeros_like(x)
-    ux = np.zeros_like(x)
-    ur = np.zeros_like(x)
-    for k in range(-K, K + 1):
-        for z in (xs + 2 * k * H, -xs + 2 * k * H):
-            d = np.sqrt((x - z) ** 2 + r**2)
-            s = (-1.0) ** k / (4 * math.pi)
-            u += s / d
-            ux -= s * (x - z) / d**3
-            ur -= s * r / d**3
-    z = K + 1.0
-    eta = 0.5 * (digamma(0.5 * (z + 1)) - digamma(0.5 * z))  # sum_n (-1)^n/(n + z)
-    u += 4 * (-1.0) ** (K + 1) * eta / (2 * H) / (4 * math.pi)
-    return u, ux, ur
-
-
-def slab_green(x, r, xs, H):
-    """u, du/dx, du/dr: modes where r > H/50 (exponential convergence), images near the axis."""
-    u, ux, ur = (np.empty_like(x) for _ in range(3))
-    far = r > 0.02 * H
-    if far.any():
-        n = int(40 * H / (math.pi * r[far].min())) + 50
-        u[far], ux[far], ur[far] = _modes(x[far], r[far], xs, H, n)
-    if (~far).any():
-        u[~far], ux[~far], ur[~far] = _images(x[~far], r[~far], xs, H)
-    return u, ux, ur
+# exact reference: the Green's function of the slab (dphi/dx = 0 at x = 0, phi = 0 at x = H) for a
+# point source on the axis, by two independent series (eigenfunctions and images; fem_check's study,
+# which shares no code with the BEM)
+from fem_check.plate_study import _dC_dP, _images, _modes, slab_green  # noqa: E402
 
 
 def test_reference_series_agree():
@@ -99,20 +56,6 @@ def test_slab_bem_exact_point_source(kind, P_over_L, H_over_L):
     nd = sol.nodes
     u, _, _ = slab_green(nd.x, nd.r, xs, H)
     assert np.max(np.abs(nd.phi - u)) < 1e-6 * np.max(np.abs(u))
-
-
-def _dC_dP(nose, P):
-    """dC/dP from the geometry alone: C = pi r(P)^2 while the nose enters (r: the nose radius at P
-    behind the tip), by a central difference of the exact profile."""
-    from semianalytic.bem.panels import param_at_x
-
-    def r(p):
-        for s in nose.segments:
-            if float(s.point(s.t1)[0]) <= -p:
-                return float(s.point(param_at_x(s, -p))[1])
-
-    h = 1e-6 * P
-    return math.pi * (r(P + h) ** 2 - r(P - h) ** 2) / (2 * h) if P < nose.length else 0.0
 
 
 @pytest.mark.parametrize("kind", ["ogive", "cone"])
