@@ -92,6 +92,7 @@ def exact_check(cases=((0.5, 2.0), (0.9, 2.0), (2.0, 2.5), (1.3, 1.0), (1.5, 1.0
             for ref in refinements:
                 sol = solve_slab(slab_layout(nose, P, H, LayoutOptions(8, ref, 6)), neumann=neumann)
                 nd = sol.nodes
+                row["gap_over_L"] = float(np.min(np.hypot(nd.x - xs, nd.r)) / L)  # source to surface
                 u, _, _ = slab_green(nd.x, nd.r, xs, H)
                 row[f"err_{ref}"] = float(np.max(np.abs(nd.phi - u)) / np.max(np.abs(u)))
                 row[f"unknowns_{ref}"] = int(sol.unknowns)
