@@ -62,7 +62,7 @@ from semianalytic.coefficients.table import (
 )
 from semianalytic.geometry import Nose
 
-PLATE_VERSION = 1  # bump when the numerics change, to invalidate cached plate tables
+PLATE_VERSION = 2  # bump when the numerics change, to invalidate cached plate tables (2: the back-face cut re-graded)
 DEFAULT_TOLERANCE = 1e-5
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")
 INTERPOLATED = CONTROLLED + ("phi_tip",)
