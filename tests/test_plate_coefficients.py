@@ -100,8 +100,8 @@ def test_halfspace_limit_deeper(kind):
 @pytest.mark.parametrize("P_over_L", [0.6, 1.4])
 def test_fem_agreement(kind, P_over_L, tmp_path, monkeypatch):
     """fem_check on the same plate (H = L_h; P2 elements, h = d/20, Dirichlet back face) against the
-    BEM: A within 1e-4 (measured 3e-5 at h = d/20, falling like h^4: 3e-6 at d/25... the FEM error
-    dominates), C to round-off (both integrate the exact geometry)."""
+    BEM: A within 1e-4 (measured 7e-6 to 2e-5 at h = d/20, falling like h^4 to 1e-6 to 3e-6 at d/33:
+    the FEM's error dominates), C to round-off (both integrate the exact geometry)."""
     monkeypatch.setenv("FEM_CHECK_MESH_CACHE", str(tmp_path))
     from fem_check.meshing import MeshOptions
     from fem_check.plate import plate_potential
