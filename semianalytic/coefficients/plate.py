@@ -54,6 +54,7 @@ from semianalytic.coefficients.table import (
     FLAT_TIP_DEPTH,
     NEAR_BREAK,
     ROUND_OFF,
+    _coef6,
     breakpoints,
     check_tolerance,
     flat_tip,
@@ -61,7 +62,7 @@ from semianalytic.coefficients.table import (
 )
 from semianalytic.geometry import Nose
 
-PLATE_VERSION = 1  # bump when the numerics change, to invalidate cached plate tables
+PLATE_VERSION = 2  # bump when the numerics change, to invalidate cached plate tables (2: the back-face cut re-graded)
 DEFAULT_TOLERANCE = 1e-5
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")
 INTERPOLATED = CONTROLLED + ("phi_tip",)
@@ -276,12 +277,6 @@ def _spline(v: np.ndarray, y: np.ndarray, dy=None):
         return CubicHermiteSpline(v, y, dy)
     k = 5 if len(v) >= 6 else (3 if len(v) >= 4 else 1)
     return PPoly.from_spline(make_interp_spline(v, y, k=k))
-
-
-def _coef6(f, v0: float, fallback: float) -> list:
-    if f is None:
-        return [0.0] * 5 + [fallback]
-    return [float(f(v0, nu=i)) / math.factorial(i) for i in range(5, -1, -1)]
 
 
 @dataclass
