@@ -152,11 +152,15 @@ def test_table_interface_and_zero_beyond_exit(tmp_path):
     assert plate_table_key(nose, H, depths=depths) != plate_table_key(nose, 1.01 * H, depths=depths)
 
 
-def test_table_rejects_bad_thickness():
-    with pytest.raises(ValueError):
-        plate_coefficient_table(NOSES["ogive"], 0.0)
-    with pytest.raises(ValueError):
-        plate_coefficient_table(NOSES["ogive"], -1e-3)
+@pytest.mark.parametrize("H", [0.0, -1e-3, float("nan"), float("inf"), 1e-9, "thick"])
+def test_table_rejects_bad_thickness(H):
+    """Zero, negative, non-finite, non-numeric and sub-reach (1 nm) thicknesses: InputError naming
+    target.thickness (exit 2 in a command), before any solve."""
+    from semianalytic.errors import InputError
+
+    with pytest.raises(InputError) as e:
+        plate_coefficient_table(NOSES["ogive"], H)
+    assert e.value.field == "target.thickness"
 
 
 @pytest.mark.parametrize("kind", ["ogive", "cone"])
