@@ -21,11 +21,9 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import zipfile
 from pathlib import Path
 
-__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case",
-           "plate_table_key", "cached_plate_table"]
+__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 
@@ -103,6 +101,8 @@ def cached_plate_table(nose, thickness: float, cache_dir: str | os.PathLike | No
     """:func:`semianalytic.coefficients.plate.plate_coefficient_table` of a nose in a plate of
     thickness H [m], read from the cache when there, else built and stored (atomically) under
     :func:`plate_table_key`.  ``reading`` is applied after reading (it is not part of the key)."""
+    import zipfile
+
     from semianalytic.coefficients.plate import PlateCoefficientTable, plate_coefficient_table
     from semianalytic.io import atomic_write_bytes
 
