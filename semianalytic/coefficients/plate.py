@@ -376,9 +376,13 @@ class PlateCoefficientTable:
         c5, c4, c3, c2, c1, c0 = self._coef[name][j]
         if not deriv:
             return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
+        if m > 1.0 and (v < 1e-6 if side == 0 else v > 1.0 - 1e-6):
+            # dP/dv = 0 at the clustered end: the limit of dy/dv / dP/dv, taken 1e-6 inside
+            v = 1e-6 if side == 0 else 1.0 - 1e-6
+            h = v - v0
         dy_dv = (((5 * c5 * h + 4 * c4) * h + 3 * c3) * h + 2 * c2) * h + c1
         dP_dv = (b - a) * m * (v ** (m - 1.0) if side == 0 else (1.0 - v) ** (m - 1.0))
-        return dy_dv / dP_dv if dP_dv > 0 else 0.0
+        return dy_dv / dP_dv
 
     def _eval(self, name: str, P, deriv: bool = False):
         if isinstance(P, float):
