@@ -103,16 +103,17 @@ def _recentre_waterline_edges(dm: DomainMesh, facets, nodes, x, r, curve: Piece)
         x[im], r[im] = curve.project(mid[None, :])[0]
 
 
-def moved_meshes(dm: DomainMesh, steps) -> list[DomainMesh]:
+def moved_meshes(dm: DomainMesh, steps, motion=None) -> list[DomainMesh]:
     """The meshes of depths P + eps (eps in ``steps``) with the topology of ``dm``: harmonic extension
-    of the boundary motion, one factorisation of the Laplacian shared by all steps."""
+    of the boundary motion (``motion(dm, eps)``, default the half-space's), one factorisation of the
+    Laplacian shared by all steps."""
     basis = Basis(dm.mesh, element_for(dm.order))
     if not np.allclose(basis.doflocs, dm.mesh.doflocs):
         raise RuntimeError("geometry nodes and FEM dofs are numbered differently")
     K = _laplace.assemble(basis).tocsr()
     lu, Kib, interior, out = None, None, None, []
     for eps in steps:
-        nodes, new = _boundary_motion(dm, eps)
+        nodes, new = (motion or _boundary_motion)(dm, eps)
         if lu is None:
             interior = np.setdiff1d(np.arange(basis.N), nodes)
             lu = symmetric_lu(K[interior][:, interior])  # the Laplacian's interior block: symmetric positive definite

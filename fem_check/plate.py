@@ -89,7 +89,8 @@ def plate_domain(nose: Nose, depth: float, thickness: float, options: MeshOption
 
 @dataclass(frozen=True)
 class PlatePotential:
-    """FEM A and C of Part I, eq. (12) for a nose in a plate."""
+    """FEM A and C of Part I, eq. (12) for a nose in a plate; dA/dP (= B_bernoulli, errata item 2a)
+    when asked for (nan otherwise)."""
 
     depth: float
     thickness: float
@@ -97,15 +98,11 @@ class PlatePotential:
     C: float  # m^2
     n_dofs: int
     seconds: float
+    dA_dP: float = math.nan  # m^2
 
 
-def plate_potential(nose: Nose, depth: float, thickness: float, options: MeshOptions | None = None) -> PlatePotential:
-    """Solve the plate problem (module docstring) with P2 (``options.order``) elements; A is the
-    load functional (= the energy), C the integral of n_x over the wetted body."""
-    options = options or MeshOptions()
-    t0 = time.perf_counter()
-    dom = plate_domain(nose, depth, thickness, options)
-    dm = build_mesh(dom, options)
+def _solve(dm, depth: float):
+    """(A, C, dofs) on the plate mesh ``dm`` (nose tip at x = depth)."""
     # work in x - P (tip at the origin), as fem_check.potential does for the half-space
     mesh = moved_mesh(dm.mesh, dm.mesh.doflocs - np.array([[depth], [0.0]]))
     mapping = mapping_for(mesh)
@@ -120,6 +117,52 @@ def plate_potential(nose: Nose, depth: float, thickness: float, options: MeshOpt
     phi = np.zeros(basis.N)
     Kc, fc, _, I = condense(K, f, D=fixed)
     phi[I] = symmetric_lu(Kc).solve(fc)
-    A = 2 * math.pi * float(f @ phi)
-    C = 2 * math.pi * float(_contact_area.assemble(fb))
-    return PlatePotential(depth, thickness, A, C, int(basis.N), time.perf_counter() - t0)
+    return 2 * math.pi * float(f @ phi), 2 * math.pi * float(_contact_area.assemble(fb)), int(basis.N)
+
+
+def _plate_motion(dm, eps: float):
+    """Boundary nodes and their positions for the nose moved from P to P + eps, the tip inside the
+    plate and the nose fully in (L_h < P <= H - eps): the body translates, the axis between the tip
+    and the back face and the hole wall stretch, the faces and the far boundary stay."""
+    info = dm.domain.info
+    P, H, Lh = info["depth"], info["thickness"], info["nose_length"]
+    pos = dm.mesh.doflocs
+    nodes_all, new_all = [], []
+    for idx, facets in dm.pieces.items():
+        tag = dm.domain.loop[idx][0]
+        nodes = dm.facet_nodes(facets)
+        x, r = pos[0, nodes].copy(), pos[1, nodes].copy()
+        if tag == "axis":
+            x = P + eps + (x - P) * (H - P - eps) / (H - P)
+        elif tag == "wall":
+            x = x * (P + eps - Lh) / (P - Lh)
+        elif tag == "body":
+            x = x + eps
+        nodes_all.append(nodes)
+        new_all.append(np.vstack([x, r]))
+    nodes, first = np.unique(np.concatenate(nodes_all), return_index=True)
+    return nodes, np.hstack(new_all)[:, first]
+
+
+def plate_potential(nose: Nose, depth: float, thickness: float, options: MeshOptions | None = None,
+                    derivative: bool = False, step: float = 2e-4) -> PlatePotential:
+    """Solve the plate problem (module docstring) with P2 (``options.order``) elements; A is the
+    load functional (= the energy), C the integral of n_x over the wetted body.  ``derivative``:
+    also dA/dP by a central shape difference (the mesh moved with the nose, same topology; step
+    ``step`` L_h), for a nose fully in the plate with its tip inside (L_h < P < H)."""
+    from fem_check.coefficients import moved_meshes
+
+    options = options or MeshOptions()
+    t0 = time.perf_counter()
+    dom = plate_domain(nose, depth, thickness, options)
+    dm = build_mesh(dom, options)
+    A, C, n = _solve(dm, depth)
+    dA = math.nan
+    if derivative:
+        Lh = nose.length
+        eps = step * Lh
+        if not (Lh + 2 * eps < depth < thickness - 2 * eps):
+            raise InputError("depth", "the FEM dA/dP of a plate needs the nose fully in and its tip inside (L_h < P < H)")
+        plus, minus = moved_meshes(dm, [eps, -eps], motion=_plate_motion)
+        dA = (_solve(plus, depth + eps)[0] - _solve(minus, depth - eps)[0]) / (2 * eps)
+    return PlatePotential(depth, thickness, A, C, n, time.perf_counter() - t0, dA)

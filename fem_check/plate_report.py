@@ -107,6 +107,16 @@ def render(study: dict, quick: bool = False):
               [(r["nose"], f"{r['P_over_L']:g}", f"{r['H_over_L']:g}", f"{r['h_over_d']:g}", r["dofs"],
                 f"{r['A_rel']:.2e}", f"{r['C_rel']:.0e}", r["bem_unknowns"]) for r in study["fem"]])
 
+    if study.get("fem_drag"):
+        doc.para(
+            "B on the same plate (P = 1.4 L_h, H = 2 L_h): the FEM's dA/dP, a central shape difference of its energy "
+            "on the mesh moved with the nose (same topology, step 2e-4 L_h), against the BEM's B_bernoulli, a surface "
+            "integral at P (errata item 2a: B_bernoulli = dA/dP). Target: 1e-4."
+        )
+        doc.table(("nose", "h/d", "FEM dofs", "B_bernoulli/(pi R^2) (BEM)", "FEM dA/dP / BEM B_bernoulli - 1"),
+                  [(r["nose"], f"{r['h_over_d']:g}", r["dofs"], f"{r['B_over_S']:.6f}",
+                    f"{r['rel']:.1e}") for r in study["fem_drag"]])
+
     doc.heading("A, B, C against P")
     doc.para(
         "Direct solves (tables' settings: order 8, refinement 0.3, 6 levels) from first contact to past the exit, "

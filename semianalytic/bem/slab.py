@@ -49,6 +49,7 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
+import scipy.linalg
 from scipy.special import digamma, zeta
 
 from semianalytic.bem.kernels import single_double
@@ -68,10 +69,11 @@ from semianalytic.bem.solve import (
     SurfaceSolution,
     _flat_nodes,
     _layers,
+    _single_threaded_blas,
     assemble,
     near_pairs,
     near_quadrature,
-    solve_panels,
+    raise_non_finite,
 )
 from semianalytic.geometry import Line, Nose
 
@@ -393,5 +395,19 @@ def solve_slab(layout: SlabLayout, *, neumann=None, plan: SlabPlan | None = None
     checks against exact solutions); ``plan`` reuses the quadrature rules of a layout of the
     same topology (the stencil of a difference in P)."""
     ps = layout.panels()
-    matrices = assemble_slab(ps, layout.thickness, plan, layout.cap_radius(), cap_levels(layout))
-    return solve_panels(ps, "slab", depth=layout.depth, neumann=neumann, matrices=matrices)
+    S, D = assemble_slab(ps, layout.thickness, plan, layout.cap_radius(), cap_levels(layout))
+    # as semianalytic.bem.solve.solve_panels after its assembly (kept apart: that module is being
+    # reworked on another branch)
+    n = ps.n_primary
+    geo = ps.nodes
+    if neumann is None:
+        g = -geo.tr[:n].ravel()
+    else:
+        x = geo.x[:n].ravel() + ps.offset
+        g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
+    with _single_threaded_blas():
+        phi = scipy.linalg.solve(0.5 * np.eye(S.shape[0]) - D, -S @ g, overwrite_a=True, check_finite=False)
+    if not np.all(np.isfinite(phi)):
+        raise_non_finite(ps, layout.depth)
+    shape = (ps.n_primary, ps.order)
+    return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), "slab", depth=layout.depth)

@@ -92,6 +92,26 @@ def plate_breakpoints(nose: Nose, thickness: float) -> list[float]:
     return out
 
 
+def check_thickness(nose: Nose, thickness) -> float:
+    """The plate thickness H [m] as a float, or InputError naming ``target.thickness``: a finite
+    length > 0, and at least MIN_THICKNESS_RADII nose radii (thinner plates need more image copies
+    than the series allows: :data:`semianalytic.bem.slab.MAX_COPIES`)."""
+    from semianalytic.bem.slab import MAX_COPIES, TAIL_SEPARATION
+    from semianalytic.errors import InputError
+
+    try:
+        H = float(thickness)
+    except (TypeError, ValueError):
+        raise InputError("target.thickness", f"expected a length in m; got {thickness!r}") from None
+    if not (math.isfinite(H) and H > 0):
+        raise InputError("target.thickness", f"must be a finite length > 0 (m); got {thickness!r}")
+    H_min = 0.5 * TAIL_SEPARATION * nose.radius / MAX_COPIES
+    if H < H_min:
+        raise InputError("target.thickness", f"{H * 1e3:.4g} mm is below the plate BEM's reach "
+                         f"({H_min * 1e3:.3g} mm = {H_min / nose.radius:.3g} nose radii); use a thicker plate")
+    return H
+
+
 def plate_end(nose: Nose, thickness: float) -> float:
     """H + L_h: beyond it the nose has left the plate (A = B = C = 0)."""
     return thickness + nose.length
@@ -217,8 +237,7 @@ def plate_coefficients_at(nose: Nose, thickness: float, depths, order: int = 8, 
     interpolation between the solves at b (1 -+ BREAK_OFFSET)."""
     from semianalytic.bem.panels import LayoutOptions
 
-    if not (math.isfinite(thickness) and thickness > 0):
-        raise ValueError("thickness must be finite and > 0")
+    thickness = check_thickness(nose, thickness)
     opts = LayoutOptions(order, refinement, levels)
     kinks = plate_breakpoints(nose, thickness)
     end = plate_end(nose, thickness)
@@ -357,9 +376,13 @@ class PlateCoefficientTable:
         c5, c4, c3, c2, c1, c0 = self._coef[name][j]
         if not deriv:
             return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
+        if m > 1.0 and (v < 1e-6 if side == 0 else v > 1.0 - 1e-6):
+            # dP/dv = 0 at the clustered end: the limit of dy/dv / dP/dv, taken 1e-6 inside
+            v = 1e-6 if side == 0 else 1.0 - 1e-6
+            h = v - v0
         dy_dv = (((5 * c5 * h + 4 * c4) * h + 3 * c3) * h + 2 * c2) * h + c1
         dP_dv = (b - a) * m * (v ** (m - 1.0) if side == 0 else (1.0 - v) ** (m - 1.0))
-        return dy_dv / dP_dv if dP_dv > 0 else 0.0
+        return dy_dv / dP_dv
 
     def _eval(self, name: str, P, deriv: bool = False):
         if isinstance(P, float):
@@ -625,8 +648,7 @@ def plate_coefficient_table(
     ``depths``: fixed knots instead (error estimates from dropping every other knot)."""
     from semianalytic.bem.panels import LayoutOptions
 
-    if not (isinstance(thickness, (int, float)) and math.isfinite(thickness) and thickness > 0):
-        raise ValueError("thickness must be a finite length > 0 [m]")
+    thickness = check_thickness(nose, thickness)
     if reading not in READINGS:
         raise ValueError(f"reading must be one of {READINGS}")
     tol = check_tolerance(DEFAULT_TOLERANCE if tolerance is None else tolerance)
