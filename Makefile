@@ -50,6 +50,7 @@ reports: bench
 	$(PY) -m fem_check rod cases/fig9_ogive_7075T651.toml --out reports --force
 	$(PY) -m fem_check cavity --out reports --force
 	$(PY) -m fem_check bench --out reports --force
+	$(PY) -m fem_check plate --out reports --force
 	$(PY) tests/hardening_tally.py --out reports
 
 clean:
