@@ -50,6 +50,9 @@ def run(args) -> int:
     result = run_calibration(args, command)
     print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
     for m in result["settings"]["models"]:
+        for w in result["posterior"]["models"][m]["diagnostics"].get("warnings") or []:
+            print(f"warning: {m}: sampler: {w}", file=sys.stderr)
+    for m in result["settings"]["models"]:
         s = result["posterior"]["models"][m]["summary"]
         line = f"  {m:<18} " + ", ".join(f"{k} median {s[k]['q50'] / 1e6:.1f} MPa [{s[k]['q05'] / 1e6:.1f}, {s[k]['q95'] / 1e6:.1f}]"
                                          for k in result["settings"]["parameters"]) + f"  sigma {s['sigma']['q50']:.3f}"
