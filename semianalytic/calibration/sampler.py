@@ -209,7 +209,8 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
     tau = np.max(np.array(taus), axis=0)
     n_kept = chain.shape[0] * chain.shape[1]
     ess = float(n_kept / np.max(tau)) if np.all(np.isfinite(tau)) else math.nan
-    nat_chains = np.stack([np.column_stack(problem.to_natural(ch.reshape(-1, ndim))[:2]) for ch in chains])
+    # every walker of every ensemble one chain for arviz (as arviz.from_emcee reads an ensemble)
+    nat_chains = np.stack([np.column_stack(problem.to_natural(w)[:2]) for ch in chains for w in np.swapaxes(ch, 0, 1)])
     diagnostics = chain_diagnostics(nat_chains, (*problem.names, "sigma"))
     flat = chain.reshape(-1, ndim)
     thin = max(1, int(math.ceil(len(flat) / max_draws)))
@@ -251,7 +252,8 @@ def chain_diagnostics(chains, names) -> dict:
                 warn.append(f"{name}: R-hat {rhat:.3f} > {RHAT_MAX} (the chains disagree; sample longer or reparametrise)")
             if not min(bulk, tail) >= ESS_MIN:
                 warn.append(f"{name}: effective sample size {min(bulk, tail):.0f} < {ESS_MIN} (sample longer)")
-    return {"parameters": out, "chains": int(chains.shape[0]), "draws_per_chain": int(chains.shape[1]), "warnings": warn}
+    return {"parameters": out, "chains": int(chains.shape[0]), "draws_per_chain": int(chains.shape[1]), "ensembles": CHAINS,
+            "warnings": warn}
 
 
 def mixture_quantiles(mu: np.ndarray, sigma: np.ndarray, probs, max_draws: int = 2000) -> np.ndarray:
