@@ -332,7 +332,7 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
     apart, f uniform over ``start_f``."""
     import emcee
 
-    from semianalytic.calibration.sampler import chain_diagnostics
+    from semianalytic.calibration.sampler import MOVES, chain_diagnostics
 
     rng = np.random.default_rng(seed)
 
@@ -353,7 +353,9 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
     for c in range(chains):
         p0 = np.column_stack([rng.uniform(*start_f, walkers), np.log(rng.uniform(0.05, 0.4, walkers)),
                               np.log(rng.uniform(0.01, 0.15, walkers))])
-        sampler = emcee.EnsembleSampler(walkers, 3, log_prob, vectorize=True)
+        # differential-evolution moves (ter Braak 2006; emcee.moves.DEMove / DESnookerMove): the posterior
+        # has steps in f where a transition crosses a shot, which the stretch move crosses slowly
+        sampler = emcee.EnsembleSampler(walkers, 3, log_prob, vectorize=True, moves=MOVES())
         sampler.random_state = np.random.RandomState(seed + 1000 * c).get_state()
         sampler.run_mcmc(p0, steps, progress=False)
         chains_out.append(sampler.get_chain(discard=burn))  # (steps - burn, walkers, 2)

@@ -192,10 +192,12 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
         u0 = _mode(problem, rng)
     ndim = problem.ndim
     walkers = max(walkers, 2 * ndim + 2)
-    p0 = u0[None, :] + 1e-3 * rng.standard_normal((walkers, ndim))
-    # CHAINS independent ensembles (own walkers, own random stream): arviz's R-hat between them
-    per = max(walkers // CHAINS, 2 * ndim + 2)
+    # CHAINS independent ensembles (own walkers, own random stream): arviz's R-hat between them;
+    # each ensemble half the walkers (twice the former cost; a quarter mixed too slowly to meet the
+    # quadrature check of tests/test_calibration.py)
+    per = max(walkers // 2, 2 * ndim + 2)
     walkers = per * CHAINS
+    p0 = u0[None, :] + 1e-2 * rng.standard_normal((walkers, ndim))
     chains, taus, acc = [], [], []
     for c in range(CHAINS):
         sampler = emcee.EnsembleSampler(per, ndim, problem.log_prob, vectorize=True)
@@ -212,9 +214,10 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
     # every walker of every ensemble one chain for arviz (as arviz.from_emcee reads an ensemble)
     nat_chains = np.stack([np.column_stack(problem.to_natural(w)[:2]) for ch in chains for w in np.swapaxes(ch, 0, 1)])
     diagnostics = chain_diagnostics(nat_chains, (*problem.names, "sigma"))
-    flat = chain.reshape(-1, ndim)
-    thin = max(1, int(math.ceil(len(flat) / max_draws)))
-    flat = flat[::thin]
+    # thin by steps, keeping every walker (thinning the flattened (step, walker) array would keep
+    # the same few walkers at every step)
+    thin = max(1, int(math.ceil(chain.shape[0] * chain.shape[1] / max_draws)))
+    flat = chain[::thin].reshape(-1, ndim)
     theta, sigma, _ = problem.to_natural(flat)
     R = problem.resistance(theta)
     theta_mode, sigma_mode, _ = problem.to_natural(u0[None, :])
@@ -225,6 +228,17 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
 
 
 CHAINS = 4  # independent ensembles per calibration (issue 22 item 5)
+
+
+def MOVES():
+    """emcee moves of ``calibrate --model regimes``: differential evolution (ter Braak 2006,
+    Statistics and Computing 16:239; emcee.moves.DEMove) with its snooker update (ter Braak & Vrugt
+    2008) in 1 of 5 steps; from walkers spread over the prior they cross the steps of that posterior
+    (a transition passing a shot) faster than the stretch move.  (The other calibrations keep the
+    stretch move: their walkers start in a small ball at the mode, which DE moves would not expand.)"""
+    import emcee
+
+    return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
 RHAT_MAX = 1.01  # Vehtari et al. (2021), Bayesian Analysis 16:667: R-hat < 1.01 and ESS > 400
 ESS_MIN = 400
 
