@@ -22,7 +22,8 @@ def run_regimes(args, command: str) -> dict:
     from semianalytic.calibration.regimes_report import build_regimes_report
     from semianalytic.case import load_case
     from semianalytic.report.document import to_markdown
-    from semianalytic.report.output import StagedDir, check_output_dir
+    from semianalytic.calibration.pipeline import check_outputs_and_load
+    from semianalytic.report.output import StagedDir
 
     if args.model != ["regimes"]:
         raise InputError("--model", "'regimes' is calibrated alone (it holds its own rigid, deforming and eroding models)")
@@ -33,16 +34,7 @@ def run_regimes(args, command: str) -> dict:
         raise InputError("--steps", f"must be at least 200 with --model regimes; got {args.steps}")
     if args.transfer and not args.cross_validate:
         raise InputError("--transfer", "is used only with --cross-validate")
-    check_output_dir(args.out, args.force)
-    if args.report is not None:
-        from semianalytic.io import check_report_target
-
-        if not str(args.report).endswith(".md"):
-            raise InputError("--report", f"expected a path ending in .md; got {args.report!r}")
-        check_report_target(args.report, args.force)
-    case = load_case(args.case)
-    for sec in ("projectile", "target", "data"):
-        case.require(sec)
+    case = check_outputs_and_load(args)
     others = []
     for p in args.transfer:
         c = load_case(p)

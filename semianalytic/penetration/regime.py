@@ -22,9 +22,10 @@ L_r(U_s) <= l_n (erosion needs a yielding nose, so never below U_y):
 
     L_r(U_*) = l_n,   U_e = max(U_y, U_*).
 
-This criterion is this project's, not the paper's; on the bundled VAR 4340 shots it puts the
-depth drop between the last deep shot (1493 m/s, 277 mm) and the first shallow one (1585 m/s,
-105 mm), see reports/validation_regimes.md.
+This criterion is this project's own, not the paper's (``nose_length`` of
+:data:`EROSION_CRITERIA`); on the bundled VAR 4340 shots it puts the depth drop between the last
+deep shot (1493 m/s, 277 mm) and the first shallow one (1585 m/s, 105 mm); the transfer between
+steels does not choose it (reports/validation_regimes.md).
 
 Alekseevskii-Tate (Alekseevskii 1966, Tate 1967; Part IV, eq. (1) for the rigid phase):
 rho_p L dv/dt = -Y_p, dL/dt = -(v - u), dP/dt = u,
