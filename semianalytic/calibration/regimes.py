@@ -489,6 +489,9 @@ def _rank(rec):
 
 
 REGIMES_FORMAT = "semianalytic-regimes-posterior"
+# draws per prediction of penetrate --posterior (evenly thinned): against 1000 draws the quantiles move by
+# a median 0.4 % (at most 5 %) of the 90 % interval over 50 velocities; the CPU time falls by about 1 s
+PREDICTION_DRAWS = 400
 REGIMES_VERSION = 1
 
 
@@ -607,7 +610,8 @@ def predict_case(case, coefficients, path, U, probs=(0.05, 0.25, 0.5, 0.75, 0.95
     post = read_regimes_posterior(path, case)
     shots = shots_at(case, coefficients, U)
     d = post["draws"]
-    pred = predict(shots, post["options"], d["dynamic_factor"], d["sigma"], d["tau"], probs)
+    idx = np.linspace(0, len(d["sigma"]) - 1, min(PREDICTION_DRAWS, len(d["sigma"]))).astype(int)
+    pred = predict(shots, post["options"], d["dynamic_factor"][idx], d["sigma"][idx], d["tau"][idx], probs)
     lo, hi = post["raw"]["velocity_range_m_s"]
     holds = (shots.velocity >= 0.9 * lo) & (shots.velocity <= 1.1 * hi)
     q = np.where(holds[None, :], pred["quantiles"], np.nan)
