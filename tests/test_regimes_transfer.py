@@ -316,3 +316,16 @@ def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     assert f"regime label right {right}/34" in stdout and right >= 28
     assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
     assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 67
+
+
+def test_shipped_regimes_posterior_is_healthy():
+    """Issue 22, item 5: the shipped posterior (reports/calibration_piekutowski1999_regimes) of 4
+    independent ensembles has R-hat <= 1.01 and bulk and tail ESS >= 400 for every parameter, no
+    sampler warning, and its dynamic factor is inside its prior (1, 3), away from the edges."""
+    post = json.loads((ROOT / "reports" / "calibration_piekutowski1999_regimes" / "posterior.json").read_text())
+    d = post["diagnostics"]
+    assert d["ensembles"] == 4 and set(d["parameters"]) == {"dynamic_factor", "sigma", "tau"} and not d["warnings"]
+    for p in d["parameters"].values():
+        assert p["r_hat"] <= 1.01 and min(p["ess_bulk"], p["ess_tail"]) >= 400
+    f = post["summary"]["dynamic_factor"]
+    assert 1.05 < f["q05"] < f["q95"] < 2.95 and not post["at_prior_edge"]["dynamic_factor"]
