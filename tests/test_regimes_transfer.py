@@ -315,7 +315,7 @@ def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
     assert f"regime label right {right}/34" in stdout and right >= 28
     assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
-    assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 67
+    assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 68  # 2 header lines + 66 velocities
 
 
 def test_shipped_regimes_posterior_is_healthy():
