@@ -112,8 +112,30 @@ class ProjectileSection(Section):
     poisson_ratio: float | None = None
     yield_stress: Pressure | None = None
     dynamic_yield_stress: Pressure | None = None  # Y_p of the eroding rod (Alekseevskii-Tate); default: yield_stress
+    # instead of yield_stress: Rockwell C hardness ("39.5 HRC") times dynamic_factor (penetration/hardness.py)
+    hardness: str | None = None
+    dynamic_factor: float | None = None
     buckling: Literal["none", "johnson-euler", "table"] = "none"
     buckling_table: list[tuple[float, float]] | None = None
+
+    @model_validator(mode="before")
+    @classmethod
+    def _hardness(cls, data):
+        """``hardness`` -> ``yield_stress`` = dynamic_factor x the static yield stress of that
+        hardness (semianalytic.penetration.hardness: ASTM E140 + Pavlina & Van Tyne 2008)."""
+        if isinstance(data, dict) and ("hardness" in data or "dynamic_factor" in data):
+            from semianalytic.penetration.hardness import DEFAULT_DYNAMIC_FACTOR, dynamic_yield_stress, parse_hardness
+
+            if "hardness" not in data:
+                raise InputError("projectile.dynamic_factor", "only with projectile.hardness (it multiplies the static "
+                                                              "yield stress of the hardness); remove it or give hardness")
+            if "yield_stress" in data:
+                raise InputError("projectile.hardness", "give hardness or yield_stress, not both")
+            f = data.get("dynamic_factor", DEFAULT_DYNAMIC_FACTOR)
+            if isinstance(f, bool) or not isinstance(f, (int, float)):
+                raise InputError("projectile.dynamic_factor", f"must be a number >= 1 (dimensionless); got {f!r}")
+            data = dict(data, yield_stress=f"{float(dynamic_yield_stress(parse_hardness(data['hardness']), float(f))):.9g} Pa")
+        return data
 
     @field_validator("poisson_ratio")
     @classmethod

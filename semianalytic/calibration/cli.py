@@ -18,9 +18,10 @@ def add_arguments(parser) -> None:
 
     parser.add_argument("case", metavar="CASE.toml", help="case with [projectile], [target], [data] (and [calibration])")
     parser.add_argument("--out", required=True, metavar="DIR", help="output folder")
-    parser.add_argument("--model", action="append", choices=CALIBRATION_MODELS, default=None,
+    parser.add_argument("--model", action="append", choices=(*CALIBRATION_MODELS, "regimes"), default=None,
                         help="depth model to calibrate (repeatable; default: [calibration] models, else all but "
-                             "'eroding'); 'eroding' (Alekseevskii-Tate, on the shots recorded eroded) runs alone")
+                             "'eroding'); 'eroding' (Alekseevskii-Tate, on the shots recorded eroded) runs alone; 'regimes' (the whole "
+                             "velocity range from the projectile's hardness, every shot) runs alone")
     parser.add_argument("--parameter", action="append", default=None, metavar="KEY",
                         help="case key to calibrate, e.g. target.resistance.yield_stress (repeatable); eroding model: "
                              "target.resistance.eroding_resistance, projectile.dynamic_yield_stress (default both)")
@@ -37,6 +38,8 @@ def add_arguments(parser) -> None:
     parser.add_argument("--report", metavar="PATH.md", default=None,
                         help="also write the report as PATH.md and PATH.html, figures beside it (e.g. reports/validation.md)")
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
+    parser.add_argument("--quick", action="store_true",
+                        help="--model regimes --cross-validate: the transfer of the default model set only (no comparison)")
     parser.add_argument("--force", action="store_true", help="replace an existing DIR")
 
 
@@ -47,8 +50,13 @@ def run(args) -> int:
 
     command = "python -m semianalytic calibrate " + " ".join(shlex.quote(a) for a in sys.argv[2:]) if sys.argv[1:2] == [
         "calibrate"] else f"python -m semianalytic calibrate {args.case} --out {args.out}"
+    if args.model and "regimes" in args.model:
+        return _run_regimes(args, command)
     result = run_calibration(args, command)
     print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
+    for m in result["settings"]["models"]:
+        for w in result["posterior"]["models"][m]["diagnostics"].get("warnings") or []:
+            print(f"warning: {m}: sampler: {w}", file=sys.stderr)
     for m in result["settings"]["models"]:
         s = result["posterior"]["models"][m]["summary"]
         line = f"  {m:<18} " + ", ".join(f"{k} median {s[k]['q50'] / 1e6:.1f} MPa, 90 % interval [{s[k]['q05'] / 1e6:.1f}, {s[k]['q95'] / 1e6:.1f}] MPa"
@@ -60,4 +68,34 @@ def run(args) -> int:
             if m == "eroding":
                 line += f" (issue 17 target: mean |e| <= 15 %, {'met' if st['mean_abs_error'] <= 0.15 else 'NOT met'})"
         print(line)
+    return 0
+
+
+def _run_regimes(args, command: str) -> int:
+    from pathlib import Path
+
+    from semianalytic.calibration.regimes_pipeline import run_regimes
+
+    result = run_regimes(args, command)
+    post = result["posterior"]
+    for w in post["diagnostics"]["warnings"]:
+        print(f"warning: regimes: sampler: {w}", file=sys.stderr)
+    print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
+    s = post["summary"]
+    diag = post["diagnostics"]["parameters"]
+    print(f"  regimes ({', '.join(f'{k}={v}' for k, v in post['options'].items())}): dynamic factor median "
+          f"{s['dynamic_factor']['q50']:.3f} [{s['dynamic_factor']['q05']:.3f}, {s['dynamic_factor']['q95']:.3f}], sigma "
+          f"{s['sigma']['q50']:.3f}, tau {s['tau']['q50']:.3f}; R-hat "
+          + ", ".join(f"{k} {d['r_hat']:.3f}" for k, d in diag.items()) + "; ESS "
+          + ", ".join(f"{k} {min(d['ess_bulk'], d['ess_tail']):.0f}" for k, d in diag.items()))
+    tr = result["transfer"]
+    if tr is not None:
+        best = next(o for o in tr["options"] if o["options"] == tr["chosen"])
+        sm = best["summary"]
+        print(f"  transfer (leave one material out), chosen model set {best['label']}: regime label right "
+              f"{sm['label_right']}/{sm['labelled']}")
+        for k in ("rigid", "deforming", "eroding"):
+            if sm[k]["n"]:
+                print(f"    {k:<10} n {sm[k]['n']:2d}  mean |e| of the median {100 * sm[k]['mean_abs_error']:5.1f} %  "
+                      f"90 % coverage {100 * sm[k]['coverage_90']:5.1f} %  labels right {sm[k]['label_right']}/{sm[k]['labelled']}")
     return 0

@@ -228,6 +228,11 @@ def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, 
                 "effective_sample_size": post.effective_sample_size,
                 "walkers": post.n_walkers, "steps": post.n_steps, "burn": post.n_burn,
                 "draws_stored": int(len(idx)),
+                "chains": (post.diagnostics or {}).get("chains"),
+                "r_hat": {k: v["r_hat"] for k, v in ((post.diagnostics or {}).get("parameters") or {}).items()},
+                "ess_bulk": {k: v["ess_bulk"] for k, v in ((post.diagnostics or {}).get("parameters") or {}).items()},
+                "ess_tail": {k: v["ess_tail"] for k, v in ((post.diagnostics or {}).get("parameters") or {}).items()},
+                "warnings": list((post.diagnostics or {}).get("warnings") or []),
             },
             "fit": {f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)},
         }
@@ -517,10 +522,17 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
     ``"regime_aware"``: per velocity the quantiles of the model of its predicted regime
     (:func:`_regime_aware`; the model names in ``posterior_regime_aware``).  ``warnings``:
     lines for stderr."""
+    from semianalytic.calibration.regimes import is_regimes_posterior, predict_case
+
     paths = [path] if isinstance(path, (str, bytes)) or not hasattr(path, "__iter__") else list(path)
     U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
     quantiles, seen = {}, {}
+    regime_files = [p for p in paths if is_regimes_posterior(p)]
+    if len(regime_files) > 1:
+        raise InputError("--posterior", f"two regimes posteriors ({regime_files[0]} and {regime_files[1]}); give one")
     for one in paths:
+        if one in regime_files:
+            continue
         post = read_posterior(one)
         keys = post["parameters"]
         check_target(case, post["target"], keys)
@@ -547,12 +559,21 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
             shots = ShotSet(U, np.full(U.shape, mass), np.full(U.shape, np.nan), tuple(str(k) for k in range(len(U))))
             q = _quantiles_at(_eroding_depths(case, coefficients, mkeys, shots, record["fixed"])[0], draws[ERODING])[0]
             quantiles[ERODING] = {f"{p:g}": q[k].tolist() for k, p in enumerate(QUANTILES)}
-    aware, info, warnings = _regime_aware(case, coefficients, U, quantiles, part1_model)
+    extra = {}
+    if regime_files:  # issue 22: the regime mixture replaces the per-regime pick
+        rp = predict_case(case, coefficients, regime_files[0], U)
+        aware, warnings = rp["quantiles"], rp["warnings"]
+        info = {"model": "regimes", "options": rp["options"], "file": str(regime_files[0])}
+        extra = {"regime_probability": rp["regime_probability"], "regime_model_holds": rp["model_holds"],
+                 "regime_transition_velocities_m_s": rp["transition_velocities_m_s"]}
+    else:
+        aware, info, warnings = _regime_aware(case, coefficients, U, quantiles, part1_model)
     if aware:
         quantiles["regime_aware"] = aware
     return {
         "depth_quantiles_m": quantiles,
         "posterior_file": ", ".join(map(str, paths)),
         "posterior_regime_aware": info,
+        **extra,
         "warnings": warnings,
     }

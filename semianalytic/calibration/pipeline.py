@@ -12,20 +12,12 @@ from pathlib import Path
 from semianalytic.errors import InputError
 
 
-def run_calibration(args: argparse.Namespace, command: str) -> dict:
-    """Calibrate ``args.case`` as the flags say and write DIR (and ``--report``); returns the
-    calibration result (:func:`semianalytic.calibration.evaluate.calibrate_case`) with the
-    cross-validation under "cross_validation" (None without ``--cross-validate``)."""
-    from semianalytic.cache import coefficients_for_case
-    from semianalytic.calibration.evaluate import calibrate_case, cross_validate
-    from semianalytic.calibration.report import build_report
+def check_outputs_and_load(args):
+    """Refuse an existing --out / --report (without --force) or a --report not ending in .md, then
+    load the case and require [projectile], [target] and [data]."""
     from semianalytic.case import load_case
-    from semianalytic.report.document import to_markdown
-    from semianalytic.report.html import to_html
-    from semianalytic.report.output import StagedDir, check_output_dir
+    from semianalytic.report.output import check_output_dir
 
-    if args.steps is not None and args.steps < 50:
-        raise InputError("--steps", f"must be at least 50; got {args.steps}")
     check_output_dir(args.out, args.force)
     if args.report is not None:
         from semianalytic.io import check_report_target
@@ -36,6 +28,24 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
     case = load_case(args.case)
     for sec in ("projectile", "target", "data"):
         case.require(sec)
+    return case
+
+
+def run_calibration(args: argparse.Namespace, command: str) -> dict:
+    """Calibrate ``args.case`` as the flags say and write DIR (and ``--report``); returns the
+    calibration result (:func:`semianalytic.calibration.evaluate.calibrate_case`) with the
+    cross-validation under "cross_validation" (None without ``--cross-validate``)."""
+    from semianalytic.cache import coefficients_for_case
+    from semianalytic.calibration.evaluate import calibrate_case, cross_validate
+    from semianalytic.calibration.report import build_report
+    from semianalytic.case import load_case
+    from semianalytic.report.document import to_markdown
+    from semianalytic.report.html import to_html
+    from semianalytic.report.output import StagedDir
+
+    if args.steps is not None and args.steps < 50:
+        raise InputError("--steps", f"must be at least 50; got {args.steps}")
+    case = check_outputs_and_load(args)
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []

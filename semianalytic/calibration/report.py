@@ -96,11 +96,19 @@ def _rest(doc, figs, result, command, cv, extra, prefix, post, settings, models,
         cells.append(f"{s['sigma']['q50']:.3f} [{s['sigma']['q05']:.3f}, {s['sigma']['q95']:.3f}]")
         tau = max(d["autocorrelation_time"].values())
         cells += [f"{d['acceptance_fraction']:.2f}", f"{tau:.0f}", f"{d['effective_sample_size']:.0f}"]
+        rh, eb, et = d.get("r_hat") or {}, d.get("ess_bulk") or {}, d.get("ess_tail") or {}
+        cells += [", ".join(f"{k} {v:.3f}" for k, v in rh.items()) or "-",
+                  ", ".join(f"{k} {min(eb[k], et[k]):.0f}" for k in eb) or "-"]
         rows.append(cells)
     doc.table(["model", *[f"{k} median [5 %, 95 %]" for k in keys], "eroding R_t [MPa]" if settings.get("eroding") else "R_t [MPa]", "sigma",
-               "acceptance", "max autocorr. time [steps]", "ESS"], rows,
+               "acceptance", "max autocorr. time [steps]", "ESS", "R-hat (arviz)", "min(bulk, tail) ESS (arviz)"], rows,
               caption="Posterior medians and 90 % credible intervals; sampler diagnostics (emcee: acceptance fraction, "
-                      "integrated autocorrelation time, effective sample size = kept draws / max time)")
+                      "integrated autocorrelation time, effective sample size = kept draws / max time; arviz: "
+                      "rank-normalised split R-hat and bulk/tail ESS over 4 independent ensembles, targets R-hat <= 1.01 "
+                      "and ESS >= 400, Vehtari et al. 2021)")
+    for m in models:
+        for w in post["models"][m]["diagnostics"].get("warnings") or []:
+            doc.note(f"Sampler warning ({m}): {w}", kind="warning")
     doc.heading("Predicted against measured (in-sample)")
     header = ["shot", "U_s [m/s]", "measured [mm]"] + [f"{m}: median [5 %, 95 %] mm" for m in models]
     rows = []

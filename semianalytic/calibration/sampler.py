@@ -29,7 +29,7 @@ from scipy import special
 
 from semianalytic.calibration.models import DepthSurrogate
 
-__all__ = ["ResistanceMap", "Problem", "Posterior", "sample_posterior", "mixture_quantiles", "log_predictive_density"]
+__all__ = ["ResistanceMap", "Problem", "Posterior", "sample_posterior", "chain_diagnostics", "CHAINS", "mixture_quantiles", "log_predictive_density"]
 
 
 @dataclass(frozen=True)
@@ -153,6 +153,7 @@ class Posterior:
     n_burn: int
     mode: tuple[float, ...]
     mode_u: tuple[float, ...] = ()
+    diagnostics: dict | None = None  # chain_diagnostics: R-hat and ESS per parameter, warnings
 
 
 def _mode(problem: Problem, rng) -> np.ndarray:
@@ -191,26 +192,82 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
         u0 = _mode(problem, rng)
     ndim = problem.ndim
     walkers = max(walkers, 2 * ndim + 2)
-    p0 = u0[None, :] + 1e-3 * rng.standard_normal((walkers, ndim))
-    sampler = emcee.EnsembleSampler(walkers, ndim, problem.log_prob, vectorize=True)
-    state = np.random.RandomState(seed)
-    sampler.random_state = state.get_state()
-    sampler.run_mcmc(p0, steps, progress=progress, progress_kwargs={"desc": f"sampling {problem.surrogate.model}",
-                                                                      "leave": False})
-    chain = sampler.get_chain(discard=burn)  # (steps - burn, walkers, ndim)
-    tau = np.asarray(sampler.get_autocorr_time(discard=burn, tol=0, quiet=True), float)
+    # CHAINS independent ensembles (own walkers, own random stream): arviz's R-hat between them;
+    # each ensemble half the walkers (twice the former cost; a quarter mixed too slowly to meet the
+    # quadrature check of tests/test_calibration.py)
+    per = max(walkers // 2, 2 * ndim + 2)
+    walkers = per * CHAINS
+    p0 = u0[None, :] + 1e-2 * rng.standard_normal((walkers, ndim))
+    chains, taus, acc = [], [], []
+    for c in range(CHAINS):
+        sampler = emcee.EnsembleSampler(per, ndim, problem.log_prob, vectorize=True)
+        sampler.random_state = np.random.RandomState(seed + 7919 * c).get_state()
+        sampler.run_mcmc(p0[c * per:(c + 1) * per], steps, progress=progress,
+                         progress_kwargs={"desc": f"sampling {problem.surrogate.model} ({c + 1}/{CHAINS})", "leave": False})
+        chains.append(sampler.get_chain(discard=burn))  # (steps - burn, per, ndim)
+        taus.append(np.asarray(sampler.get_autocorr_time(discard=burn, tol=0, quiet=True), float))
+        acc.append(float(np.mean(sampler.acceptance_fraction)))
+    chain = np.concatenate(chains, axis=1)  # (steps - burn, walkers, ndim)
+    tau = np.max(np.array(taus), axis=0)
     n_kept = chain.shape[0] * chain.shape[1]
     ess = float(n_kept / np.max(tau)) if np.all(np.isfinite(tau)) else math.nan
-    flat = chain.reshape(-1, ndim)
-    thin = max(1, int(math.ceil(len(flat) / max_draws)))
-    flat = flat[::thin]
+    # every walker of every ensemble one chain for arviz (as arviz.from_emcee reads an ensemble)
+    nat_chains = np.stack([np.column_stack(problem.to_natural(w)[:2]) for ch in chains for w in np.swapaxes(ch, 0, 1)])
+    diagnostics = chain_diagnostics(nat_chains, (*problem.names, "sigma"))
+    # thin by steps, keeping every walker (thinning the flattened (step, walker) array would keep
+    # the same few walkers at every step)
+    thin = max(1, int(math.ceil(chain.shape[0] * chain.shape[1] / max_draws)))
+    flat = chain[::thin].reshape(-1, ndim)
     theta, sigma, _ = problem.to_natural(flat)
     R = problem.resistance(theta)
     theta_mode, sigma_mode, _ = problem.to_natural(u0[None, :])
     return Posterior(
-        problem.names, theta, R, sigma, float(np.mean(sampler.acceptance_fraction)), tuple(map(float, tau)), ess,
-        walkers, steps, burn, (*map(float, theta_mode[0]), float(sigma_mode[0])), tuple(map(float, u0)),
+        problem.names, theta, R, sigma, float(np.mean(acc)), tuple(map(float, tau)), ess,
+        walkers, steps, burn, (*map(float, theta_mode[0]), float(sigma_mode[0])), tuple(map(float, u0)), diagnostics,
     )
+
+
+CHAINS = 4  # independent ensembles per calibration (issue 22 item 5)
+
+
+def MOVES():
+    """emcee moves of ``calibrate --model regimes``: differential evolution (ter Braak 2006,
+    Statistics and Computing 16:239; emcee.moves.DEMove) with its snooker update (ter Braak & Vrugt
+    2008) in 1 of 5 steps; from walkers spread over the prior they cross the steps of that posterior
+    (a transition passing a shot) faster than the stretch move.  (The other calibrations keep the
+    stretch move: their walkers start in a small ball at the mode, which DE moves would not expand.)"""
+    import emcee
+
+    return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
+RHAT_MAX = 1.01  # Vehtari et al. (2021), Bayesian Analysis 16:667: R-hat < 1.01 and ESS > 400
+ESS_MIN = 400
+
+
+def chain_diagnostics(chains, names) -> dict:
+    """Per parameter: arviz's rank-normalised split R-hat and bulk and tail effective sample
+    sizes (Vehtari, Gelman, Simpson, Carpenter & Buerkner 2021, Bayesian Analysis 16:667) of
+    ``chains`` (n_chains, n_draws, n_params), and ``warnings`` naming each parameter with R-hat >
+    1.01 or an ESS below 400 (the thresholds of that paper)."""
+    import warnings as _w
+
+    with _w.catch_warnings():
+        _w.simplefilter("ignore")
+        import arviz as az
+
+        chains = np.asarray(chains, float)
+        out, warn = {}, []
+        for j, name in enumerate(names):
+            x = chains[:, :, j]
+            rhat = float(az.rhat(x))
+            bulk = float(az.ess(x, method="bulk"))
+            tail = float(az.ess(x, method="tail"))
+            out[name] = {"r_hat": rhat, "ess_bulk": bulk, "ess_tail": tail}
+            if not rhat <= RHAT_MAX:
+                warn.append(f"{name}: R-hat {rhat:.3f} > {RHAT_MAX} (the chains disagree; sample longer or reparametrise)")
+            if not min(bulk, tail) >= ESS_MIN:
+                warn.append(f"{name}: effective sample size {min(bulk, tail):.0f} < {ESS_MIN} (sample longer)")
+    return {"parameters": out, "chains": int(chains.shape[0]), "draws_per_chain": int(chains.shape[1]), "ensembles": CHAINS,
+            "warnings": warn}
 
 
 def mixture_quantiles(mu: np.ndarray, sigma: np.ndarray, probs, max_draws: int = 2000) -> np.ndarray:

@@ -75,6 +75,8 @@ class DataSection(Section):
     cavity_C: float | None = Field(default=None, ge=0)
     critical_velocity: Velocity | None = None
     response_column: str | None = Field(default=None, description="column of the recorded response (rigid, curved, eroded, ...)")
+    hardness_column: str | None = Field(default=None, description="column of each projectile's Rockwell C hardness "
+                                        "(used with [projectile] hardness: per-shot strength)")
 
     @model_validator(mode="after")
     def _complete(self):

@@ -13,6 +13,11 @@ eroding), ``depth_m`` (the Part I model ``--part1-model`` below the erosion onse
 Alekseevskii-Tate eroding rod above), ``depth_eroding_m``, ``transition_velocity_m_s`` (U_sC),
 ``erosion_velocity_m_s``, ``valid`` (per model, a list of booleans); every depth outside its
 model's validity is warned on stderr, naming the model and the reason.
+
+``--posterior`` of ``calibrate --model regimes`` (issue 22) adds ``regime_probability``
+({"rigid", "deforming", "eroding"} per velocity, summing to 1), ``regime_model_holds`` and
+``depth_quantiles_m["regime_aware"]`` from the mixture of the regimes' predictions
+(:func:`semianalytic.calibration.regimes.predict_case`).
 """
 
 from __future__ import annotations
@@ -63,7 +68,8 @@ def add_arguments(parser) -> None:
                         "onset (default: elastic_exact_rod, the elastic projectile with the exact-rod W2)")
     parser.add_argument("--posterior", metavar="POSTERIOR.json", default=None, action="append",
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
-                             "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding)")
+                             "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding); a "
+                             "posterior of calibrate --model regimes adds regime_probability and the regime mixture")
     parser.add_argument("--csv", metavar="FILE", default=None,
                         help="also write FILE (CSV): one row per case, striking velocity and model (units in the header)")
 

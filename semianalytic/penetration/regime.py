@@ -22,9 +22,10 @@ L_r(U_s) <= l_n (erosion needs a yielding nose, so never below U_y):
 
     L_r(U_*) = l_n,   U_e = max(U_y, U_*).
 
-This criterion is this project's, not the paper's; on the bundled VAR 4340 shots it puts the
-depth drop between the last deep shot (1493 m/s, 277 mm) and the first shallow one (1585 m/s,
-105 mm), see reports/validation_regimes.md.
+This criterion is this project's own, not the paper's (``nose_length`` of
+:data:`EROSION_CRITERIA`); on the bundled VAR 4340 shots it puts the depth drop between the last
+deep shot (1493 m/s, 277 mm) and the first shallow one (1585 m/s, 105 mm); the transfer between
+steels does not choose it (reports/validation_regimes.md).
 
 Alekseevskii-Tate (Alekseevskii 1966, Tate 1967; Part IV, eq. (1) for the rigid phase):
 rho_p L dv/dt = -Y_p, dL/dt = -(v - u), dP/dt = u,
@@ -265,3 +266,73 @@ def regime_depth(regimes, part1_depth, eroding_depth_m) -> np.ndarray:
     p1 = np.asarray(part1_depth, float)
     er = np.asarray(eroding_depth_m, float)
     return np.where(np.asarray(regimes) == "eroding", er, p1)
+
+
+# --- published transition criteria and target resistance (issue 22) -------------------------
+
+TABOR_CONSTRAINT = 3.0
+"""Constraint factor C of a plastically indented solid: mean contact pressure = C x flow stress,
+C ~ 3 for metals (Tabor 1951, The Hardness of Metals, Oxford, ch. 4-5)."""
+
+ONSET_CRITERIA = ("part1_usc", "tate_tip")
+"""Rigid -> deforming.  ``part1_usc``: Part I, eqs. (33)/(36) (the mean axial stress of the
+shank reaches Y_p).  ``tate_tip``: Tate's criterion (Tate 1967, J. Mech. Phys. Solids 15:387:
+a rod deforms and erodes once the interface pressure (1/2) rho_t U^2 + R_t exceeds its strength)
+applied to the nose tip, whose strength as a constrained indenter is C Y_p (Tabor 1951,
+C = 3): U_y = sqrt(2 (C Y_p - R_t)/rho_t).  The combination (Tate's pressure against Tabor's
+constrained strength of the tip) is this project's reading of the two published relations."""
+
+EROSION_CRITERIA = ("tate", "tate_tip_uts", "nose_length")
+"""Deforming -> eroding.  ``tate`` (published): Tate (1967): a flat-ended rod of strength Y_p
+erodes once (1/2) rho_t U^2 + R_t > Y_p, from U_T = sqrt(2 (Y_p - R_t)/rho_t) (0 if
+Y_p <= R_t).  ``tate_tip_uts``: the same pressure against the tip's constrained ultimate
+strength C sigma_u (the tip breaks up, not only yields; Tabor 1951, C = 3; sigma_u from the
+hardness, Pavlina & Van Tyne 2008, eq. (5)) -- this project's reading, as ``tate_tip``.
+``nose_length``: this project's own (:func:`erosion_onset_velocity`: the Alekseevskii-Tate rod
+consumed down to its nose length).  Every criterion starts the eroding regime at
+max(U_y, U_e): a nose that does not yield does not erode."""
+
+RESISTANCE_RELATIONS = ("part1", "tate1986")
+"""R_t of the eroding rod from the target's properties: ``part1`` = the case's Part I R_t (eq.
+(16) for the elastic-plastic target); ``tate1986`` = Tate (1986), Int. J. Mech. Sci. 28:599,
+R_t = Y_t (2/3 + ln(0.57 E_t / Y_t)) (:func:`tate_resistance`)."""
+
+ROD_STRENGTHS = ("yield", "ultimate")
+"""Y_p of the Alekseevskii-Tate rod: the dynamic factor times the static yield stress or times
+the ultimate strength (a flow stress at the large strains of an eroding nose) from the hardness."""
+
+DEFORMING_MODELS = ("part1_upper", "eroding", "breakup")
+"""Depth in the deforming band: ``part1_upper`` (this project's own reading: the Part I depth of a
+nose that keeps its shape, an upper bound); ``eroding`` (the Alekseevskii-Tate rod with its
+rigid-rod phase, Tate 1967 / Part IV eqs. (2)-(3), which covers a rod that erodes while it
+decelerates and penetrates rigidly below v_e); ``breakup`` (this project's own combination of
+the two: the Part I depth while the tip's pressure stays below its constrained ultimate strength,
+the tip-UTS velocity of :data:`EROSION_CRITERIA` ``tate_tip_uts``, the eroding rod's above it: a
+nose that has yielded keeps penetrating as a slightly bent rigid body until it breaks up)."""
+
+
+def tate_erosion_velocity(rod_strength, target_resistance, target_density: float, constraint: float = 1.0):
+    """U_T = sqrt(2 (C Y - R_t)/rho_t), 0 where C Y <= R_t: Tate's (1967) criterion
+    (1/2) rho_t U^2 + R_t > C Y (C = 1: the flat-ended rod; C = :data:`TABOR_CONSTRAINT`: the
+    nose tip as a constrained indenter, see :data:`ONSET_CRITERIA`); vectorised."""
+    Y, R = np.asarray(rod_strength, float), np.asarray(target_resistance, float)
+    return np.sqrt(np.maximum(2.0 * (constraint * Y - R) / target_density, 0.0))[()]
+
+
+def tate_resistance(yield_stress: float, youngs_modulus: float) -> float:
+    """R_t [Pa] of Tate (1986), Int. J. Mech. Sci. 28:599-612: R_t = Y_t (2/3 + ln(0.57 E_t/Y_t))
+    from the target's yield stress Y_t and Young's modulus E_t."""
+    if not (yield_stress > 0 and youngs_modulus > yield_stress):
+        raise InputError("target.resistance.yield_stress", "Tate's R_t needs 0 < Y_t < E_t")
+    return float(yield_stress * (2.0 / 3.0 + math.log(0.57 * youngs_modulus / yield_stress)))
+
+
+def regime_codes(striking_velocity, yield_velocity, erosion_velocity) -> np.ndarray:
+    """Regime index (0 rigid, 1 deforming, 2 eroding; :data:`REGIMES`) for broadcast arrays of
+    U_s, U_y (:data:`ONSET_CRITERIA`) and U_e (:data:`EROSION_CRITERIA`); the vectorised
+    :func:`classify_regimes` (NaN or inf U_y: rigid)."""
+    U, Uy, Ue = np.broadcast_arrays(*(np.asarray(x, float) for x in (striking_velocity, yield_velocity, erosion_velocity)))
+    with np.errstate(invalid="ignore"):
+        yields = np.isfinite(Uy) & (U >= Uy)
+        erodes = yields & np.isfinite(Ue) & (U >= Ue)
+    return np.where(erodes, 2, np.where(yields, 1, 0))

@@ -1,0 +1,331 @@
+"""Issue 22: projectile strength from its hardness, published transition criteria, the regime
+mixture of ``penetrate --posterior`` and the leave-one-material-out transfer on Piekutowski et
+al. (1999).
+
+Checked against what the code under test does not produce: the numbers printed in ASTM E140 and
+in Pavlina & Van Tyne (2008) (hand arithmetic), the tensile yield stresses printed by Piekutowski
+et al. beside each steel's hardness, the recorded responses and depths of the data file (read
+here with the csv module), iid draws of known effective sample size, and the exact grid
+posterior against emcee (a second method).
+"""
+
+import csv
+import json
+import math
+import shutil
+import subprocess
+import sys
+from pathlib import Path
+
+import numpy as np
+import pytest
+
+from semianalytic.cli import main
+
+ROOT = Path(__file__).resolve().parents[1]
+CASES = ROOT / "cases"
+CSV = "piekutowski1999_ogive_6061T6511.csv"
+VAR = "piekutowski1999_var4340_hardness_regimes.toml"
+AER = "piekutowski1999_aermet100_hardness_regimes.toml"
+RESPONSE_REGIME = {"rigid": "rigid", "curved": "deforming", "exited": "deforming", "turned_around": "deforming",
+                   "broken": "deforming", "eroded": "eroding", "broken_eroding": "eroding"}
+
+
+def _rows():
+    with (CASES / CSV).open() as fh:
+        return list(csv.DictReader(line for line in fh if not line.startswith("#")))
+
+
+def _run(capsys, *argv):
+    code = main([*map(str, argv)])
+    out = capsys.readouterr()
+    return code, out.out, out.err
+
+
+def _copy(tmp_path, name, edit=None):
+    text = (CASES / name).read_text()
+    if edit is not None:
+        new = edit(text)
+        assert new != text
+        text = new
+    (tmp_path / name).write_text(text)
+    shutil.copy(CASES / CSV, tmp_path / CSV)
+    return tmp_path / name
+
+
+# --- hardness -> strength -----------------------------------------------------------------
+
+
+def test_hardness_conversion_against_the_published_tables():
+    """ASTM E140 Table 1 rows (38 HRC = 372 HV, 53 HRC = 560 HV) and Pavlina & Van Tyne (2008),
+    eq. (4) by hand: 2.876 x 372 - 90.7 = 979.17 MPa; eq. (5): 3.734 x 560 - 99.8 = 1991.24 MPa.
+    Against the experiment: Piekutowski et al. print tensile yields of 1140 MPa (VAR 4340, Rc 38)
+    and 1720 MPa (AerMet 100, Rc 53); the conversion is within 20 % of both (the 2-sigma scatter
+    of Pavlina & Van Tyne's fit is about 200 MPa, 15-20 % at these strengths)."""
+    from semianalytic.penetration import hardness as H
+
+    assert H.vickers_from_rockwell_c(38) == 372 and H.vickers_from_rockwell_c(53) == 560
+    assert H.vickers_from_rockwell_c(38.5) == pytest.approx(377.0)  # halfway between 372 and 382
+    assert H.yield_stress_from_hardness(38) == pytest.approx(979.172e6, rel=1e-12)
+    assert H.ultimate_strength_from_vickers(560) == pytest.approx(1991.24e6, rel=1e-12)
+    for hrc, printed in ((38, 1140e6), (53, 1720e6)):
+        assert abs(H.yield_stress_from_hardness(hrc) / printed - 1) < 0.20
+    assert H.parse_hardness("39.5 HRC") == 39.5 and H.parse_hardness("Rc 53") == 53
+
+
+def test_case_hardness_gives_the_yield_stress(tmp_path):
+    """[projectile] hardness = '38 HRC', dynamic_factor = 1.2 -> yield_stress = 1.2 x 979.172 MPa;
+    without dynamic_factor the stated default (1.5) applies."""
+    from semianalytic.case import load_case
+    from semianalytic.penetration.hardness import DEFAULT_DYNAMIC_FACTOR
+
+    case = load_case(_copy(tmp_path, VAR, lambda t: t.replace("dynamic_factor = 1.5", "dynamic_factor = 1.2")))
+    assert case.projectile.yield_stress == pytest.approx(1.2 * 979.172e6, rel=1e-9)
+    case = load_case(_copy(tmp_path, VAR, lambda t: t.replace("dynamic_factor = 1.5", "# no dynamic factor")))
+    assert DEFAULT_DYNAMIC_FACTOR == 1.5 and case.projectile.yield_stress == pytest.approx(1.5 * 979.172e6, rel=1e-9)
+
+
+@pytest.mark.parametrize("edit, field", [
+    (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "38 HRC"\nyield_stress = "1.6 GPa"'), "projectile.hardness"),
+    (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "75 HRC"'), "projectile.hardness"),
+    (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "12 HRC"'), "projectile.hardness"),
+    (lambda t: t.replace('hardness = "38 HRC"', 'hardness = "38 HB"'), "projectile.hardness"),
+    (lambda t: t.replace("dynamic_factor = 1.5", "dynamic_factor = 0.8"), "projectile.dynamic_factor"),
+    (lambda t: t.replace('hardness = "38 HRC"   # nominal; each shot its own (hardness_column)', 'yield_stress = "1.6 GPa"'),
+     "projectile.dynamic_factor"),
+])
+def test_bad_hardness_input_exits_2_naming_the_key(tmp_path, capsys, edit, field):
+    case = _copy(tmp_path, VAR, edit)
+    code, _, err = _run(capsys, "penetrate", case, "--coefficients", "paper")
+    assert code == 2 and err.startswith(f"error: {field}:"), err
+    assert "Traceback" not in err
+
+
+# --- criteria against the recorded transitions ----------------------------------------------
+
+
+def test_tip_criterion_places_both_onsets_between_the_recorded_shots():
+    """Tate's pressure against the tip's constrained strength (C = 3, Tabor) with ONE dynamic
+    factor: for f = 1.28 the rigid -> deforming velocity of each steel lies between its last
+    rigid and its first deformed shot in the data file (VAR 4340: 1237 / 1365 m/s; AerMet 100:
+    1786 / 1816 m/s), from the shots' mean hardness.  Part I's U_sC (eqs. (33)/(36)) with one
+    Y_p = f sigma_y cannot do this for both steels (it needs f >= 1.7 for VAR 4340, and then puts
+    AerMet 100's onset above 2.5 km/s): checked too."""
+    from semianalytic.penetration import hardness as H
+    from semianalytic.penetration import regime as rg
+
+    rows = _rows()
+    R_t = 1453.55e6  # Part I, eq. (16), Y = 400 MPa, E = 68.9 GPa, nu = 0.33 (the cases' target)
+    for mat in ("VAR4340", "AerMet100"):
+        mine = sorted((float(r["Vs_m_s"]), r["regime"]) for r in rows if r["material"] == mat)
+        last_rigid = max(v for v, g in mine if g == "rigid")
+        first_def = min(v for v, g in mine if g != "rigid")
+        hrc = np.mean([float(r["hardness_Rc"]) for r in rows if r["material"] == mat])
+        U = rg.tate_erosion_velocity(1.28 * H.yield_stress_from_hardness(hrc), R_t, 2710.0, rg.TABOR_CONSTRAINT)
+        assert last_rigid < U < first_def, (mat, U)
+    # independent closed form of the criterion: (1/2) rho U^2 + R_t = C Y at U
+    U = rg.tate_erosion_velocity(2.0e9, R_t, 2710.0, 3.0)
+    assert 0.5 * 2710.0 * U**2 + R_t == pytest.approx(6.0e9, rel=1e-12)
+    assert rg.tate_erosion_velocity(1.0e9, R_t, 2710.0) == 0.0  # Y_p < R_t: erodes at any velocity
+
+
+def test_tate_1986_resistance_by_hand():
+    """Tate (1986): R_t = Y (2/3 + ln(0.57 E / Y)); Y = 276 MPa, E = 68.9 GPa: 0.57 x 68900 / 276
+    = 142.29, ln = 4.9579, R_t = 276 x 5.6246 = 1552.4 MPa."""
+    from semianalytic.penetration.regime import tate_resistance
+
+    assert tate_resistance(276e6, 68.9e9) == pytest.approx(1552.4e6, rel=2e-4)
+
+
+# --- sampler diagnostics ---------------------------------------------------------------------
+
+
+def test_chain_diagnostics_against_iid_and_disagreeing_chains():
+    """arviz's R-hat and ESS: 4 chains of iid N(0, 1) draws have R-hat ~ 1 and an ESS near the
+    number of draws (4000; within 25 %: the ESS estimate's own scatter at this size is ~5 %); two
+    chains centred 1 apart give R-hat far above 1.01 and a warning naming the parameter."""
+    from semianalytic.calibration.sampler import chain_diagnostics
+
+    rng = np.random.default_rng(3)
+    d = chain_diagnostics(rng.standard_normal((4, 1000, 1)), ("theta",))
+    p = d["parameters"]["theta"]
+    assert p["r_hat"] < 1.01 and 3000 < p["ess_bulk"] < 5000 and not d["warnings"]
+    bad = rng.standard_normal((4, 500, 1)) + np.array([0, 0, 1, 1])[:, None, None]
+    d = chain_diagnostics(bad, ("dynamic_factor",))
+    assert d["parameters"]["dynamic_factor"]["r_hat"] > 1.1
+    assert any(w.startswith("dynamic_factor: R-hat") for w in d["warnings"])
+    short = rng.standard_normal((4, 50, 1))  # 200 draws: ESS < 400
+    assert any("effective sample size" in w for w in chain_diagnostics(short, ("sigma",))["warnings"])
+
+
+# --- transfer (fast: API on the default model set) ------------------------------------------
+
+
+@pytest.fixture(scope="module")
+def groups():
+    from semianalytic.cache import coefficients_for_case
+    from semianalytic.calibration import regimes as R
+    from semianalytic.case import load_case
+
+    out = []
+    for name in (VAR, AER):
+        case = load_case(CASES / name)
+        out.append(R.regime_shots(case, coefficients_for_case(case, "bem", None)[0]))
+    return out
+
+
+@pytest.fixture(scope="module")
+def study(groups):
+    from semianalytic.calibration import regimes as R
+
+    return R.transfer_study(groups, (R.DEFAULT_OPTIONS,), n_draws=600)
+
+
+def _recorded(mat):
+    return {r["shot"]: (RESPONSE_REGIME[r["regime"]], float(r["P_mm"]) / 1e3 if r["P_mm"] else math.nan)
+            for r in _rows() if r["material"] == mat}
+
+
+def test_transfer_between_materials_against_the_data_file(study):
+    """Leave one material out with the default model set: each steel predicted from the fit on the
+    other; the figures are recomputed here from the predicted labels and quantiles against the
+    data file's recorded responses and depths.  Measured (reports/validation_regimes.md): labels
+    right 29 of 34 (85 %: shots at the transitions, e.g. AerMet 100's last rigid shot at 1786 m/s
+    and first deformed ones at 1816-2042 m/s); eroding mean |error| 8 %, rigid 8 %.  Asserted: at
+    least 28 of 34 labels (the issue's 90 % is 31: missed, see test_issue22_targets; one label of
+    slack for the 600-draw Monte Carlo at shots whose probabilities are near 1/2), eroding and
+    rigid mean |error| <= 15 % (the issue's target, met), every eroded shot labelled eroding."""
+    shots = [s for t in study["options"][0]["transfer"] for s in t["shots"]]
+    rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
+    assert sorted(s["shot"] for s in shots) == sorted(rec)
+    right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
+    assert right >= 28
+    for reg in ("rigid", "eroding"):
+        e = [abs(s["q50_m"] / rec[s["shot"]][1] - 1) for s in shots if rec[s["shot"]][0] == reg and math.isfinite(rec[s["shot"]][1])]
+        assert np.mean(e) <= 0.15, (reg, np.mean(e))
+    assert all(s["predicted"] == "eroding" for s in shots if rec[s["shot"]][0] == "eroding")
+    for s in shots:  # probabilities sum to 1
+        assert sum(s["regime_probability"].values()) == pytest.approx(1.0, abs=1e-12)
+
+
+@pytest.mark.xfail(strict=True, reason="issue 22 targets missed by transfer: 29/34 labels (85 % < 90 %), deforming-band "
+                                       "median error 26 %, 90 % coverage 100 % (> 95 %) in the rigid and deforming "
+                                       "regimes (reports/validation_regimes.md)")
+def test_issue22_targets(study):
+    sm = study["options"][0]["summary"]
+    assert sm["label_right"] >= 0.9 * sm["labelled"]
+    for k in ("rigid", "deforming", "eroding"):
+        assert sm[k]["mean_abs_error"] <= 0.15 and 0.80 <= sm[k]["coverage_90"] <= 0.95
+
+
+# --- penetrate --posterior with a regimes posterior -----------------------------------------
+
+
+def _regimes_posterior(tmp_path, case_path, **over):
+    from semianalytic.calibration import regimes as R
+    from semianalytic.case import load_case
+
+    rng = np.random.default_rng(1)
+    n = 400
+    obj = {"format": R.REGIMES_FORMAT, "version": R.REGIMES_VERSION, "model": "regimes",
+           "options": R.DEFAULT_OPTIONS.as_dict(), "signature": R.geometry_signature(load_case(case_path)),
+           "velocity_range_m_s": [569.0, 2988.0],
+           "samples": {"dynamic_factor": (1.26 + 0.02 * rng.standard_normal(n)).tolist(),
+                       "sigma": np.full(n, 0.12).tolist(), "tau": np.full(n, 0.04).tolist()}}
+    obj.update(over)
+    p = tmp_path / "posterior.json"
+    p.write_text(json.dumps(obj))
+    return p
+
+
+def _no_data(text):
+    return text[: text.index("[data]")].replace(
+        'striking_velocities = ["0.5 km/s", "1.0 km/s", "1.5 km/s", "2.0 km/s", "2.5 km/s", "3.0 km/s"]',
+        'striking_velocities = ["1.0 km/s", "1.3 km/s", "1.6 km/s", "2.0 km/s", "2.6 km/s", "4.0 km/s"]')
+
+
+def test_penetrate_regime_probability_and_mixture(tmp_path):
+    """Through the command line: regime_probability per velocity sums to 1; at 1.0 km/s (all
+    VAR 4340 shots rigid up to 1237 m/s in the data) rigid is near certain, at 2.6 km/s (shots
+    eroded) eroding is; near the recorded onset (1.3 km/s) rigid and deforming are both possible;
+    near the transitions (1.3 km/s, 1.6 km/s: 277 mm recorded at 1493 m/s, 105 mm at 1585 m/s)
+    the interval spans both depths, far wider (relative) than at 1.0 km/s; 4 km/s is outside the calibrated
+    range: null and a warning on stderr.  The old keys stay."""
+    case = _copy(tmp_path, VAR, _no_data)
+    post = _regimes_posterior(tmp_path, case)
+    res = subprocess.run([sys.executable, "-m", "semianalytic", "penetrate", str(case), "--posterior", str(post),
+                          "--json", "--coefficients", "paper"], capture_output=True, text=True, cwd=tmp_path)
+    assert res.returncode == 0, res.stderr
+    out = json.loads(res.stdout)
+    p = out["regime_probability"]
+    for k in range(5):
+        assert p["rigid"][k] + p["deforming"][k] + p["eroding"][k] == pytest.approx(1.0, abs=1e-9)
+    assert p["rigid"][0] > 0.99 and p["eroding"][4] > 0.95
+    assert 0.05 < p["rigid"][1] < 0.95
+    q = out["depth_quantiles_m"]["regime_aware"]
+    width = [(q["0.95"][k] - q["0.05"][k]) / q["0.5"][k] for k in range(5)]
+    k = 1 if width[1] > width[2] else 2  # the transition velocity with the widest interval
+    assert width[k] > 2 * width[0]
+    # it spans the eroding rod's depth (105-142 mm recorded above the drop) and the deep rigid one
+    # (224 mm recorded at 1237 m/s)
+    assert q["0.05"][k] < 0.130 and q["0.95"][k] > 0.220
+    assert q["0.5"][5] is None and p["rigid"][5] is None and out["regime_model_holds"][5] is False
+    assert "no model holds at U_s = 4000 m/s" in res.stderr
+    for key in ("regime", "depth_m", "valid", "depth_eroding_m"):
+        assert key in out
+
+
+def test_penetrate_refuses_a_regimes_posterior_of_another_geometry(tmp_path, capsys):
+    case = _copy(tmp_path, VAR, _no_data)
+    sig_case = _copy(tmp_path / "..", VAR, lambda t: _no_data(t).replace("crh = 3.0", "crh = 2.0"))
+    post = _regimes_posterior(tmp_path, sig_case)
+    code, _, err = _run(capsys, "penetrate", case, "--posterior", post, "--coefficients", "paper")
+    assert code == 2 and err.startswith("error: --posterior:") and str(post) in err and "crh" in err
+
+
+# --- the shipped posterior: emcee against the exact grid (slow) ------------------------------
+
+
+@pytest.mark.slow
+def test_emcee_against_the_grid_posterior_and_diagnostics(groups):
+    """The 4-ensemble emcee posterior of the dynamic factor against the exact grid posterior (a
+    second method): medians within 0.03 (the grid is 0.005 apart; 2000 steps leave a Monte-Carlo
+    error of the median below 0.01)."""
+    from semianalytic.calibration import regimes as R
+
+    s = R.sample_regimes(groups[0], R.DEFAULT_OPTIONS, steps=2000, burn=700)
+    g = R.grid_posterior(groups[0], R.DEFAULT_OPTIONS)
+    assert abs(np.median(s["f"]) - g["f_quantiles"][0.5]) < 0.03
+    assert set(s["diagnostics"]["parameters"]) == {"dynamic_factor", "sigma", "tau"}
+
+
+@pytest.mark.slow
+def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
+    """calibrate --model regimes --cross-validate --transfer (the other material) --quick: the
+    transfer table printed and written, recomputed here from transfer.json's shots against the
+    data file's responses."""
+    var, aer = _copy(tmp_path, VAR), _copy(tmp_path, AER)
+    out = tmp_path / "out"
+    code, stdout, _ = _run(capsys, "calibrate", var, "--model", "regimes", "--cross-validate", "--transfer", aer,
+                           "--quick", "--steps", "300", "--out", out)
+    assert code == 0
+    tr = json.loads((out / "transfer.json").read_text())
+    rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
+    shots = [s for t in tr["options"][0]["transfer"] for s in t["shots"]]
+    right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
+    assert f"regime label right {right}/34" in stdout and right >= 28
+    assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
+    assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 68  # 2 header lines + 66 velocities
+
+
+def test_shipped_regimes_posterior_is_healthy():
+    """Issue 22, item 5: the shipped posterior (reports/calibration_piekutowski1999_regimes) of 4
+    independent ensembles has R-hat <= 1.01 and bulk and tail ESS >= 400 for every parameter, no
+    sampler warning, and its dynamic factor is inside its prior (1, 3), away from the edges."""
+    post = json.loads((ROOT / "reports" / "calibration_piekutowski1999_regimes" / "posterior.json").read_text())
+    d = post["diagnostics"]
+    assert d["ensembles"] == 4 and set(d["parameters"]) == {"dynamic_factor", "sigma", "tau"} and not d["warnings"]
+    for p in d["parameters"].values():
+        assert p["r_hat"] <= 1.01 and min(p["ess_bulk"], p["ess_tail"]) >= 400
+    f = post["summary"]["dynamic_factor"]
+    assert 1.05 < f["q05"] < f["q95"] < 2.95 and not post["at_prior_edge"]["dynamic_factor"]
