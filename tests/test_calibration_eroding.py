@@ -170,7 +170,7 @@ def test_penetrate_two_posteriors_every_regime_against_the_shots(eroding_calibra
     n_rigid = len(rigid_shots)
     assert res["regime"][n_rigid:] == ["eroding"] * len(ERODED)
     for i, reg in enumerate(res["regime"]):
-        src = q["eroding"] if reg == "eroding" else q["elastic_exact_rod"]
+        src = q["elastic_exact_rod"] if reg == "rigid" else q["eroding"]  # the default rule's depth model
         assert all(q["regime_aware"][p][i] == src[p][i] for p in ("0.05", "0.5", "0.95"))
     P = np.array([p for _, p in shots]) / 1e3
     inside = (np.array(q["regime_aware"]["0.05"]) <= P) & (P <= np.array(q["regime_aware"]["0.95"]))

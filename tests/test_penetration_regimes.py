@@ -85,7 +85,8 @@ def validations():
     for mat in ("var4340", "aermet100"):
         case = load_case(CASES / f"piekutowski1999_{mat}_regimes.toml")
         coef = coefficients_for_case(case, "bem", None)[0]
-        out[mat] = regime_validation(case, coef, velocities=np.linspace(500.0, 3000.0, 26), loo=(mat == "var4340"))
+        out[mat] = regime_validation(case, coef, velocities=np.linspace(500.0, 3000.0, 26), loo=(mat == "var4340"),
+                                     rule="nose_length")
     return out
 
 
@@ -178,7 +179,8 @@ def _case(tmp_path, nose="ogive", nose_keys="crh = 3.0", extra="", res_extra="")
 def test_cli_json_keys_and_warnings(tmp_path, capsys, nose, keys):
     """Old and new JSON keys, regimes in velocity order, depth_m from the model that holds, valid
     per model, one warning per model outside its validity naming it and the reason."""
-    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper")
+    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper",
+                          "--regime-rule", "nose_length")
     assert code == 0, err
     res = json.loads(out)
     from semianalytic.penetration.cli import JSON_KEYS
@@ -247,7 +249,7 @@ def test_cli_regimes_case_json(capsys):
     """penetrate --json on the bundled regimes case: the rigid-model statistics use only the shots
     recorded rigid (7 VAR 4340 shots); the confusion table's recorded side matches the data file's
     responses and its rigid row the printed U_sC."""
-    code, out, err = _run(capsys, CASES / "piekutowski1999_var4340_regimes.toml", "--json")
+    code, out, err = _run(capsys, CASES / "piekutowski1999_var4340_regimes.toml", "--json", "--regime-rule", "nose_length")
     assert code == 0, err
     res = json.loads(out)
     assert res["validation"]["statistics"]["rigid"]["n"] == 7
@@ -282,3 +284,32 @@ def test_cli_regimes_report(tmp_path, capsys):
     for part in ("Regime confusion table", "Per recorded regime", "leave-one-out", "validation_regimes_depth_velocity_VAR4340.png"):
         assert part in text
     assert (tmp_path / "validation_regimes_depth_velocity_VAR4340.png").stat().st_size > 10000
+
+
+@pytest.mark.parametrize("nose, keys", [("ogive", "crh = 3.0"), ("sphere", "")])
+def test_default_regime_rule_is_tate_tabor(tmp_path, capsys, nose, keys):
+    """The default labels (chosen by transfer, reports/validation_regimes.md): rigid below
+    U_y = sqrt(2 (3 Y_p - R_t) / rho_t) (Tate 1967's tip pressure against Tabor's constrained yield
+    stress), eroding from U_e with the ultimate strength of Pavlina & Van Tyne (2008) in place of
+    Y_p, the Alekseevskii-Tate depth beyond U_y.  U_y and U_e are recomputed here by hand from the
+    printed R_t, Y_p and the case's density (independent of the code's path)."""
+    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper")
+    assert code == 0, err
+    res = json.loads(out)
+    rho_t = 2710.0
+    Y, R = res["yield_stress_Pa"], res["resistance_Pa"]
+    U_y = math.sqrt(2.0 * (3.0 * Y - R) / rho_t)
+    assert res["regime_rule"] == "tate_tabor"
+    assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
+    # sigma_u from the same Vickers hardness: HV = (Y/1.5 [MPa] + 90.7)/2.876, sigma_u = 1.5 (3.734 HV - 99.8)
+    HV = (Y / 1.5e6 + 90.7) / 2.876
+    U_e = math.sqrt(2.0 * (3.0 * 1.5e6 * (3.734 * HV - 99.8) - R) / rho_t)
+    assert res["erosion_velocity_m_s"] == pytest.approx(U_e, rel=1e-12)
+    U = res["striking_velocity_m_s"]
+    assert [r == "rigid" for r in res["regime"]] == [u < U_y for u in U]
+    assert [r == "eroding" for r in res["regime"]] == [u >= U_e for u in U]
+    for i, r in enumerate(res["regime"]):
+        expect = res["depth_elastic_exact_rod_m"][i] if r == "rigid" else res["depth_eroding_m"][i]
+        assert res["depth_m"][i] == expect
+    assert all(res["valid"]["regime_aware"])
+    assert "Tate 1967" in err

@@ -472,23 +472,20 @@ def check_eroding(case, coefficients, record: dict, keys) -> None:
 
 def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | None) -> tuple[dict, dict, list[str]]:
     """The regime-aware predictive quantiles at ``U``: per velocity the quantiles of the model
-    that holds in the case's predicted regime (penetration.regime_setup, the same labels as
-    ``penetrate``'s ``regime``): a rigid-projectile model below the erosion onset U_e (in the
-    deforming band as the upper bound, as ``depth_m``), the eroding rod from U_e.  Returns
+    that holds in the case's predicted regime (penetration.regime_setup.regime_labels, the same
+    labels as ``penetrate``'s ``regime``): a rigid-projectile model while the projectile is rigid,
+    the eroding rod beyond the onset (default rule ``tate_tabor``, as ``depth_m``).  Returns
     ({quantile: list}, {"regime": [...], "rigid_model": name, "eroding_model": name}, warnings)."""
-    from semianalytic.penetration import regime as rg
     from semianalytic.penetration.curve import PenetrationSetup
-    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, PART1_MODELS, eroding_inputs
+    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, DEFAULT_REGIME_RULE, PART1_MODELS, regime_labels
 
     setup = PenetrationSetup.from_case(case, coefficients, require_material=False)
     warnings = []
     if setup.rod is None or setup.yield_stress is None:
         return {}, {}, ["warning: posterior: no regime-aware intervals: the regimes need the projectile's youngs_modulus and "
                         "yield_stress (U_sC of Part I, eqs. (33)/(36))"]
-    ei = eroding_inputs(case, setup)
-    U_y = setup.critical_velocity()
-    U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
-    regimes = rg.classify_regimes(U, U_y, U_e)
+    regimes, _, _, _ = regime_labels(case, setup, U)  # the labels of penetrate's regime (default rule)
+    eroding_band = [r != "rigid" for r in regimes] if DEFAULT_REGIME_RULE == "tate_tabor" else [r == "eroding" for r in regimes]
     order = [part1_model or DEFAULT_PART1_MODEL, *PART1_MODELS, *MODELS]
     rigid = next((m for m in order if m in quantiles and m != ERODING), None)
     ero = ERODING if ERODING in quantiles else None
@@ -498,9 +495,8 @@ def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | Non
         key = f"{p:g}"
         r_q = quantiles[rigid][key] if rigid else nan
         e_q = quantiles[ero][key] if ero else nan
-        out[key] = [e if reg == "eroding" else r for reg, r, e in zip(regimes, r_q, e_q)]
-    for label, model, mask in (("rigid or deforming", rigid, [r != "eroding" for r in regimes]),
-                               ("eroding", ero, [r == "eroding" for r in regimes])):
+        out[key] = [e if band else r for band, r, e in zip(eroding_band, r_q, e_q)]
+    for label, model, mask in (("rigid", rigid, [not b for b in eroding_band]), ("eroding", ero, eroding_band)):
         if model is None and any(mask):
             at = ", ".join(f"{u:.0f}" for u, k in zip(U, mask) if k)
             how = "calibrate --model eroding" if label == "eroding" else "calibrate on the rigid shots"

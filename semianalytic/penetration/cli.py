@@ -70,6 +70,10 @@ def add_arguments(parser) -> None:
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
                              "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding); a "
                              "posterior of calibrate --model regimes adds regime_probability and the regime mixture")
+    parser.add_argument("--regime-rule", choices=("tate_tabor", "nose_length"), default="tate_tabor",
+                        help="regime labels without a posterior: tate_tabor (default, chosen by transfer: Tate's tip "
+                             "pressure against 3 x the rod's dynamic yield and ultimate strengths) or nose_length (the "
+                             "earlier rule: U_sC of eqs. (33)/(36), then the shank eroded to the nose length)")
     parser.add_argument("--csv", metavar="FILE", default=None,
                         help="also write FILE (CSV): one row per case, striking velocity and model (units in the header)")
 
@@ -111,10 +115,16 @@ def _print_text(result: dict, desc: str, file=None) -> None:
         f"  U_sC = {_fmt(Uc, 1, 0)} m/s (eqs. (33)/(36); Y_p = {result['yield_stress_Pa'] / 1e6:.0f} MPa, "
         f"buckling factor {result['buckling_factor']:.3f}); W1: {result['w1']}"
     )
-    p(f"  regimes: rigid below U_sC = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, eroding from U_e = "
-      f"{_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s (Alekseevskii-Tate, Y_p = "
-      f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa), "
-      f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
+    if result.get("regime_rule") == "nose_length":
+        p(f"  regimes (--regime-rule nose_length): rigid below U_sC = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, "
+          f"eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s (Alekseevskii-Tate, Y_p = "
+          f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa), "
+          f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
+    else:
+        p(f"  regimes (Tate 1967 tip pressure against 3 x the rod's strength, Tabor 1951): rigid below U_y = "
+          f"{_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s, "
+          f"deforming between; depth = {result['part1_model']} below U_y, Alekseevskii-Tate rod above (Y_p = "
+          f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")
     head = (
         f"  {'U_s':>7} | {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} | {'elastic exact rod':>17} |"
         f" {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8} | {'regime':>9} | {'depth':>7} | yields"
@@ -211,7 +221,8 @@ def run(args) -> int:
 
             quantiles = predict_with_posterior(case, coefficients, args.posterior, part1_model=args.part1_model)
         notes = quantiles.pop("warnings", [])
-        results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model), **quantiles))
+        results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model,
+                                                 regime_rule=args.regime_rule), **quantiles))
         results[-1]["warnings"] = [*results[-1]["warnings"], *notes]
         descs.append(desc)
         _warn_separation(results[-1])

@@ -31,7 +31,8 @@ def contact_summary(setup, U, profile=None) -> dict:
             "separation_onset_m": separation_onset(coef, setup.mass, setup.target_density, setup.resistance_pa, prof, U)}
 
 
-def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, part1_model: str | None = None) -> dict:
+def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, part1_model: str | None = None,
+                  regime_rule: str | None = None) -> dict:
     """All results of one case as a JSON-able dict (SI units in the keys).  The regime-aware
     keys (regime, depth_m, depth_eroding_m, transition_velocity_m_s, valid, warnings) come from
     :func:`.regime_setup.regime_prediction` with the Part I model ``part1_model``."""
@@ -94,9 +95,11 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
     pe = peer_depths(case, setup, U)
     out["depth_forrestal_m"] = pe["forrestal"].tolist()
     out["depth_chen_li_m"] = pe["chen_li"].tolist()
-    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, regime_prediction
+    from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, DEFAULT_REGIME_RULE, regime_prediction
 
-    out.update(regime_prediction(case, setup, U, res, pe, part1_model=part1_model or DEFAULT_PART1_MODEL))
+    rule = regime_rule or DEFAULT_REGIME_RULE
+
+    out.update(regime_prediction(case, setup, U, res, pe, part1_model=part1_model or DEFAULT_PART1_MODEL, rule=rule))
     if not np.all(res["converged"]):  # never silent: the CLI prints every warning line on stderr
         bad = [f"{u:g}" for u, ok in zip(U, res["converged"]) if not ok]
         out["warnings"] = [*out.get("warnings", []), f"eq. (11): an iterative solve did not converge at "
@@ -107,6 +110,6 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
         if data.response_column:  # every shot: recorded against predicted regime (issue 12, item 4)
             from semianalytic.penetration.regime_setup import regime_validation
 
-            rv = regime_validation(case, coefficients, part1_model=part1_model or DEFAULT_PART1_MODEL, velocities=U, loo=False, w1=w1)
+            rv = regime_validation(case, coefficients, part1_model=part1_model or DEFAULT_PART1_MODEL, velocities=U, loo=False, w1=w1, rule=rule)
             out["validation"]["regimes"] = {k: rv[k] for k in ("rows", "confusion", "recorded", "yield_check", "erosion_check", "errors")}
     return out

@@ -118,8 +118,68 @@ def _velocities(U, mask) -> str:
     return ", ".join(f"{u:.0f}" for u in np.asarray(U)[mask])
 
 
+REGIME_RULES = ("tate_tabor", "nose_length")
+"""How ``penetrate`` labels the regimes without a posterior.  ``tate_tabor`` (default, chosen by
+the leave-one-material-out transfer of reports/validation_regimes.md, the ``Options()`` default of
+semianalytic/calibration/regimes.py): rigid while Tate's (1967) tip pressure (1/2) rho_t U^2 + R_t
+stays below the constrained dynamic yield stress C Y_p (C = 3, Tabor 1951), eroding once it reaches
+C f sigma_u (the dynamic ultimate strength), the Alekseevskii-Tate rod (Y_p = f sigma_u, R_t of
+Part I) giving the depth beyond the onset; the combination of Tate's criterion with Tabor's factor
+is this project's reading of the two published relations.  ``nose_length``: the earlier rule (U_sC
+of Part I, eqs. (33)/(36), then the shank eroded down to the nose length; this project's own),
+kept as a named option; it lost on transfer."""
+DEFAULT_REGIME_RULE = "tate_tabor"
+
+
+def rod_strengths(case, setup) -> tuple[float, float, float]:
+    """(dynamic yield stress, dynamic ultimate strength [Pa], dynamic factor f) of the projectile.
+
+    With ``[projectile] hardness`` the yield stress is already f sigma_y(HV) (case layer) and the
+    ultimate strength is f sigma_u(HV) (ASTM E140, Pavlina & Van Tyne 2008, eqs. (4)-(5)).  With a
+    ``yield_stress`` only, it is read as f sigma_y of a steel (f = ``dynamic_factor`` default) and
+    sigma_u follows through the Vickers hardness eq. (4) implies (eq. (4) inverted, then eq. (5))."""
+    from semianalytic.penetration.hardness import (DEFAULT_DYNAMIC_FACTOR, parse_hardness,
+                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c)
+
+    psec = case.projectile
+    f = float(getattr(psec, "dynamic_factor", None) or DEFAULT_DYNAMIC_FACTOR)
+    Y = setup.yield_stress
+    if Y is None:
+        raise InputError("projectile.yield_stress", "missing: the regimes need the projectile's strength "
+                                                    "(yield_stress, e.g. '1.5 GPa', or hardness, e.g. '38 HRC')")
+    if getattr(psec, "hardness", None) is not None:
+        HV = float(vickers_from_rockwell_c(parse_hardness(psec.hardness)))
+    else:
+        HV = (Y / f / 1e6 + 90.7) / 2.876  # Pavlina & Van Tyne (2008), eq. (4) inverted
+    return float(Y), float(f * ultimate_strength_from_vickers(HV)), f
+
+
+def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
+    """(regimes per velocity, U_y, U_e [m/s], the eroding rod's inputs) by the rule ``rule``
+    (:data:`REGIME_RULES`); the one place both ``penetrate`` and ``penetrate --posterior`` label."""
+    if rule not in REGIME_RULES:
+        raise InputError("--regime-rule", f"must be one of {', '.join(REGIME_RULES)}; got {rule!r}")
+    U = np.atleast_1d(np.asarray(U, float))
+    ei = eroding_inputs(case, setup)
+    if rule == "tate_tabor":
+        Y_dyn, Yu_dyn, f = rod_strengths(case, setup)
+        R1 = setup.resistance_pa  # the onset criteria are about the rigid nose: Part I's R_t
+        rho_t = ei.target_density
+        U_y = float(rg.tate_erosion_velocity(Y_dyn, R1, rho_t, rg.TABOR_CONSTRAINT))
+        U_e = max(U_y, float(rg.tate_erosion_velocity(Yu_dyn, R1, rho_t, rg.TABOR_CONSTRAINT)))
+        if case.projectile.dynamic_yield_stress is None:  # the eroding rod flows at its ultimate strength
+            ei = ErodingInputs(**{**ei.__dict__, "rod_strength": Yu_dyn,
+                                  "defaults": tuple(d for d in ei.defaults if "dynamic_yield_stress" not in d)
+                                  + (f"projectile.dynamic_yield_stress not given: the eroding rod uses Y_p = f sigma_u "
+                                     f"= {Yu_dyn / 1e6:.0f} MPa (f = {f:g}, Pavlina & Van Tyne 2008)",)})
+    else:
+        U_y = float(setup.critical_velocity())
+        U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
+    return rg.classify_regimes(U, U_y, U_e), U_y, U_e, ei
+
+
 def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
-                      part1_model: str = DEFAULT_PART1_MODEL) -> dict:
+                      part1_model: str = DEFAULT_PART1_MODEL, rule: str = DEFAULT_REGIME_RULE) -> dict:
     """Regime-aware results at the striking velocities ``U`` (``curve`` from penetration_curve,
     ``peers`` the Forrestal / Chen-Li depths): JSON-able dict with ``regime``, ``depth_m``,
     ``depth_eroding_m``, ``transition_velocity_m_s`` (U_y = U_sC, rigid -> deforming),
@@ -128,22 +188,26 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     if part1_model not in PART1_MODELS:
         raise InputError("--part1-model", f"must be one of {', '.join(PART1_MODELS)}; got {part1_model!r}")
     U = np.atleast_1d(np.asarray(U, float))
-    ei = eroding_inputs(case, setup)
-    U_y = float(curve["critical_velocity_m_s"][0])
-    U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
-    er = rg.eroding_depth(U, **ei.kwargs(mass=setup.mass))
-    regimes = rg.classify_regimes(U, U_y, U_e)
     part1 = np.asarray(curve[f"depth_{part1_model}_m"], float)
-    depth = rg.regime_depth(regimes, part1, er.depth)
+    regimes, U_y, U_e, ei = regime_labels(case, setup, U, rule)
+    er = rg.eroding_depth(U, **ei.kwargs(mass=setup.mass))
     reg = np.asarray(regimes)
+    if rule == "tate_tabor":
+        depth = np.where(reg == "rigid", part1, er.depth)  # the deforming band: the eroding rod (chosen by transfer)
+    else:
+        depth = rg.regime_depth(regimes, part1, er.depth)
     rigid_ok = reg == "rigid"
     valid = {k: rigid_ok.tolist() for k in PART1_MODELS}
     if peers is not None:
         valid.update({k: rigid_ok.tolist() for k in ("forrestal", "chen_li")})
-    valid["eroding"] = (reg == "eroding").tolist()
-    valid["regime_aware"] = (reg != "deforming").tolist()  # depth_m: no model holds in the deforming band
+    if rule == "tate_tabor":
+        valid["eroding"] = (reg != "rigid").tolist()
+        valid["regime_aware"] = [True] * len(reg)
+    else:
+        valid["eroding"] = (reg == "eroding").tolist()
+        valid["regime_aware"] = (reg != "deforming").tolist()  # depth_m: no model holds in the deforming band
     warnings = []
-    if U_y == math.inf and setup.rod is not None:  # eq. (33) without a real root (critical.no_real_root_reason)
+    if rule == "nose_length" and U_y == math.inf and setup.rod is not None:  # eq. (33) without a real root
         from semianalytic.penetration.critical import no_real_root_reason
 
         reason = no_real_root_reason(setup.critical_inputs())
@@ -151,16 +215,20 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
             warnings.append(f"U_sC: {reason}; every striking velocity is labelled rigid, which only reflects this "
                             "reading, not the projectile")
     if np.any(~rigid_ok):
-        why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))")
+        why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))" if rule == "nose_length" else
+               f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches 3 Y_p (Tate 1967, Tabor 1951): "
+               "the nose yields")
         for k in valid:
             if k not in ("eroding", "regime_aware"):
                 warnings.append(f"{_LABEL[k]}: depth outside the model's validity at U_s = {_velocities(U, ~rigid_ok)} m/s; {why}")
-    if np.any(reg != "eroding"):
-        why = (f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
-               "rigid or deforming, not eroding" if math.isfinite(U_e) else "no erosion predicted")
+    bad_eroding = (reg == "rigid") if rule == "tate_tabor" else (reg != "eroding")
+    if np.any(bad_eroding):
+        why = ((f"U_s < U_y = {U_y:.0f} m/s: the projectile stays rigid" if rule == "tate_tabor" else
+                f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
+                "rigid or deforming, not eroding") if math.isfinite(U_e) else "no erosion predicted")
         warnings.append(f"{_LABEL['eroding']}: depth outside the model's validity at U_s = "
-                        f"{_velocities(U, reg != 'eroding')} m/s; {why}")
-    if np.any(reg == "deforming"):
+                        f"{_velocities(U, bad_eroding)} m/s; {why}")
+    if rule == "nose_length" and np.any(reg == "deforming"):
         warnings.append(f"regime-aware depth_m at U_s = {_velocities(U, reg == 'deforming')} m/s (deforming band "
                         f"{U_y:.0f} <= U_s < {U_e:.0f} m/s): no model holds; the {_LABEL[part1_model]} depth is given "
                         "as the upper bound, depth_eroding_m is the lower bound")
@@ -173,6 +241,7 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         "transition_velocity_m_s": U_y,
         "erosion_velocity_m_s": U_e,
         "part1_model": part1_model,
+        "regime_rule": rule,
         "eroding_inputs": {"rod_strength_Pa": ei.rod_strength, "target_resistance_Pa": ei.target_resistance,
                            "rod_length_m": rg.eroding_rod_length(ei.length, ei.nose_length, ei.diameter, ei.density, setup.mass)},
         "valid": valid,
@@ -180,7 +249,8 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     }
 
 
-def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PART1_MODEL, w1: str = "neglect") -> list[dict]:
+def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PART1_MODEL, w1: str = "neglect",
+                    rule: str = DEFAULT_REGIME_RULE) -> list[dict]:
     """Per shot (each with its own mass): recorded response and regime, predicted regime, the
     regime-aware, Part I and eroding depths and the measured depth (NaN where the data give only
     a channel length)."""
@@ -193,7 +263,7 @@ def predict_regimes(case, coefficients, shots, *, part1_model: str = DEFAULT_PAR
     for shot in shots:
         setup = base if shot.mass is None else PenetrationSetup.from_case(case, coefficients, mass=shot.mass)
         curve = penetration_curve(setup, [shot.velocity], w1=w1)
-        pred = regime_prediction(case, setup, [shot.velocity], curve, part1_model=part1_model)
+        pred = regime_prediction(case, setup, [shot.velocity], curve, part1_model=part1_model, rule=rule)
         response = shot.row.get(col, "") if col else ""
         if col and response not in RESPONSE_REGIME:
             raise InputError("data.response_column", f"shot {shot.id}: response {response!r} is not one of "
@@ -291,7 +361,7 @@ def transition_check(predicted: float, below: float, above: float, tolerance: fl
 
 
 def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MODEL, velocities=None,
-                      loo: bool = True, w1: str = "neglect") -> dict:
+                      loo: bool = True, w1: str = "neglect", rule: str = DEFAULT_REGIME_RULE) -> dict:
     """Everything the regimes report shows for one case with a ``[data]`` file and a
     ``response_column``: the shots (all responses) against the predicted regimes, the confusion
     counts, the recorded and predicted transitions, per recorded regime the errors of the
@@ -301,12 +371,12 @@ def regime_validation(case, coefficients, *, part1_model: str = DEFAULT_PART1_MO
     from semianalytic.penetration.validation import load_shots
 
     shots = load_shots(case, require_depth=False)
-    rows = predict_regimes(case, coefficients, shots, part1_model=part1_model, w1=w1)
+    rows = predict_regimes(case, coefficients, shots, part1_model=part1_model, w1=w1, rule=rule)
     masses = [r["mass_kg"] for r in rows]
     setup = PenetrationSetup.from_case(case, coefficients, mass=float(np.mean(masses)) if masses else None)
     U = np.linspace(300.0, 3200.0, 146) if velocities is None else np.asarray(velocities, float)
     curve = penetration_curve(setup, U, w1=w1)
-    pred = regime_prediction(case, setup, U, curve, part1_model=part1_model)
+    pred = regime_prediction(case, setup, U, curve, part1_model=part1_model, rule=rule)
     rec = recorded_transitions(rows)
     errors = {}
     for reg in rg.REGIMES:
