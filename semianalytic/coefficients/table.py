@@ -219,9 +219,10 @@ def graded_breakpoints(nose: Nose, kinks) -> set:
     return {b for b in kinks if any(abs(b - c) <= tol for c in at)}
 
 
-def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) -> DepthCoefficients:
+def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None, cache=None) -> DepthCoefficients:
     """One direct BEM solve at depth P (Part I, eqs. (12)-(14)); beside a breakpoint the
-    difference in P is of fourth order with a step of a hundredth of the distance to it."""
+    difference in P is of fourth order with a step of a hundredth of the distance to it.
+    ``cache``: an :class:`~semianalytic.bem.solve.AssemblyCache` shared by the depths of a table."""
     from semianalytic.coefficients.depth import coefficients_at_depth  # the BEM: not on a cached table's path
 
     kinks = breakpoints(nose) if kinks is None else kinks
@@ -230,8 +231,8 @@ def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) ->
     if dist < NEAR_BREAK * scale:
         if dist == 0.0:
             raise ValueError("a breakpoint itself has no layout; use direct_coefficients")
-        return coefficients_at_depth(nose, depth, options, fd_order=4, step=1e-2 * dist / 3.0)
-    return coefficients_at_depth(nose, depth, options)
+        return coefficients_at_depth(nose, depth, options, fd_order=4, step=1e-2 * dist / 3.0, cache=cache)
+    return coefficients_at_depth(nose, depth, options, cache=cache)
 
 
 def _row(d: DepthCoefficients) -> dict:
@@ -629,13 +630,16 @@ class _Builder:
         self.noise_limited = 0
         self.limit_err: dict = {}
         self.solved: dict = {}  # depth -> (row, nodes, unknowns)
+        from semianalytic.bem.solve import AssemblyCache  # the BEM: imported when a table is built
+
+        self.cache = AssemblyCache()  # blocks of the panels that stay in place from depth to depth
 
     # one solve
     def solve(self, P: float):
         if P in self.solved:  # a knot shared by two pieces
             row, nodes, n = self.solved[P]
             return dict(row), nodes, n
-        r = solve_depth(self.nose, P, self.opts, self.kinks)
+        r = solve_depth(self.nose, P, self.opts, self.kinks, self.cache)
         self.solves += 1
         if self.progress is not None:
             self.progress.update(1)
