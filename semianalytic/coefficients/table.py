@@ -50,7 +50,7 @@ from semianalytic.coefficients import READINGS
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose, SplineCurve
 
-TABLE_VERSION = 8  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners) bump when the numerics change, to invalidate caches
+TABLE_VERSION = 9  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners; 9: flat tips to 1e-6 R, near-hemispheres in sqrt(P), bounded shallow layouts) bump when the numerics change, to invalidate caches
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
 # the default depth range (nose lengths, Nose.depth_unit); when the tolerance needs deeper solves
