@@ -246,8 +246,11 @@ def _revision(python: str) -> str:
     """Short git revision (with ``+dirty``) of the checkout an interpreter imports ``semianalytic`` from."""
     import subprocess
 
-    where = subprocess.run([python, "-c", "import os, semianalytic; print(os.path.dirname(os.path.dirname(semianalytic.__file__)))"],
-                           capture_output=True, text=True, timeout=120).stdout.strip()
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as neutral:  # not the working folder: each imports its own package
+        where = subprocess.run([python, "-c", "import os, semianalytic; print(os.path.dirname(os.path.dirname(semianalytic.__file__)))"],
+                               capture_output=True, text=True, timeout=120, cwd=neutral).stdout.strip()
     rev = subprocess.run(["git", "-C", where, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
     dirty = subprocess.run(["git", "-C", where, "status", "--porcelain", "--untracked-files=no"], capture_output=True,
                            text=True).stdout.strip()
@@ -264,10 +267,14 @@ def interleaved_ratio(baseline_python: str, repeats: int = 5) -> dict:
 
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
     best = {"this": [math.inf, math.inf, 0], "baseline": [math.inf, math.inf, 0]}
+    import tempfile
+
     load0 = os.getloadavg()
     for _ in range(repeats):
         for name, py in (("baseline", baseline_python), ("this", sys.executable)):
-            out = subprocess.run([py, "-c", _TIMING_SNIPPET], capture_output=True, text=True, env=env, timeout=900)
+            with tempfile.TemporaryDirectory() as neutral:  # `python -c` imports from its working folder first
+                out = subprocess.run([py, "-c", _TIMING_SNIPPET], capture_output=True, text=True, env=env, timeout=900,
+                                     cwd=neutral)
             if out.returncode:
                 raise InputError("--baseline-python", f"the baseline run failed: {out.stderr.strip().splitlines()[-1:]}")
             wall, cpu, knots = out.stdout.split()
