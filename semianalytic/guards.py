@@ -119,14 +119,24 @@ def _arithmetic_unknowns(nose, order: int, refinement: float, max_depth_nose_len
 
 def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_depth_nose_lengths: float = 300.0,
                            levels: int = 12) -> float:
-    """Primary unknowns N of the deepest half-space layout of ``nose`` (order x panels)."""
+    """Primary unknowns N of the largest half-space layout of ``nose`` (order x panels): the
+    deepest one, and the layouts at the shallowest depth a table solves (a flat tip's first
+    knots reach 1e-6 R; a cut segment is counted on its wetted length) and on either side of
+    the shoulder, where the layout changes topology; the largest of them."""
     from semianalytic.bem.panels import LayoutOptions, halfspace_layout
 
     estimate = _estimated_nose_panels(nose, refinement, levels)
     if estimate > EXACT_PLAN_PANELS:
         return _arithmetic_unknowns(nose, order, refinement, max_depth_nose_lengths, levels)
-    layout = halfspace_layout(nose, max_depth_nose_lengths * nose.depth_unit, LayoutOptions(order, refinement, levels))
-    return float(order * sum(len(p.panels) for p in layout.pieces))
+    opts = LayoutOptions(order, refinement, levels)
+    probes = [max_depth_nose_lengths * nose.depth_unit, 1e-6 * nose.radius]
+    if nose.length > 0:
+        probes += [1e-6 * nose.length, 0.5 * nose.length, nose.length * (1 - 1e-6), nose.length * (1 + 1e-6)]
+    best = 0
+    for P in probes:
+        layout = halfspace_layout(nose, P, opts)
+        best = max(best, sum(len(p.panels) for p in layout.pieces))
+    return float(order * best)
 
 
 def bem_body_unknowns(meridian, order: int = 8, refinement: float = 1.0, levels: int = 12) -> float:

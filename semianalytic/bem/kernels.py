@@ -60,12 +60,42 @@ def _polevl(x, coef):
     return out
 
 
+def _powers(q, n: int = 11) -> np.ndarray:
+    """Rows q^0 .. q^(n-1) (shape (n,) + q.shape): every polynomial of the kernels in q is then
+    one matrix product (all coefficients positive and q in [0, 1]: the power sum is as accurate
+    as Horner's scheme, and one BLAS call replaces two array passes per coefficient)."""
+    q = np.asarray(q, dtype=float)
+    V = np.empty((n,) + q.shape)
+    V[0] = 1.0
+    V[1] = q
+    for k in range(2, n):
+        np.multiply(V[k - 1 : k], q, out=V[k : k + 1])
+    return V
+
+
+def _poly_matrix(*polys) -> np.ndarray:
+    """Coefficient matrix (11, len(polys)) of polynomials given highest power first."""
+    M = np.zeros((11, len(polys)))
+    for j, c in enumerate(polys):
+        M[: len(c), j] = np.asarray(c)[::-1]
+    return M
+
+
+_KE_MATRIX = _poly_matrix(_PK, _QK, _PE, _QE)
+
+
+def _ke_from_powers(q, V, lnq, matrix=_KE_MATRIX):
+    """K(1 - q), E(1 - q) and the values of any further polynomials in ``matrix`` (columns 4 on)."""
+    M = np.tensordot(matrix.T, V, axes=1)
+    K = M[0] - lnq * M[1]
+    E = M[2] - lnq * q * M[3]
+    return K, E, M[4:]
+
+
 def ellip_ke(q):
     """K(1 - q) and E(1 - q) for the complementary parameter q in [0, 1]."""
     q = np.asarray(q, dtype=float)
-    lnq = np.log(q)
-    K = _polevl(q, _PK) - lnq * _polevl(q, _QK)
-    E = _polevl(q, _PE) - lnq * q * _polevl(q, _QE)
+    K, E, _ = _ke_from_powers(q, _powers(q), np.log(q))
     return K, E
 
 _TWO_OVER_PI = 2.0 / math.pi
@@ -106,13 +136,15 @@ _K_SERIES = (math.pi / 2) * _C2  # K(q) = (pi/2) sum c_n^2 q^n
 _KME_Q_SERIES = (math.pi / 2) * _C2 * np.array([2 * n / (2 * n - 1) for n in range(SPLIT_TERMS)])  # K - E
 
 
+_SPLIT_MATRIX = _poly_matrix(_PK, _QK, _PE, _QE, _K_SERIES[::-1], _KME_Q_SERIES[::-1])
+
+
 def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2."""
     dx, dr, d2, D = _geometry(x, r, x1, r1, delta)
     m1 = d2 / D
-    K, E = ellip_ke(m1)
-    Kc = _polevl(m1, _K_SERIES[::-1])  # K(1 - m), truncated
-    KcmEc = _polevl(m1, _KME_Q_SERIES[::-1])  # K(1 - m) - E(1 - m), truncated
+    # K(1 - m) and K(1 - m) - E(1 - m), truncated, from the same powers of 1 - m as K and E
+    K, E, (Kc, KcmEc) = _ke_from_powers(m1, _powers(m1), np.log(m1), _SPLIT_MATRIX)
     inv = 1.0 / (math.pi * np.sqrt(D))
     bracket_over_d2 = (r1 * (dx * nx1 + dr * nr1) + 0.5 * nr1 * d2) / d2
     S = r1 * K * inv

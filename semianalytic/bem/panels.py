@@ -614,7 +614,23 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         # segments the gain does not pay for its cost)
         ends = [turning[k - 1] if k > 0 else 0.0, turning[k] if k < len(segs) - 1 else _shoulder_turning(nose)]
         rough = isinstance(seg, Line) and any(abs(corner_power(a) - round(corner_power(a))) > 1e-9 for a in ends)
-        n = _count(arc, scale, ref, 4.8 if rough else 1.6, minimum=1 if isinstance(seg, SplineCurve) else 2)
+        # a segment wholly in the target (a flat face at a shallow depth) is counted on its own
+        # length, not on the depth: its solution varies on the depth's scale only next to the
+        # segment that the free surface cuts, where it is graded (below); counted on the depth,
+        # a flat face took (face radius)/P panels (this project's own bound)
+        # The cut segment itself is counted on the depth, but on no less than 1/30 of its wetted
+        # length (at most ~15 panels at refinement 1 beside the grading at the cut): on a
+        # shallow cap (a thin lens with its mirror image) the solution varies on the lens's
+        # size except at the cut, where it is graded; counted on P alone the panels grew like
+        # P^-1/2 (measured: a 1 mm corner radius at 1e-9 m, 3000 unknowns and growing)
+        seg_scale = max(scale, min(R, arc) / 30.0) if cut_here else max(scale, min(R, arc))
+        # a segment ending in a corner (a flat face, a meplat) has at least 2 panels per 0.3 of
+        # refinement: the clamp of 2 panels made --refinement a no-op on a flat nose, whose face
+        # is one radius long (this project's own rule; 2 at the tables' default 0.3)
+        at_corner = any(a and abs(corner_power(a) - 1.0) > 1e-9 for a in ends) or (
+            k == len(segs) - 1 and not cut_here and _shoulder_is_corner(nose))
+        minimum = 1 if isinstance(seg, SplineCurve) else (max(2, math.ceil(2.0 * ref / 0.3 - 1e-9)) if at_corner else 2)
+        n = _count(arc, seg_scale, ref, 4.8 if rough else 1.6, minimum=minimum)
         if isinstance(seg, SplineCurve):
             n = max(n, int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) + 1)
         if k == 0:

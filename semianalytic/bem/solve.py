@@ -108,13 +108,16 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     return u, du
 
 
-def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.ndarray | None = None):
+def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.ndarray | None = None,
+               exclude_block: tuple[np.ndarray, np.ndarray] | None = None):
     """(target, panel) pairs needing graded quadrature, with the panel point u* nearest to
     the target and its distance in the panel's parameter.
 
     The image of the target in the axis, (x, -r), counts as well: the ring kernels,
     continued analytically through the axis, are singular there, which matters for
-    panels touching the axis and targets close to it.
+    panels touching the axis and targets close to it.  ``exclude_block`` = (target mask,
+    panel mask): pairs of both masks are left out (their block is reused, see
+    :class:`AssemblyCache`).
     """
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
@@ -124,6 +127,10 @@ def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.n
         rows = np.arange(len(xt))
         near[rows, exclude_panel] = False
         near_img[rows, exclude_panel] = False
+    if exclude_block is not None:
+        skip = exclude_block[0][:, None] & exclude_block[1][None, :]
+        near &= ~skip
+        near_img &= ~skip
     tgt, pan = np.nonzero(near | near_img)
     if tgt.size == 0:
         return tgt, pan, np.empty(0), np.empty(0)
@@ -176,18 +183,34 @@ class PairQuadrature:
             return PairQuadrature(empty, empty, empty, empty, *(np.empty(0),) * 3, np.empty((0, order)))
         nodes = gauss_legendre(order)[0]
         order_idx = np.concatenate([sel for sel, *_ in parts])
-        counts = np.concatenate([np.full(len(sel), u.shape[1]) for sel, u, *_ in parts])
+        # a part of flat points carries its counts per pair as a sixth entry
+        counts = np.concatenate([part[5] if len(part) > 5 else np.full(len(part[0]), part[1].shape[1]) for part in parts])
         starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         pair = np.repeat(np.arange(len(order_idx)), counts)
         u, a, b = (np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3))
         lags = []
-        for sel, uu, _, _, lag in parts:
+        for part in parts:
+            uu, lag = part[1], part[4]
             if lag is None:
                 lag = lagrange_matrix(nodes, uu)
-            lags.append(np.broadcast_to(lag, (*uu.shape, order)).reshape(-1, order))
+            lags.append(lag if lag.ndim == 2 and lag.shape[0] == uu.size else
+                        np.broadcast_to(lag, (*uu.shape, order)).reshape(-1, order))
         return PairQuadrature(
             target[order_idx], panel[order_idx], pair, starts, u, a, b, np.concatenate(lags),
             None if target_u is None else target_u[order_idx],
+        )
+
+    def subset(self, keep: np.ndarray) -> "PairQuadrature":
+        """The rules of the pairs where ``keep`` (a mask over pairs) is true."""
+        if keep.all():
+            return self
+        points = keep[self.pair]
+        renumber = np.cumsum(keep) - 1
+        pair = renumber[self.pair[points]]
+        counts = np.bincount(pair, minlength=int(keep.sum()))
+        return PairQuadrature(
+            self.target[keep], self.panel[keep], pair, np.cumsum(counts) - counts, self.u[points], self.a[points],
+            self.b[points], self.lag[points], None if self.target_u is None else self.target_u[keep],
         )
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
@@ -224,36 +247,84 @@ class PairQuadrature:
         return out
 
 
+def _dyadic_sides(ustar, n_l, n_r):
+    """Points and weights of the rules split at u* with n_l (n_r) dyadic pieces left (right)
+    of it, for arrays of pairs: (pair index per point, u, w).
+
+    Side s (left of u*, length 1 + u*, or right, 1 - u*) with L = n - 1 levels has the
+    pieces [0, 2^-L], [2^-L, 2^-L+1], ..., [1/2, 1] of :func:`dyadic_rule` scaled by the
+    side's length, N_NEAR Gauss points each."""
+    npieces = n_l + n_r
+    first = np.cumsum(npieces) - npieces
+    pair = np.repeat(np.arange(len(ustar)), npieces)
+    j = np.arange(int(npieces.sum())) - first[pair]
+    is_left = j < n_l[pair]
+    k = np.where(is_left, j, j - n_l[pair])  # 0: the innermost piece of its side
+    lev = np.where(is_left, n_l[pair], n_r[pair]) - 1
+    b = np.ldexp(1.0, k - lev)
+    a = np.where(k == 0, 0.0, 0.5 * b)
+    side = np.where(is_left, -(1.0 + ustar[pair]), 1.0 - ustar[pair])  # signed length
+    g, gw = gauss_legendre(N_NEAR)
+    u = ustar[pair][:, None] + side[:, None] * (a[:, None] + (b - a)[:, None] * (0.5 * (g + 1.0)))
+    w = (np.abs(side) * 0.5 * (b - a))[:, None] * gw
+    return np.repeat(pair, N_NEAR), u.ravel(), w.ravel()
+
+
+@functools.lru_cache(maxsize=256)
+def _end_rule(order: int, end: float, n: int):
+    """The rule of a pair whose nearest panel point is an end (u* = -1 or +1, a neighbouring
+    panel): n dyadic pieces towards that end, and its Lagrange matrix."""
+    us = np.array([end])
+    n_l, n_r = (np.array([0]), np.array([n])) if end < 0 else (np.array([n]), np.array([0]))
+    _, u, w = _dyadic_sides(us, n_l, n_r)
+    lag = lagrange_matrix(gauss_legendre(order)[0], u)
+    for a in (u, w, lag):
+        a.setflags(write=False)
+    return u, w, lag
+
+
 def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     """Dyadic rules on [-1, 1] split at u* (the panel point nearest each target), with
-    pieces no longer than their distance from the target (``du`` in the panel parameter)."""
+    pieces no longer than their distance from the target (``du`` in the panel parameter).
+
+    Pairs whose u* is an end of the panel (neighbouring panels: most pairs) take a rule
+    built once per level (:func:`_end_rule`); the others are built together."""
+    target, panel = np.asarray(target), np.asarray(panel)
+    if target.size == 0:
+        return PairQuadrature.build(target, panel, order, [])
     left, right = 1.0 + ustar, 1.0 - ustar
-    # levels per side; -1: the side is empty (u* at that end of the panel)
-    lev_l = np.where(left > 0, _levels(left, du), -1)
-    lev_r = np.where(right > 0, _levels(right, du), -1)
-    base = MAX_LEVELS + 2
-    key = (lev_l + 1) * base + lev_r + 1
+    # pieces per side; 0: the side is empty (u* at that end of the panel)
+    n_l = np.where(left > 0, _levels(left, du) + 1, 0)
+    n_r = np.where(right > 0, _levels(right, du) + 1, 0)
+    at_end = (n_l == 0) | (n_r == 0)
     parts = []
-    for k in np.unique(key):
-        sel = np.nonzero(key == k)[0]
-        us = ustar[sel, None]
-        u_parts, w_parts = [], []
-        for lev, side, sign in ((int(k // base) - 1, left, -1.0), (int(k % base) - 1, right, 1.0)):
-            if lev >= 0:
-                s_, w_ = dyadic_rule(lev, N_NEAR)
-                u_parts.append(us + sign * side[sel, None] * s_)
-                w_parts.append(side[sel, None] * w_)
-        u, w = np.concatenate(u_parts, axis=1), np.concatenate(w_parts, axis=1)
-        # u* at an end (neighbouring panels): the same nodes for the whole group
-        shared = np.all(u == u[0])
-        lag = lagrange_matrix(gauss_legendre(order)[0], u[0]) if shared else None
-        parts.append((sel, u, w, np.zeros_like(w), lag))
+    key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
+    for k in np.unique(key[at_end]):
+        sel = np.nonzero(at_end & (key == k))[0]
+        u, w, lag = _end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k)))
+        uu = np.broadcast_to(u, (sel.size, u.size))
+        parts.append((sel, uu, np.broadcast_to(w, uu.shape), np.zeros(uu.shape), lag))
+    inner = np.nonzero(~at_end)[0]
+    if inner.size:
+        pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
+        counts = np.bincount(pair, minlength=inner.size)
+        pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
+        parts.append((inner, u[pts], w[pts], np.zeros(u.size), lagrange_matrix(gauss_legendre(order)[0], u[pts]), counts))
     return PairQuadrature.build(target, panel, order, parts)
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
-    """Self rules (log split, graded towards the node by ``levels``) for every primary node."""
-    N = len(levels)
+    """Self rules (log split, graded towards the node by ``levels``) for every primary node.
+
+    The rules live in the panel coordinate only: the same levels give the same rules at
+    every depth, so they are built once (cached on the levels)."""
+    levels = np.ascontiguousarray(levels, dtype=np.int64)
+    return _self_quadrature(levels.tobytes(), len(levels), order)
+
+
+@functools.lru_cache(maxsize=128)
+def _self_quadrature(key: bytes, N: int, order: int) -> PairQuadrature:
+    levels = np.frombuffer(key, dtype=np.int64).reshape(N, 2)
     q = np.arange(N) % order
     uq = gauss_legendre(order)[0][q]
     key = levels[:, 0] * (MAX_LEVELS + 1) + levels[:, 1]
@@ -294,14 +365,20 @@ class AssemblyPlan:
 
     self_rule: PairQuadrature
     near_rule: PairQuadrature
+    # primary panels whose block (their nodes against themselves) is taken from an
+    # AssemblyCache instead of being integrated: no rules for those pairs here
+    fixed: np.ndarray | None = None
 
 
-def plan_assembly(ps: PanelSet) -> AssemblyPlan:
+def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan:
     """Choose the self and near rules for the primary nodes of ``ps``.
 
     Self rules are graded towards the node where the target's image in the axis, (x, -r),
     is close to its own panel (the analytically continued kernels are singular there), so
-    that the innermost piece stays IMAGE_MARGIN times shorter than the distance to it."""
+    that the innermost piece stays IMAGE_MARGIN times shorter than the distance to it.
+
+    ``fixed`` (a mask over the primary panels, from :meth:`AssemblyCache.match`): the pairs
+    among those panels are not planned (their block is reused)."""
     p = ps.order
     X, R, _, _, _ = _flat_nodes(ps)
     N = ps.n_primary * p
@@ -310,7 +387,11 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
     uq = gauss_legendre(p)[0][np.arange(N) % p]
     levels = np.zeros((N, 2), dtype=int)
     cx, cr = ps.centers
-    close = np.nonzero(np.hypot(xt - cx[own_panel], rt + cr[own_panel]) < (IMAGE_MARGIN + 1) * ps.lengths[own_panel])[0]
+    if fixed is not None and not fixed.any():
+        fixed = None
+    free_node = np.ones(N, bool) if fixed is None else ~fixed[own_panel]
+    close = np.nonzero(free_node & (np.hypot(xt - cx[own_panel], rt + cr[own_panel])
+                                    < (IMAGE_MARGIN + 1) * ps.lengths[own_panel]))[0]
     if close.size:
         _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
@@ -323,8 +404,57 @@ def plan_assembly(ps: PanelSet) -> AssemblyPlan:
         gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
         levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
         levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
-    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel)
-    return AssemblyPlan(self_quadrature(levels, p), near_quadrature(tgt, pan, ustar, du, p))
+    block = None
+    if fixed is not None:
+        block = (~free_node, np.concatenate([fixed, np.zeros(ps.n_panels - ps.n_primary, bool)]))
+    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel, exclude_block=block)
+    self_rule = self_quadrature(levels, p)
+    if fixed is not None:
+        self_rule = self_rule.subset(free_node[self_rule.target])
+    return AssemblyPlan(self_rule, near_quadrature(tgt, pan, ustar, du, p), fixed)
+
+
+@dataclass
+class AssemblyCache:
+    """The raw single- and double-layer block of the primary nodes against the primary
+    panels of the last panel set assembled, kept to be reused (this project's own).
+
+    At depths past the shoulder only the panels next to the free surface move in the body
+    frame (the nose and the shank up to its last panels stay where they are), so their
+    block is the same at every depth: :meth:`match` finds the panels whose nodes coincide
+    with the cached ones, :func:`plan_assembly` plans only the other pairs and
+    :func:`assemble` copies the block.  Entries then agree with a fresh assembly to
+    round-off of the coordinates (1e-13 relative), and the two solves of a difference in P
+    read the same copy, so the error cancels in phi'_P."""
+
+    nodes: np.ndarray | None = None  # (n_primary, p, 3): x, r and weight of the cached panels' nodes
+    S: np.ndarray | None = None  # (N, N) raw blocks (weights applied, before folding and the diagonal rule)
+    D: np.ndarray | None = None
+
+    @staticmethod
+    def _signature(ps: PanelSet) -> np.ndarray:
+        g = ps.nodes
+        n = ps.n_primary
+        return np.stack([g.x[:n], g.r[:n], g.w[:n]], axis=-1)
+
+    def match(self, ps: PanelSet) -> np.ndarray:
+        """Mask over the primary panels of ``ps``: True where the panel of the same index in
+        the cache has the same nodes (to 1e-13 of the body's size)."""
+        out = np.zeros(ps.n_primary, bool)
+        if self.nodes is None or self.nodes.shape[1] != ps.order:
+            return out
+        new = self._signature(ps)
+        n = min(len(new), len(self.nodes))
+        scale = max(float(np.max(np.abs(new[..., :2]))), 1e-300)
+        close = np.abs(new[:n, :, :2] - self.nodes[:n, :, :2]).max(axis=(1, 2)) <= 1e-13 * scale
+        wclose = np.abs(new[:n, :, 2] - self.nodes[:n, :, 2]).max(axis=1) <= 1e-13 * np.abs(new[:n, :, 2]).max(axis=1)
+        out[:n] = close & wclose
+        return out
+
+    def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray) -> None:
+        N = ps.n_primary * ps.order
+        self.nodes = self._signature(ps)
+        self.S, self.D = S[:, :N].copy(), D[:, :N].copy()
 
 
 def _layers(X, R, x, r, nx, nr, delta=None):
@@ -337,8 +467,11 @@ def _layers_split(X, R, x, r, nx, nr, delta=None):
     return (S, QS), (D, QD)
 
 
-def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray, np.ndarray]:
+def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCache | None = None) -> tuple[np.ndarray, np.ndarray]:
     """Matrices (Smat, Dmat) of the single and double layer at the primary nodes.
+
+    With ``cache`` the block of the plan's fixed panels is copied from it, and the raw
+    primary block of ``ps`` is stored in it for the next assembly.
 
     Columns of mirror nodes are already folded onto their images, so both are
     (N, N) with N = n_primary * p, and (**) reads (I/2 - Dmat) phi = -Smat g.
@@ -348,10 +481,28 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray
     X, R, NX, NR, W = _flat_nodes(ps)
     N = ps.n_primary * p
     xt, rt = X[:N], R[:N]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        S, D = single_double(xt[:, None], rt[:, None], X[None, :], R[None, :], NX[None, :], NR[None, :])
-    S *= W[None, :]
-    D *= W[None, :]
+
+    def dense(rows, cols):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            S, D = single_double(xt[rows, None], rt[rows, None], X[None, cols], R[None, cols], NX[None, cols], NR[None, cols])
+        S *= W[None, cols]
+        D *= W[None, cols]
+        return S, D
+
+    if plan.fixed is None:
+        S, D = dense(slice(None), slice(None))
+    else:  # the block of the fixed panels from the cache, the rest computed
+        if cache is None:
+            raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
+        fix = np.repeat(plan.fixed, p)
+        fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
+        other = np.concatenate([fr, np.arange(N, X.size)])
+        S, D = np.empty((N, X.size)), np.empty((N, X.size))
+        S[:, other], D[:, other] = dense(slice(None), other)
+        if fr.size:
+            S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
+        S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
+        D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
@@ -359,6 +510,8 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None) -> tuple[np.ndarray
             cols = rule.panel[:, None] * p + np.arange(p)[None, :]
             S[rows, cols] = Sb
             D[rows, cols] = Db
+    if cache is not None:
+        cache.store(ps, S, D)
     mirror = ps.mirror_node_index()
     if mirror.size:
         S = S[:, :N] + S[:, mirror]
@@ -570,6 +723,7 @@ def solve_panels(
     volume: float | None = None,
     neumann=None,
     plan: AssemblyPlan | None = None,
+    cache: AssemblyCache | None = None,
 ) -> SurfaceSolution:
     """Assemble and solve (**).
 
@@ -577,7 +731,7 @@ def solve_panels(
     unit motion in +x, g = -n_x (Part I, eq. (7)).  ``plan`` reuses the quadrature rules
     of a panel set of the same topology.
     """
-    S, D = assemble(ps, plan)
+    S, D = assemble(ps, plan, cache)
     N = S.shape[0]
     geo = ps.nodes
     n = ps.n_primary

@@ -37,6 +37,9 @@ def add_arguments(parser) -> None:
     parser.add_argument("--force", action="store_true", help="overwrite existing reports")
     parser.add_argument("--quick", action="store_true", help="fewer repeats and depths (for a smoke test)")
     parser.add_argument("--corners", action="store_true", help="only the cornered-nose study: bem_corners.md/.png (issue 10)")
+    parser.add_argument("--baseline-python", default=None, metavar="PYTHON",
+                        help="interpreter of another checkout (e.g. main's .venv/bin/python): its certified Fig. 5 "
+                             "ogive table is timed interleaved with this one's, and the ratio reported")
 
 
 def _best_time(fn, repeats: int) -> float:
@@ -228,6 +231,79 @@ def _table_studies(quick: bool):
     return table_study, contact, certified
 
 
+_TIMING_SNIPPET = """
+import time, scipy.interpolate, scipy.linalg, scipy.special
+from semianalytic.geometry import ogive_nose
+from semianalytic.coefficients.table import coefficient_table
+nose = ogive_nose(7.11e-3, 3.0)
+t, c = time.perf_counter(), time.process_time()
+tab = coefficient_table(nose, tolerance=1e-5)
+print(time.perf_counter() - t, time.process_time() - c, len(tab.depth))
+"""
+
+
+def _revision(python: str) -> str:
+    """Short git revision (with ``+dirty``) of the checkout an interpreter imports ``semianalytic`` from."""
+    import subprocess
+
+    import tempfile
+
+    with tempfile.TemporaryDirectory() as neutral:  # not the working folder: each imports its own package
+        where = subprocess.run([python, "-c", "import os, semianalytic; print(os.path.dirname(os.path.dirname(semianalytic.__file__)))"],
+                               capture_output=True, text=True, timeout=120, cwd=neutral).stdout.strip()
+    rev = subprocess.run(["git", "-C", where, "rev-parse", "--short", "HEAD"], capture_output=True, text=True).stdout.strip()
+    dirty = subprocess.run(["git", "-C", where, "status", "--porcelain", "--untracked-files=no"], capture_output=True,
+                           text=True).stdout.strip()
+    return (rev or "unknown") + ("+dirty" if dirty else "")
+
+
+def interleaved_ratio(baseline_python: str, repeats: int = 5) -> dict:
+    """The certified Fig. 5 ogive table (tolerance 1e-5) built by this checkout and by a baseline
+    interpreter alternately, each in a fresh process with one BLAS thread: best wall and CPU times,
+    knots, and the load average before and after (the machine is shared: only the ratio compares)."""
+    import os
+    import subprocess
+    import sys
+
+    env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
+    best = {"this": [math.inf, math.inf, 0], "baseline": [math.inf, math.inf, 0]}
+    import tempfile
+
+    load0 = os.getloadavg()
+    for _ in range(repeats):
+        for name, py in (("baseline", baseline_python), ("this", sys.executable)):
+            with tempfile.TemporaryDirectory() as neutral:  # `python -c` imports from its working folder first
+                out = subprocess.run([py, "-c", _TIMING_SNIPPET], capture_output=True, text=True, env=env, timeout=900,
+                                     cwd=neutral)
+            if out.returncode:
+                raise InputError("--baseline-python", f"the baseline run failed: {out.stderr.strip().splitlines()[-1:]}")
+            wall, cpu, knots = out.stdout.split()
+            b = best[name]
+            b[0], b[1], b[2] = min(b[0], float(wall)), min(b[1], float(cpu)), int(knots)
+    return {"best": best, "load": (load0, os.getloadavg()), "repeats": repeats,
+            "revisions": {"this": _revision(sys.executable), "baseline": _revision(baseline_python)}}
+
+
+def _append_interleaved(path: Path, r: dict) -> list[Path]:
+    """A section of bench_bem.md: this checkout's certified ogive table against a baseline's."""
+    from semianalytic.io import atomic_write_text
+
+    b, t = r["best"]["baseline"], r["best"]["this"]
+    (l0, l1) = r["load"]
+    lines = ["", "## Certified Fig. 5 ogive table against the code before it (issue 24)", "",
+             f"Each side built the certified table (tolerance 1e-5) in a fresh process, one BLAS thread, alternately, "
+             f"{r['repeats']} times; best of each. Load average (1, 5, 15 min) {l0[0]:.1f}, {l0[1]:.1f}, {l0[2]:.1f} "
+             f"before and {l1[0]:.1f}, {l1[1]:.1f}, {l1[2]:.1f} after, on a 2-core machine shared with other jobs: "
+             "the absolute times are inflated by the load, the ratio is the comparable number.", "",
+             "| code | revision | knots | wall [s] | CPU [s] |", "|---|---|---|---|---|",
+             f"| before (baseline) | {r['revisions']['baseline']} | {b[2]} | {b[0]:.2f} | {b[1]:.2f} |",
+             f"| after (this) | {r['revisions']['this']} | {t[2]} | {t[0]:.2f} | {t[1]:.2f} |", "",
+             f"Ratio before/after: {b[0] / t[0]:.2f} in wall time, {b[1] / t[1]:.2f} in CPU time "
+             "(issue 24's target: at least 4, same knots)."]
+    text = path.read_text() + "\n".join(lines) + "\n"
+    return [atomic_write_text(path, text, overwrite=True)]
+
+
 def _append_certified(path: Path, certified) -> list[Path]:
     """A section of bench_bem.md: the certified tables' cost beside the legacy 60-depth table."""
     from semianalytic.io import atomic_write_text
@@ -273,6 +349,8 @@ def run(args) -> int:
 
     study, contact, certified = _table_studies(args.quick)
     written += _append_certified(out / "bench_bem.md", certified)
+    if getattr(args, "baseline_python", None):
+        written += _append_interleaved(out / "bench_bem.md", interleaved_ratio(args.baseline_python, 2 if args.quick else 5))
     written += write_coefficients_report(out, n_depths=16 if args.quick else None, table_study=study, contact=contact)
     for p in written:
         print(f"wrote {p}")

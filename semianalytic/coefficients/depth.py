@@ -22,8 +22,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semianalytic.bem.panels import HalfspaceLayout, LayoutOptions, halfspace_layout
-from semianalytic.bem.solve import SurfaceSolution, plan_assembly, solve_panels
+from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+from semianalytic.bem.solve import AssemblyCache, SurfaceSolution, plan_assembly, solve_panels
 from semianalytic.geometry import Nose
 
 # central stencils (step h): order -> offsets, weights of the first derivative, and weights
@@ -73,6 +73,7 @@ def coefficients_at_depth(
     options: LayoutOptions = LayoutOptions(),
     fd_order: int = 2,
     step: float | None = None,
+    cache: AssemblyCache | None = None,
 ) -> DepthCoefficients:
     """A, B (three readings), C, dA/dP and phi at the tip, at depth P > 0.
 
@@ -83,6 +84,10 @@ def coefficients_at_depth(
 
     The potential at P itself is interpolated from the stencil (error O(h^2), about 1e-8
     relative with the default step), so each depth costs two solves.
+
+    ``cache`` (an :class:`~semianalytic.bem.solve.AssemblyCache` kept across the depths of a
+    table): the panels that the depth change leaves in place keep their quadrature and
+    their block of the matrices; only the rest is planned and integrated again.
     """
     if depth == nose.length:
         raise ValueError("the depth P = L_h is where the layout changes topology; use a nearby depth")
@@ -90,8 +95,14 @@ def coefficients_at_depth(
     h = step if step is not None else _step(nose, depth)
     offsets, weights, interp = STENCILS[fd_order]
     panels = layout.panels()
-    plan = plan_assembly(panels)  # the same rules at every depth of the stencil
-    sols = [_solve(layout.at_depth(depth + k * h), plan) for k in offsets]
+    stencil = [layout.at_depth(depth + k * h).panels() for k in offsets]
+    fixed = None
+    if cache is not None:
+        fixed = cache.match(panels)
+        for ps in stencil:
+            fixed &= cache.match(ps)
+    plan = plan_assembly(panels, fixed)  # the same rules at every depth of the stencil
+    sols = [solve_panels(ps, "halfspace", depth=depth + k * h, plan=plan, cache=cache) for k, ps in zip(offsets, stencil)]
     center = SurfaceSolution(
         panels,
         sum(c * s.phi_nodes for c, s in zip(interp, sols)),
@@ -100,10 +111,6 @@ def coefficients_at_depth(
         depth=depth,
     )
     return _combine(center, sols, weights, h)
-
-
-def _solve(layout: HalfspaceLayout, plan) -> SurfaceSolution:
-    return solve_panels(layout.panels(), "halfspace", depth=layout.depth, plan=plan)
 
 
 def _combine(center: SurfaceSolution, sols, weights, h) -> DepthCoefficients:

@@ -18,8 +18,9 @@ segment junctions.  Each smooth piece is interpolated in its own variable:
   the free-surface image approaches like 1/P (errata item 2b), so the coefficients are
   smooth in 1/P there.  The limit is extrapolated from the deepest solves by polynomials in
   1/P, with the difference of two orders as its error estimate; the table is extended
-  (deeper solves) until that estimate is within the tolerance, or stops with an error
-  naming ``coefficients.max_depth_nose_lengths``.
+  (deeper solves) until that estimate is within the tolerance; the default range
+  (DEFAULT_MAX_DEPTH nose lengths) extends itself as far as that needs (with a warning), a range
+  the user set stops with an error naming ``coefficients.max_depth_nose_lengths``.
 
 A is interpolated by cubic Hermite splines using dA/dP (= B_bernoulli) at the knots, the
 others by not-a-knot cubic splines.  Knots are placed adaptively: every interval is tested
@@ -49,14 +50,26 @@ from semianalytic.coefficients import READINGS
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose, SplineCurve
 
-TABLE_VERSION = 8  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners) bump when the numerics change, to invalidate caches
+TABLE_VERSION = 9  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners; 9: flat tips to 1e-6 R, near-hemispheres in sqrt(P), bounded shallow layouts) bump when the numerics change, to invalidate caches
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
+# the default depth range (nose lengths, Nose.depth_unit); when the tolerance needs deeper solves
+# (the deep limit to 1e-8 needs about 1000) it extends itself up to AUTO_MAX_DEPTH and says so;
+# any other range the user sets is a hard bound (this project's own rule)
+DEFAULT_MAX_DEPTH = 300.0
+AUTO_MAX_DEPTH = 1e5
 CONTROLLED = ("A", "B_body", "B_literal", "B_bernoulli", "C")  # error-controlled coefficients
 INTERPOLATED = CONTROLLED + ("phi_tip",)
 BREAK_OFFSET = 1e-6  # knots at b (1 -+ BREAK_OFFSET) beside a breakpoint b (relative)
 NEAR_BREAK = 1e-3  # closer than this (relative) to a breakpoint: fourth-order difference in P
 FLAT_TIP_DEPTH = 1e-2  # a flat tip's first solve, in radii (the coefficients jump at P = 0+; constant below)
+# A flat tip's coefficients start as X0 + c P^alpha (measured on the flat nose: alpha ~ 0.7-0.8 for B,
+# from 0.68 at 1e-7 R to 1.8 at 1e-2 R): below the first knot P_1 the table holds X(P_1), with the
+# estimate 2 |X(4 P_1) - X(P_1)| (a bound for any alpha >= 0.3), and P_1 is quartered (a knot at v/2)
+# until that estimate is within half the tolerance, down to FLAT_TIP_FLOOR radii (this project's own
+# rule; below about 1e-6 R the BEM's own noise in P, ~1e-5 of max |B| at 1e-7 R, exceeds what the
+# quartering would gain: measured on the flat nose)
+FLAT_TIP_FLOOR = 1e-6
 MAX_ROUNDS = 40  # bisection rounds (each halves the failing intervals)
 MAX_SOLVES = 400  # bisection stops (estimates kept) once this many depths are solved
 NOISE_RATIO = 0.7  # bisection that shrinks a discrepancy by less than this is noise-limited
@@ -126,6 +139,22 @@ def flat_tip(nose: Nose) -> bool:
     return True
 
 
+NEAR_ROUND_ANGLE = 1e-2  # rad: a curved tip this close to 90 deg is tabulated as a rounded one
+
+
+def near_round_tip(nose: Nose) -> bool:
+    """True for a curved tip whose half-angle is within NEAR_ROUND_ANGLE of 90 deg (an ogive of
+    crh 0.5 + epsilon: a hemisphere but for a cone of radius ~ (s - d/2) at the tip).
+
+    Its coefficients follow the hemisphere's powers of sqrt(P) down to P ~ (s - d/2)^2 / (2 s)
+    (7e-11 m at crh 0.5001, d = 7.11 mm) and the cone's below, which are polynomial in sqrt(P)
+    as well: interpolated in P they took ~250 knots against the hemisphere's ~50 (this
+    project's own rule)."""
+    from semianalytic.geometry import Arc
+
+    return isinstance(nose.segments[0], Arc) and 0.5 * math.pi - nose.tip_half_angle() < NEAR_ROUND_ANGLE
+
+
 @dataclass(frozen=True)
 class Piece:
     """A smooth piece of the depth axis, [P_lo, P_hi] (P_hi = inf for the deep piece), with
@@ -193,7 +222,7 @@ def depth_pieces(nose: Nose) -> tuple[list[Piece], list[float]]:
         ends.append(nose.radius)
     # from first contact: in sqrt(P) on a rounded or flat tip (A ~ P^3/2, B ~ P^1/2), in P on a
     # pointed one (A ~ P^3, B ~ P^2: polynomial in P; exactly so on a cone)
-    pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-9 and not flat_tip(nose)
+    pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-9 and not flat_tip(nose) and not near_round_tip(nose)
     pieces = [Piece("mid" if pointed else "root", 0.0, ends[1], ends[1])]
     corners = graded_breakpoints(nose, kinks)
     for a, b in zip(ends[1:-1], ends[2:]):
@@ -219,9 +248,10 @@ def graded_breakpoints(nose: Nose, kinks) -> set:
     return {b for b in kinks if any(abs(b - c) <= tol for c in at)}
 
 
-def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) -> DepthCoefficients:
+def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None, cache=None) -> DepthCoefficients:
     """One direct BEM solve at depth P (Part I, eqs. (12)-(14)); beside a breakpoint the
-    difference in P is of fourth order with a step of a hundredth of the distance to it."""
+    difference in P is of fourth order with a step of a hundredth of the distance to it.
+    ``cache``: an :class:`~semianalytic.bem.solve.AssemblyCache` shared by the depths of a table."""
     from semianalytic.coefficients.depth import coefficients_at_depth  # the BEM: not on a cached table's path
 
     kinks = breakpoints(nose) if kinks is None else kinks
@@ -230,8 +260,8 @@ def solve_depth(nose: Nose, depth: float, options: LayoutOptions, kinks=None) ->
     if dist < NEAR_BREAK * scale:
         if dist == 0.0:
             raise ValueError("a breakpoint itself has no layout; use direct_coefficients")
-        return coefficients_at_depth(nose, depth, options, fd_order=4, step=1e-2 * dist / 3.0)
-    return coefficients_at_depth(nose, depth, options)
+        return coefficients_at_depth(nose, depth, options, fd_order=4, step=1e-2 * dist / 3.0, cache=cache)
+    return coefficients_at_depth(nose, depth, options, cache=cache)
 
 
 def _row(d: DepthCoefficients) -> dict:
@@ -621,6 +651,9 @@ class _Builder:
 
     def __init__(self, nose: Nose, opts: LayoutOptions, tolerance: float, P_max: float, progress=None):
         self.nose, self.opts, self.tol, self.P_max = nose, opts, tolerance, P_max
+        # the default depth range extends itself as far as the tolerance needs (too_shallow)
+        self.extendable = abs(P_max / nose.depth_unit - DEFAULT_MAX_DEPTH) <= 1e-9 * DEFAULT_MAX_DEPTH
+        self.extended = False
         self.pieces, self.kinks = depth_pieces(nose)
         self.flat = flat_tip(nose)
         self.knots = [_PieceKnots(p) for p in self.pieces]
@@ -629,13 +662,16 @@ class _Builder:
         self.noise_limited = 0
         self.limit_err: dict = {}
         self.solved: dict = {}  # depth -> (row, nodes, unknowns)
+        from semianalytic.bem.solve import AssemblyCache  # the BEM: imported when a table is built
+
+        self.cache = AssemblyCache()  # blocks of the panels that stay in place from depth to depth
 
     # one solve
     def solve(self, P: float):
         if P in self.solved:  # a knot shared by two pieces
             row, nodes, n = self.solved[P]
             return dict(row), nodes, n
-        r = solve_depth(self.nose, P, self.opts, self.kinks)
+        r = solve_depth(self.nose, P, self.opts, self.kinks, self.cache)
         self.solves += 1
         if self.progress is not None:
             self.progress.update(1)
@@ -741,7 +777,8 @@ class _Builder:
                     tiny = (b - a) <= 1e-7 * max(abs(b), 1e-300) if pk.piece.kind != "deep" or a > 0 else False
                     up = parent.get((i, a, b))
                     # an interval at a piece end may hold a singularity (log-like at a corner): never noise
-                    inner = a > pk.v[0] and b < pk.v[-1]
+                    # (not so the first interval of a flat tip: the constant below it holds the jump)
+                    inner = (a > pk.v[0] or (i == 0 and self.flat)) and b < pk.v[-1]
                     stalled = inner and up is not None and worst > NOISE_RATIO * up[0]
                     if worst > 1.0 and not tiny and not stalled and budget:
                         nxt += [(a, m), (m, b)]
@@ -755,6 +792,7 @@ class _Builder:
                 new[i] = nxt
             self.update_limit()
             self.extend_deep(new, scale)
+            self.extend_shallow(new, scale)
             pending = new
         else:
             for i, ivs in pending.items():  # out of rounds: the parent's discrepancy, honestly
@@ -762,6 +800,35 @@ class _Builder:
                     up = parent.get((i, a, b))
                     self.knots[i].err[(a, b)] = up[1] if up else {q: math.inf for q in INTERPOLATED}
                     self.noise_limited += 1
+
+    @staticmethod
+    def shallow_estimate(pk: "_PieceKnots") -> dict:
+        """Error of the constant X(P_1) below a flat tip's first knot: 2 |X(4 P_1) - X(P_1)|
+        (the knot at v = 2 v_1 of the root piece, v = sqrt(P/l))."""
+        v0 = pk.v[0]
+        k2 = int(np.argmin(np.abs(np.array(pk.v) - 2.0 * v0)))
+        if k2 == 0 or abs(pk.v[k2] - 2.0 * v0) > 1e-9 * v0:  # no knot at 4 P_1: the change to the next, quadrupled
+            k2 = min(1, len(pk.v) - 1)
+            factor = 2.0 * max(2.0 * v0 / max(pk.v[k2] - v0, 1e-300), 1.0) if k2 else math.inf
+        else:
+            factor = 2.0
+        return {q: factor * abs(pk.rows[k2][q] - pk.rows[0][q]) for q in INTERPOLATED}
+
+    def extend_shallow(self, pending: dict, scale: dict):
+        """Shallower first knots of a flat tip (quartering P_1) until the constant below it is
+        within half the tolerance, or P_1 reaches FLAT_TIP_FLOOR radii."""
+        if not self.flat:
+            return
+        pk = self.knots[0]
+        for _ in range(40):
+            est = _Builder.shallow_estimate(pk)
+            if all(est[q] <= 0.5 * self.tol * scale[q] for q in CONTROLLED):
+                return
+            v_new = 0.5 * pk.v[0]
+            if float(pk.piece.P(v_new)) < FLAT_TIP_FLOOR * self.nose.radius:
+                return
+            self._add_solved(pk, [v_new])
+            pending[0] = pending.get(0, []) + [(v_new, pk.v[1])]
 
     def extend_deep(self, pending: dict, scale: dict):
         """Deeper solves until the extrapolated deep limit is within half the tolerance."""
@@ -782,7 +849,14 @@ class _Builder:
             self.update_limit()
 
     def too_shallow(self, what: str, P_needed: float):
+        """Extend the depth range to ``P_needed`` when it is the default one (up to
+        AUTO_MAX_DEPTH nose lengths; recorded and reported), else stop with an error naming
+        the key that bounds it."""
         unit = self.nose.depth_unit
+        if self.extendable and P_needed <= AUTO_MAX_DEPTH * unit:
+            self.P_max = max(self.P_max, P_needed * (1 + 1e-9))
+            self.extended = True
+            return
         raise InputError(
             "coefficients.max_depth_nose_lengths",
             f"{self.P_max / unit:g} nose lengths is too shallow: {what} needs solves to {P_needed / unit:.4g} nose "
@@ -835,8 +909,9 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
             if not deep and k == 0 and a > 0 and p.kind == "root":  # flat tip: constant below the first solve
                 rows.append({"P_lo": 0.0, "kind": 1, "scale": 1.0, "v0": 0.0, "origin": 0.0, "power": 1.0,
                              **{f"coef_{q}": [0.0] * 5 + [pk.rows[0][q]] for q in INTERPOLATED}})
-                for q in INTERPOLATED:  # twice the change over the next interval (X0 + c P^alpha, alpha >= 0.3)
-                    errs[q].append(2.0 * abs(pk.rows[1][q] - pk.rows[0][q]) + pk.err.get((a, b), {}).get(q, math.inf))
+                shallow = _Builder.shallow_estimate(pk)  # X0 + c P^alpha, alpha >= 0.3: see FLAT_TIP_FLOOR
+                for q in INTERPOLATED:
+                    errs[q].append(shallow[q])
             rows.append({"P_lo": P_lo, "kind": _KINDS[p.kind], "scale": p.scale, "v0": float(a),
                          "origin": p.origin, "power": p.power,
                          **{f"coef_{q}": _coef6(sp[q], float(a), pk.rows[0][q]) for q in INTERPOLATED}})
@@ -944,6 +1019,13 @@ def coefficient_table(
             b.refine()
             options["tolerance"] = tol
             options["noise_limited_intervals"] = b.noise_limited
+            if b.extended:
+                deepest = b.P_max / nose.depth_unit
+                options["max_depth_nose_lengths"] = deepest
+                import warnings
+
+                warnings.warn(f"coefficients: the depth range extended itself from {max_depth_nose_lengths:g} to "
+                              f"{deepest:.4g} nose lengths, as the tolerance {tol:g} needs (deep limit)", stacklevel=2)
         bem_err = b.bem_errors() if bem_error else {}
         return b.table(options, bem_err)
     finally:
