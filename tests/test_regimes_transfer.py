@@ -275,12 +275,26 @@ def test_penetrate_regime_probability_and_mixture(tmp_path):
         assert key in out
 
 
-def test_penetrate_refuses_a_regimes_posterior_of_another_geometry(tmp_path, capsys):
+def test_penetrate_refuses_a_regimes_posterior_of_another_target(tmp_path, capsys):
+    case = _copy(tmp_path, VAR, _no_data)
+    sig_case = _copy(tmp_path / "..", VAR, lambda t: _no_data(t).replace('yield_stress = "400 MPa"', 'yield_stress = "300 MPa"'))
+    post = _regimes_posterior(tmp_path, sig_case)
+    code, _, err = _run(capsys, "penetrate", case, "--posterior", post, "--coefficients", "paper")
+    assert code == 2 and err.startswith("error: --posterior:") and str(post) in err and "target_yield_stress" in err
+
+
+def test_penetrate_transfers_a_regimes_posterior_to_another_nose(tmp_path, capsys):
+    """The regime model's parameters belong to the rod steel and the target: a posterior fitted on
+    the 3-CRH ogive applies to another nose (the transfer the model is chosen for), with a note."""
     case = _copy(tmp_path, VAR, _no_data)
     sig_case = _copy(tmp_path / "..", VAR, lambda t: _no_data(t).replace("crh = 3.0", "crh = 2.0"))
     post = _regimes_posterior(tmp_path, sig_case)
-    code, _, err = _run(capsys, "penetrate", case, "--posterior", post, "--coefficients", "paper")
-    assert code == 2 and err.startswith("error: --posterior:") and str(post) in err and "crh" in err
+    code, out, err = _run(capsys, "penetrate", case, "--json", "--posterior", post, "--coefficients", "paper")
+    assert code == 0, err
+    assert "crh = 2.0" in err and "transfer" in err
+    probs = json.loads(out)["regime_probability"]
+    total = [sum(v) for v in zip(*(probs[k] for k in ("rigid", "deforming", "eroding"))) if None not in v]
+    assert total and all(abs(t - 1.0) < 1e-12 for t in total)
 
 
 # --- the shipped posterior: emcee against the exact grid (slow) ------------------------------

@@ -495,6 +495,11 @@ PREDICTION_DRAWS = 400
 REGIMES_VERSION = 1
 
 
+NOSE_KEYS = ("nose", "crh", "diameter_m")
+"""Signature keys a regimes posterior may differ in (transfer to another nose, with a note); any
+other difference (the target) refuses it."""
+
+
 def geometry_signature(case) -> dict:
     """What a regimes posterior is about, checked against a case: the nose and the target."""
     p, t = case.projectile, case.target
@@ -557,17 +562,27 @@ def read_regimes_posterior(path, case) -> dict:
     if obj.get("version") != REGIMES_VERSION:
         raise InputError("--posterior", f"{path}: version {obj.get('version')!r}, expected {REGIMES_VERSION}")
     mine = geometry_signature(case)
+    other_nose = []
     for k, v in sig.items():
         w = mine.get(k)
         same = (v == w) if not (isinstance(v, float) and isinstance(w, float)) else math.isclose(v, w, rel_tol=1e-9)
-        if not same:
-            raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another geometry or "
-                                            "target: refit with calibrate --model regimes)")
+        if same:
+            continue
+        if k in NOSE_KEYS:  # the parameters are the rod steel's and the target's, not the nose's
+            other_nose.append(f"{k} = {v!r} (the case: {w!r})")
+            continue
+        raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another target: "
+                                        "refit with calibrate --model regimes)")
     for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
                     ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS)):
         if getattr(opt, k) not in vals:
             raise InputError("--posterior", f"{path}: unknown model set {k} = {getattr(opt, k)!r}")
-    return {"options": opt, "draws": draws, "raw": obj}
+    notes = []
+    if other_nose:
+        notes.append(f"note: posterior {path}: fitted for {', '.join(other_nose)}; applied to this case's nose as a "
+                     "transfer: its parameters (dynamic factor of the rod steel, scatter of the transitions and depths) "
+                     "are not the nose's, while the Part I depth and the transition criteria are recomputed for this nose")
+    return {"options": opt, "draws": draws, "raw": obj, "notes": notes}
 
 
 def shots_at(case, coefficients, U) -> RegimeShots:
@@ -616,7 +631,7 @@ def predict_case(case, coefficients, path, U, probs=(0.05, 0.25, 0.5, 0.75, 0.95
     holds = (shots.velocity >= 0.9 * lo) & (shots.velocity <= 1.1 * hi)
     q = np.where(holds[None, :], pred["quantiles"], np.nan)
     prob = np.where(holds[None, :], pred["regime_probability"], np.nan)
-    warnings = []
+    warnings = list(post["notes"])
     if not holds.all():
         bad = ", ".join(f"{u:.0f}" for u in shots.velocity[~holds])
         warnings.append(f"warning: posterior {path}: no model holds at U_s = {bad} m/s: the regime model was "
