@@ -283,3 +283,14 @@ def body_added_mass(meridian: Meridian, options: MeshOptions | None = None, far_
     t1 = time.perf_counter()
     sol: PotentialSolution = solve_potential(dm, far_field)
     return AddedMass(sol.A, meridian.volume(), sol.n_dofs, int(dm.mesh.t.shape[1]), time.perf_counter() - t1, t1 - t0)
+
+
+def solved_once(memo: dict | None, nose, depth: float, options: MeshOptions):
+    """:func:`halfspace_coefficients` of (nose, depth, options), computed once per ``memo`` (one
+    command: the refinement study repeats some of the comparison's solves)."""
+    if memo is None:
+        return halfspace_coefficients(nose, depth, options)
+    key = (id(nose), depth, options)
+    if key not in memo:
+        memo[key] = (nose, halfspace_coefficients(nose, depth, options))  # the nose kept: its id stays its own
+    return memo[key][1]

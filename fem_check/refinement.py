@@ -31,7 +31,7 @@ import math
 
 import numpy as np
 
-from fem_check.coefficients import depth_scale, halfspace_coefficients
+from fem_check.coefficients import depth_scale, halfspace_coefficients, solved_once
 from fem_check.meshing import MeshOptions, halfspace_domain
 
 STUDY_KEYS = ("A", "B_body", "B_surface", "dA_dP", "B_bernoulli", "C")
@@ -80,7 +80,6 @@ def refinement_study(nose, depths_over_scale, h_list=(0.16, 0.08, 0.04, 0.02), g
     :func:`fem_check.verify.compare_depths`, so the solves both need (its h) run once."""
     from semianalytic.coefficients.table import coefficients_at
 
-    from fem_check.verify import _solved
 
     scale = depth_scale(nose)
     Ps = np.asarray(depths_over_scale, float) * scale
@@ -93,7 +92,7 @@ def refinement_study(nose, depths_over_scale, h_list=(0.16, 0.08, 0.04, 0.02), g
         rows = []
         for h in h_list:
             opts = MeshOptions(h=h) if grading is None else MeshOptions(h=h, grading=grading)
-            f = _solved(memo, nose, float(P), opts)
+            f = solved_once(memo, nose, float(P), opts)
             rows.append({"h_over_d": h, "n_dofs": f.n_dofs, "seconds": f.seconds, "A": f.A, "B_body": f.B_body,
                          "B_surface": f.G_surface + 2 * f.Q, "dA_dP": f.dA_dP, "B_bernoulli": f.B_bernoulli, "C": f.C,
                          "G_source": f.G_source})

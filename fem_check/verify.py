@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fem_check.coefficients import body_added_mass, depth_scale, halfspace_coefficients, halfspace_mesh
+from fem_check.coefficients import body_added_mass, depth_scale, halfspace_coefficients, halfspace_mesh, solved_once
 from fem_check.meshing import MeshOptions, body_domain, build_mesh
 from fem_check.potential import solve_potential
 from semianalytic.errors import InputError
@@ -129,17 +129,6 @@ def body_far_field_study(meridian, exact: float, fars=(1.5, 3.0, 6.0, 12.0), h: 
 # projectile in the half-space
 
 
-def _solved(memo: dict | None, nose, depth: float, options: MeshOptions):
-    """:func:`halfspace_coefficients` of (nose, depth, options), computed once per ``memo`` (one
-    command: the refinement study repeats some of the comparison's solves)."""
-    if memo is None:
-        return halfspace_coefficients(nose, depth, options)
-    key = (id(nose), depth, options)
-    if key not in memo:
-        memo[key] = (nose, halfspace_coefficients(nose, depth, options))  # the nose kept: its id stays its own
-    return memo[key][1]
-
-
 def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_refinement: float = 1.0,
                    grading: float | None = None, memo: dict | None = None) -> list[dict]:
     """FEM and BEM coefficients at the given depths (in nose lengths); one dict per depth (SI).
@@ -156,7 +145,7 @@ def compare_depths(nose, depths_over_Lh, h: float = 0.04, order: int = 2, bem_re
     rows = []
     for i, P in enumerate(Ps):
         opts = MeshOptions(h=h, order=order) if grading is None else MeshOptions(h=h, order=order, grading=grading)
-        f = _solved(memo, nose, float(P), opts)
+        f = solved_once(memo, nose, float(P), opts)
         row = {"depth_m": float(P), "depth_over_Lh": float(P / scale)}
         for key, fk in (("A", "A"), ("B", "B_body"), ("C", "C")):
             row[f"{key}_bem"] = float(bem[fk if key != "B" else "B_body"][i])
@@ -190,7 +179,7 @@ def convergence_study(nose, depths_over_Lh=(0.5, 2.0, 8.0), h_list=(0.16, 0.08, 
     for i, P in enumerate(Ps):
         for order in orders:
             for h in h_list:
-                f = _solved(memo, nose, float(P), MeshOptions(h=h, order=order))
+                f = solved_once(memo, nose, float(P), MeshOptions(h=h, order=order))
                 rows.append({"depth_over_Lh": float(P / nose.length), "order": order, "h_over_d": h, "n_dofs": f.n_dofs,
                              "A": abs(f.A / ref["A"][i] - 1), "B": abs(f.B_body / ref["B_body"][i] - 1),
                              "seconds": f.seconds})
