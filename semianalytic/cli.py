@@ -9,6 +9,7 @@ from __future__ import annotations
 
 import argparse
 import importlib
+import os
 import sys
 import traceback
 import warnings
@@ -120,6 +121,13 @@ def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[
         return 2
     except KeyboardInterrupt:
         print("interrupted", file=sys.stderr)
+        return 1
+    except BrokenPipeError:  # the reader went away (`... | head`): nothing more to say, no traceback
+        try:
+            devnull = os.open(os.devnull, os.O_WRONLY)
+            os.dup2(devnull, sys.stdout.fileno())  # Python's flush at exit would raise again
+        except (OSError, ValueError):
+            pass
         return 1
     except MemoryError:
         print(f"error: memory: {prog} {name} ran out of memory; lower the resolution or raise --memory-limit "
