@@ -2,8 +2,10 @@
 
 ``--vary KEY=LOW:HIGH`` (repeatable) names a nose-shape parameter and its bounds, with units
 like case files (``projectile.half_angle=10 deg:40 deg``; ``crh`` is a bare number).  Allowed
-keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; and
-``projectile.meplat_diameter`` / ``projectile.tip_radius`` where the case schema has them.
+keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; power
+``projectile.exponent`` (in (0, 1]) and ``projectile.nose_length``; and
+``projectile.meplat_diameter`` / ``projectile.tip_radius`` (blunted or truncated ogives and
+cones) where the case schema has them.
 
 Every bound corner and the bounds' centre must make a valid case that meets the constraints,
 else exit 2 naming the flag (``--vary projectile.crh``, ``--constraint mass``); nothing is
@@ -29,6 +31,8 @@ NOSE_KEYS: dict[str, tuple[tuple[str, ...] | None, str, str | None]] = {
     "projectile.half_angle": (("cone",), "rad", "angle"),
     "projectile.meplat_diameter": (None, "m", "length"),
     "projectile.tip_radius": (None, "m", "length"),
+    "projectile.exponent": (("power",), "", None),
+    "projectile.nose_length": (("power",), "m", "length"),
 }
 
 
@@ -114,6 +118,10 @@ def parse_variable(text: str) -> Variable:
     high, _ = _parse_bound(hi_t, kind, flag)
     if not high > low:
         raise InputError(flag, f"HIGH must be above LOW; got {rest!r}")
+    if key == "projectile.exponent" and not (low > 0.0 and high <= 1.0):
+        raise InputError(flag, f"the power-law exponent must lie in (0, 1]; got {rest!r}")
+    if key == "projectile.nose_length" and not low > 0.0:
+        raise InputError(flag, f"the nose length must be positive; got LOW = {low:g} m")
     if key == "projectile.crh" and low < 0.5:
         raise InputError(flag, f"crh must be >= 0.5 for a tangent ogive (0.5 is the hemisphere); got LOW = {low:g}")
     return Variable(key, low, high, unit)

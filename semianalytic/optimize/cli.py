@@ -24,7 +24,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help="overwrite --out / --report")
     parser.add_argument("--vary", action="append", default=[], metavar="KEY=LOW:HIGH",
                         help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
-                             "projectile.meplat_diameter, projectile.tip_radius (repeatable)")
+                             "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
+                             "projectile.nose_length (repeatable)")
     parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
     parser.add_argument("--depth-model", default="rigid", help="rigid or exact-rod (elastic projectile, errata item 5)")
     parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")

@@ -53,7 +53,7 @@ from semianalytic.optimize.model import Infeasible, deep_drag, depth_objective, 
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
 _SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
-               "projectile.tip_radius")
+               "projectile.tip_radius", "projectile.exponent", "projectile.nose_length")
 CLASSIC_NOSES: dict[str, dict[str, Any]] = {
     name: {**dict.fromkeys(_SHAPE_KEYS), **shape}  # None: the case's other shape keys removed (sharp tips)
     for name, shape in {
@@ -80,13 +80,18 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         case = design_case(problem, overrides)
         psec = case.require("projectile")
         proj = projectile_from_section(psec)
-        table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
-        _, B_deep, _ = table.deep_limit()
         rec.update(
-            nose=psec.nose, mass_kg=proj.mass, length_m=proj.length, shank_length_m=proj.shank_length,
-            nose_length_m=proj.nose_length, deep_drag_Bbar=deep_drag(B_deep, psec.diameter),
+            nose=psec.nose, mass_kg=proj.mass if (psec.density or psec.mass) else None, length_m=proj.length,
+            shank_length_m=proj.shank_length, nose_length_m=proj.nose_length,
             outline_m=np.asarray(proj.nose.meridian().sample(24)).round(12).tolist(),
         )
+        if problem.objective == "deep_drag":  # the deep limit alone: a few solves at depth, no table
+            lim = deep_limit_of_case(case, proj.nose)
+            rec["deep_drag_Bbar"] = deep_drag(lim.values[f"B_{case.coefficients.reading}"], psec.diameter)
+            rec["bem_depths_solved"] = lim.solves
+        else:
+            table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
+            rec["deep_drag_Bbar"] = deep_drag(table.deep_limit()[1], psec.diameter)
         if problem.objective == "depth":
             from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
@@ -108,6 +113,21 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         rec.update(status="error", message=f"{type(exc).__name__}: {exc}")
     rec["seconds"] = time.perf_counter() - t0
     return rec
+
+
+def deep_limit_of_case(case, nose):
+    """:func:`~semianalytic.optimize.model.deep_limit` with the case's BEM and table options."""
+    from semianalytic.optimize.model import deep_limit
+
+    cs = case.coefficients
+    kw = dict(order=case.bem.order, tolerance=cs.tolerance, max_depth_nose_lengths=cs.max_depth_nose_lengths,
+              strict=cs.depths is None)
+    if getattr(case.bem, "refinement", None) is not None:
+        kw["refinement"] = case.bem.refinement
+    try:
+        return deep_limit(nose, **kw)
+    except ValueError as exc:
+        raise InputError("coefficients.max_depth_nose_lengths", str(exc)) from None
 
 
 @dataclass
