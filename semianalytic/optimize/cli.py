@@ -47,7 +47,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--resolution", type=float, default=1e-3, help="designs rounded to this fraction of each range")
     parser.add_argument("--confirm", type=int, default=5, help="confirmation grid: points per variable (0: none)")
-    parser.add_argument("--scheduler", default=None, help="dask scheduler tcp://HOST:PORT, 'inline' or 'local' (default)")
+    parser.add_argument("--scheduler", default=None, help="dask scheduler tcp://HOST:PORT or its scheduler file FILE.json "
+                        "(docs/cluster.md), 'inline' or 'local' (default)")
     parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
     parser.add_argument("--no-progress", action="store_true")

@@ -42,7 +42,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="penetration: also quasi-rigid and elastic depths (slower, case by case)")
     parser.add_argument("--format", dest="fmt", choices=["csv", "parquet"], default="csv")
     parser.add_argument("--scheduler", default=None,
-                        help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process, 'local' "
+                        help="dask scheduler address (tcp://HOST:PORT) or its scheduler file (FILE.json, written by "
+                             "'dask scheduler --scheduler-file'; docs/cluster.md); 'inline' runs in this process, 'local' "
                              "starts a local cluster; default: chosen from the work (inline for cheap cases, "
                              "a local cluster for geometry sweeps)")
     parser.add_argument("--workers", type=integer(1, 256), default=2, help="workers of the local cluster (default 2)")
