@@ -186,3 +186,34 @@ def test_power_missing_key_and_bad_vary(tmp_path, capsys):
     rc = main(["optimize", str(p), "--json", "--vary", "projectile.crh=1:3", "--objective", "deep_drag",
                "--scheduler", "inline", "--no-progress"])
     assert rc == 2 and capsys.readouterr().err.startswith("error: --vary projectile.crh:")
+
+
+def test_sweep_over_the_exponent_builds_a_table_per_design(tmp_path, monkeypatch):
+    # a sweep over projectile.exponent must build one table per exponent (a geometry key), not reuse
+    # one: the exponent-1 row equals the same case with the cone of the same length (another nose kind,
+    # another segment type and layout; coarse tables, so the agreement is their interpolation's, 1e-5)
+    import tomllib
+
+    import pandas as pd
+
+    from semianalytic.sweep.engine import run_sweep
+    from semianalytic.sweep.spec import build_spec
+    from case_blocks import COARSE_TABLES, TARGET_6061_T651
+
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
+    head = POWER_CASE.format(n=0.6).split("[target]")[0]
+    text = head + TARGET_6061_T651 + '[impact]\nstriking_velocities = ["0.8 km/s"]\n' + COARSE_TABLES
+    p = tmp_path / "power.toml"
+    p.write_text(text)
+    run_sweep(p, build_spec(["projectile.exponent=0.6,1.0"]), tmp_path / "sw", scheduler="inline", progress=False)
+    df = pd.read_csv(tmp_path / "sw" / "results.csv").sort_values("projectile.exponent")
+    depth = dict(zip(df["projectile.exponent"], df["depth_rigid_m"]))
+    cone = tmp_path / "cone.toml"
+    cone.write_text(text.replace('nose = "power"\nexponent = 0.6\nnose_length = "11.8 mm"',
+                                 f'nose = "cone"\nhalf_angle = "{math.degrees(math.atan(0.5 * D / L))!r} deg"'))
+    assert tomllib.loads(cone.read_text())["projectile"]["nose"] == "cone"
+    run_sweep(cone, build_spec(["impact.striking_velocity=0.8 km/s"]), tmp_path / "cone", scheduler="inline",
+              progress=False)
+    d_cone = float(pd.read_csv(tmp_path / "cone" / "results.csv")["depth_rigid_m"].iloc[0])
+    assert math.isclose(depth[1.0], d_cone, rel_tol=1e-5), (depth, d_cone)
+    assert abs(depth[0.6] / depth[1.0] - 1) > 1e-3  # a different nose, a different depth

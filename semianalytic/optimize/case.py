@@ -164,11 +164,13 @@ def build_problem(
     depth_model: str = "rigid",
     table_depths: int | None = None,
     table_nose_lengths: float | None = None,
+    striking_velocity: str | None = None,
 ) -> Problem:
     """Parse and check everything the user gave (exit 2 naming the flag on bad input).
 
     ``table_depths`` / ``table_nose_lengths`` set every design's ``[coefficients] depths`` and
-    ``max_depth_nose_lengths`` (the design tables; None: the case's own)."""
+    ``max_depth_nose_lengths`` (the design tables; None: the case's own); ``striking_velocity``
+    (``--striking-velocity``, with units): the depth objective at that one velocity."""
     from semianalytic.geometry import projectile_from_section
 
     if objective not in OBJECTIVES:
@@ -206,9 +208,18 @@ def build_problem(
     if objective == "depth":
         if case.target is None or case.target.resistance is None:
             raise InputError("--objective", "depth needs a [target.resistance] in the case (the target's R_t)")
-        if case.impact is None:
-            raise InputError("--objective", "depth needs [impact] striking_velocities in the case")
-        velocities = tuple(case.impact.striking_velocities)
+        if case.impact is None and striking_velocity is None:
+            raise InputError("--objective", "depth needs [impact] striking_velocities in the case (or --striking-velocity)")
+        velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
+    if striking_velocity is not None:
+        from semianalytic.units import parse_quantity
+
+        if objective != "depth":
+            raise InputError("--striking-velocity", f"applies to --objective depth, not {objective}")
+        v = parse_quantity(striking_velocity, "velocity", "--striking-velocity")
+        if not v > 0:
+            raise InputError("--striking-velocity", f"must be positive (m/s); got {striking_velocity!r}")
+        velocities = (float(v),)
         if depth_model == "exact-rod" and (psec.youngs_modulus is None or psec.density is None and psec.mass is None):
             raise InputError("--depth-model", "exact-rod needs projectile.youngs_modulus (e.g. '210 GPa')")
     else:

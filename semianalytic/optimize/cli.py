@@ -27,6 +27,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
                              "projectile.nose_length (repeatable)")
     parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
+    parser.add_argument("--striking-velocity", default=None, metavar="V",
+                        help="depth: the final depth at this one striking velocity (e.g. '800 m/s') instead of the mean "
+                             "over the case's [impact] striking_velocities")
     parser.add_argument("--depth-model", default="rigid", help="rigid or exact-rod (elastic projectile, errata item 5)")
     parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")
     parser.add_argument("--method", default="grid-pattern",

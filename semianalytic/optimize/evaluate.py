@@ -239,6 +239,49 @@ def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int)
             "stopped at --maxfev polls", "success": bool(done)}
 
 
+FINER_BEM = (("bem.order", 10), ("bem.refinement", 0.6))  # the finer BEM of the optimum's check (order 8, 0.3 by default)
+
+
+def finer_check(problem: Problem, best_x, low, high, cache_dir, n: int, half_width: float) -> dict | None:
+    """The optimum checked on a finer BEM (:data:`FINER_BEM`: order 10, twice the panels): the
+    objective at the optimum and at its neighbours one confirmation-grid step away along each
+    variable, re-solved; confirmed when no neighbour beats the optimum there, and, along each
+    variable, the vertex of the parabola through the three (the finer optimum, this project's own
+    check).  Only for ``deep_drag`` (a few solves per design); None otherwise."""
+    import dataclasses
+
+    if problem.objective != "deep_drag":
+        return None
+    fine = dataclasses.replace(problem, table_overrides=tuple(problem.table_overrides) + FINER_BEM)
+    best_x = np.asarray(best_x, float)
+    step = 2.0 * half_width * (np.asarray(high) - np.asarray(low)) / max(n - 1, 1)
+    f0 = evaluate_design(fine, problem.overrides(best_x), cache_dir)
+    if f0["status"] != "ok":
+        return {"status": f0["status"], "message": f0["message"]}
+    out = {"bem": dict(FINER_BEM), "objective": f0["objective"], "variables": [], "confirmed": True}
+    for j in range(len(best_x)):
+        fs, xs = [], []
+        for sgn in (-1.0, 1.0):
+            x = best_x.copy()
+            x[j] = float(np.clip(x[j] + sgn * step[j], low[j], high[j]))
+            if x[j] == best_x[j]:
+                continue
+            r = evaluate_design(fine, problem.overrides(x), cache_dir)
+            if r["status"] == "ok":
+                fs.append(r["objective"])
+                xs.append(x[j])
+        better = [f for f in fs if f < f0["objective"]]
+        vertex = None
+        if len(fs) == 2:
+            (a, c), (fa, fc), b, fb = xs, fs, best_x[j], f0["objective"]
+            den = (b - a) * (fb - fc) - (b - c) * (fb - fa)
+            if den != 0.0:
+                vertex = float(b - 0.5 * ((b - a) ** 2 * (fb - fc) - (b - c) ** 2 * (fb - fa)) / den)
+        out["variables"].append({"x": xs, "objective": fs, "parabola_vertex": vertex, "step": float(step[j])})
+        out["confirmed"] = out["confirmed"] and not better
+    return out
+
+
 def optimise(
     problem: Problem,
     *,
@@ -255,6 +298,7 @@ def optimise(
     confirm: int = 5,
     confirm_half_width: float = 0.04,
     classic_noses: bool = True,
+    finer_bem: bool = True,
     on_done: Callable[[int], None] | None = None,
 ) -> dict:
     """Search the problem's bounds (``method``: see the module docstring), then the confirmation
@@ -341,6 +385,7 @@ def optimise(
             own_tables = {"objective": own["objective"], "design_tables_objective": best["objective"],
                           "relative_difference": abs(best["objective"] - own["objective"]) / abs(own["objective"]),
                           "seconds": own["seconds"], "table_overrides": dict(problem.table_overrides)}
+    finer = finer_check(problem, best_x, low, high, cache_dir, max(confirm, 5), confirm_half_width) if finer_bem else None
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -355,6 +400,7 @@ def optimise(
         "striking_velocities_m_s": list(problem.velocities),
         "optimizer": info,
         "own_tables_check": own_tables,
+        "finer_check": finer,
         "optimum": {**best, "x": best_x.tolist()},
         "start": start_rec,
         "confirmation": grid,

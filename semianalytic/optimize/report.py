@@ -116,6 +116,16 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
                  f"on the case's own tables: objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
                  f"on the design tables, relative difference **{chk['relative_difference']:.1e}** (the design tables' "
                  "error in the objective; compare it with the change of the objective over one resolution step).")
+    fc = result.get("finer_check")
+    if fc and "variables" in fc:
+        bem = ", ".join(f"{k.split('.', 1)[1]} {v:g}" for k, v in fc["bem"].items())
+        parts = []
+        for v, info in zip(result["variables"], fc["variables"]):
+            pts = ", ".join(f"{_shown(v, x)}: {f:.7g}" for x, f in zip(info["x"], info["objective"]))
+            vert = f"; parabola vertex {_shown(v, info['parabola_vertex'])}" if info["parabola_vertex"] is not None else ""
+            parts.append(f"{v['key']} neighbours {pts}{vert}")
+        doc.para(f"Finer BEM check ({bem}; the search's BEM: the case's): the optimum's objective {fc['objective']:.7g}; "
+                 + "; ".join(parts) + f". No neighbour better on the finer BEM: **{'yes' if fc['confirmed'] else 'NO'}**.")
     rows = [["optimum", _design_text(result, result["optimum"]), _value_text(result, result["optimum"])]]
     if result.get("start"):
         rows.append(["start", _design_text(result, result["start"]), _value_text(result, result["start"])])

@@ -34,6 +34,7 @@ _GEOMETRY_PREFIXES = (
     "projectile.corner_radius",
     "projectile.meplat_diameter",
     "projectile.tip_radius",
+    "projectile.exponent",  # the power-law nose (and projectile.nose_length, matched by "projectile.nose")
     "projectile.points",
     "bem.",
     "coefficients.depths",
@@ -50,7 +51,7 @@ def geometry_key(case: Case) -> str:
     """A content key of everything the coefficient table depends on."""
     p = case.require("projectile")
     nose = {k: getattr(p, k, None) for k in ("nose", "diameter", "crh", "half_angle", "corner_radius", "meplat_diameter",
-                                             "tip_radius")}
+                                             "tip_radius", "exponent", "nose_length")}
     nose["points"] = p.points_si() if p.points else None
     opts = {
         "order": case.bem.order,
