@@ -22,7 +22,8 @@ from typing import Any, Mapping
 
 from semianalytic.case import Case, ProjectileSection, parse_case
 from semianalytic.errors import InputError
-from semianalytic.optimize.model import CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, Infeasible, shank_for_constraints
+from semianalytic.optimize.model import (CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, PLATE_OBJECTIVES, Infeasible,
+                                         shank_for_constraints)
 from semianalytic.sweep.spec import apply_overrides
 
 # key -> (nose kinds it applies to (None: any with the schema key), SI unit of its values, parse kind)
@@ -211,22 +212,24 @@ def build_problem(
         if case.impact is None and striking_velocity is None:
             raise InputError("--objective", "depth needs [impact] striking_velocities in the case (or --striking-velocity)")
         velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
-    if striking_velocity is not None:
-        from semianalytic.units import parse_quantity
-
-        if objective != "depth":
-            raise InputError("--striking-velocity", f"applies to --objective depth, not {objective}")
-        v = parse_quantity(striking_velocity, "velocity", "--striking-velocity")
-        if not v > 0:
-            raise InputError("--striking-velocity", f"must be positive (m/s); got {striking_velocity!r}")
-        velocities = (float(v),)
         if depth_model == "exact-rod" and (psec.youngs_modulus is None or psec.density is None and psec.mass is None):
             raise InputError("--depth-model", "exact-rod needs projectile.youngs_modulus (e.g. '210 GPa')")
+    elif objective in PLATE_OBJECTIVES:
+        velocities = check_plate_objective(case, objective, striking_velocity)
     else:
         extra = [c for c in cons if c != "caliber"]
         if extra:
             raise InputError("--constraint", f"{extra[0]} is not defined for --objective deep_drag: the deep drag "
                                              "Bbar depends on the nose shape only, not on the mass or the length")
+    if striking_velocity is not None:
+        from semianalytic.units import parse_quantity
+
+        if objective not in ("depth", "residual_velocity"):
+            raise InputError("--striking-velocity", f"applies to --objective depth or residual_velocity, not {objective}")
+        v = parse_quantity(striking_velocity, "velocity", "--striking-velocity")
+        if not v > 0:
+            raise InputError("--striking-velocity", f"must be positive (m/s); got {striking_velocity!r}")
+        velocities = (float(v),)
     start = projectile_from_section(psec)
     fixed_mass = fixed_length = None
     if "mass" in cons:
@@ -252,6 +255,23 @@ def build_problem(
     )
     check_bounds(problem)
     return problem
+
+
+def check_plate_objective(case: Case, objective: str, striking_velocity: str | None) -> tuple[float, ...]:
+    """A plate objective needs a plate ([target] thickness or [[target.layers]]) and the perforation
+    model (:mod:`semianalytic.perforation`); residual_velocity also striking velocities.  Returns them."""
+    target = case.target
+    if target is None or (getattr(target, "thickness", None) is None and not getattr(target, "layers", None)):
+        raise InputError("--objective", f"{objective} needs a plate case: [target] thickness = '20 mm' (or "
+                                        "[[target.layers]]); this case is a half-space")
+    try:
+        import semianalytic.perforation.model  # noqa: F401
+    except ImportError:
+        raise InputError("--objective", f"{objective} needs the perforation model (issue 23), not in this version") from None
+    velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
+    if objective == "residual_velocity" and not velocities and striking_velocity is None:
+        raise InputError("--objective", "residual_velocity needs [impact] striking_velocities (or --striking-velocity)")
+    return velocities
 
 
 def check_bounds(problem: Problem) -> None:

@@ -26,7 +26,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
                              "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
                              "projectile.nose_length (repeatable)")
-    parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
+    parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised), deep_drag (Bbar, "
+                        "minimised), ballistic_limit (a plate's V_bl, minimised) or residual_velocity (a plate's mean V_r, "
+                        "maximised)")
     parser.add_argument("--striking-velocity", default=None, metavar="V",
                         help="depth: the final depth at this one striking velocity (e.g. '800 m/s') instead of the mean "
                              "over the case's [impact] striking_velocities")

@@ -49,7 +49,8 @@ import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.optimize.case import Problem, design_case
-from semianalytic.optimize.model import Infeasible, deep_drag, depth_objective, quantise, confirmation_grid
+from semianalytic.optimize.model import (PLATE_OBJECTIVES, Infeasible, confirmation_grid, deep_drag, depth_objective,
+                                         quantise)
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
 _SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
@@ -89,10 +90,14 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
             lim = deep_limit_of_case(case, proj.nose)
             rec["deep_drag_Bbar"] = deep_drag(lim.values[f"B_{case.coefficients.reading}"], psec.diameter)
             rec["bem_depths_solved"] = lim.solves
+        elif problem.objective in PLATE_OBJECTIVES:  # the plate's tables only (no half-space table)
+            rec.update(plate_objective(problem, case, cache_dir))
         else:
             table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
             rec["deep_drag_Bbar"] = deep_drag(table.deep_limit()[1], psec.diameter)
-        if problem.objective == "depth":
+        if problem.objective in PLATE_OBJECTIVES:
+            pass
+        elif problem.objective == "depth":
             from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
             exact = problem.depth_model == "exact-rod"
@@ -113,6 +118,35 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         rec.update(status="error", message=f"{type(exc).__name__}: {exc}")
     rec["seconds"] = time.perf_counter() - t0
     return rec
+
+
+def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
+    """``ballistic_limit``: V_bl by bisection on Part I, eq. (11) through the plate
+    (:func:`semianalytic.perforation.ballistic_limit`; the upper bracket doubled from the largest
+    striking velocity, or 500 m/s, until it perforates, at most 20 km/s), minimised;
+    ``residual_velocity``: minus the mean V_r over the striking velocities
+    (:func:`semianalytic.perforation.residual_velocity`)."""
+    from semianalytic.perforation import ballistic_limit, residual_velocity
+    from semianalytic.perforation.evaluate import perforation_setup
+
+    setup = perforation_setup(case, cache_dir)
+    out: dict = {"plate_thickness_m": setup.thickness}
+    if problem.objective == "residual_velocity":
+        vr = np.asarray(residual_velocity(setup.coefficients, setup.mass, np.asarray(problem.velocities, float)), float)
+        out["residual_velocities_m_s"] = vr.tolist()
+        out["objective"] = -float(np.mean(vr))
+        return out
+    upper = max(list(problem.velocities) + [500.0])
+    while True:
+        try:
+            bl = ballistic_limit(setup.coefficients, setup.mass, upper)
+            break
+        except ValueError:  # the upper bracket does not perforate
+            if upper >= 20e3:
+                raise InputError("--objective", "ballistic_limit: the plate is not perforated below 20 km/s") from None
+            upper = min(2.0 * upper, 20e3)
+    out.update(objective=float(bl.value), ballistic_limit_m_s=float(bl.value), ballistic_limit_error_m_s=float(bl.error))
+    return out
 
 
 def deep_limit_of_case(case, nose):

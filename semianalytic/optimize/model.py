@@ -11,7 +11,10 @@ A design changes the nose; the shank then follows the constraint:
 Objectives (minimised): ``depth``: minus the mean final depth over the striking velocities
 (Part I, eq. (11); rigid, or the elastic projectile with the exact-rod energy, errata item 5);
 ``deep_drag``: the deep-penetration drag Bbar = 4 B / (pi d^2) (Part I, eq. (13), deep limit),
-from :func:`deep_limit` alone (a few BEM solves at depth, not a table from first contact).
+from :func:`deep_limit` alone (a few BEM solves at depth, not a table from first contact);
+``ballistic_limit``: the plate's ballistic limit V_bl (minimised); ``residual_velocity``: minus
+the mean residual velocity over the striking velocities (both by Part I, eq. (11) through the
+plate: :mod:`semianalytic.perforation`).
 """
 
 from __future__ import annotations
@@ -21,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-OBJECTIVES = ("depth", "deep_drag")
+OBJECTIVES = ("depth", "deep_drag", "ballistic_limit", "residual_velocity")
+PLATE_OBJECTIVES = ("ballistic_limit", "residual_velocity")  # need a plate ([target] thickness or layers)
 CONSTRAINTS = ("mass", "length", "caliber")
 DEPTH_MODELS = ("rigid", "exact-rod")
 
