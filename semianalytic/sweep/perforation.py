@@ -18,7 +18,8 @@ import numpy as np
 
 from semianalytic.case import Case
 from semianalytic.errors import InputError
-from semianalytic.sweep.spec import VELOCITY_KEY, Axis, SweepSpec
+from semianalytic.sweep.kernels import CavityKernel, PenetrationKernel
+from semianalytic.sweep.spec import VELOCITY_KEY, SweepSpec
 
 MAX_UPPER = 20e3  # m/s: the largest upper bracket tried for the ballistic limit
 
@@ -46,8 +47,10 @@ def plate_ballistic_limit(setup, start: float):
 
 
 @dataclass(frozen=True)
-class PerforationKernel:
-    """Residual velocity and ballistic limit of a plate (see the module docstring)."""
+class PerforationKernel(CavityKernel):
+    """Residual velocity and ballistic limit of a plate (see the module docstring).  From the
+    cavity kernel only its protocol's no-op parts: no keys on arrays, no resource shared between
+    cases (``prepare`` returns None; the plate tables are cached on disk by the perforation package)."""
 
     cache_dir: str | None = None
     ballistic: bool = True  # the ballistic limit per case (a bisection; off: the residual velocities only)
@@ -62,31 +65,12 @@ class PerforationKernel:
         if not has_plate(case):
             raise InputError("target.thickness", "the perforation sweep needs a plate case: [target] thickness = "
                                                  "'20 mm' (or [[target.layers]])")
-        if VELOCITY_KEY in spec.keys:
-            return spec
-        imp = case.require("impact")
-        axis = Axis(VELOCITY_KEY, tuple(imp.striking_velocities), "m/s")
-        return SweepSpec(spec.axes + (axis,), spec.samplers, spec.n_samples, spec.seed)
+        return PenetrationKernel.complete_spec(self, case, spec)  # the case's velocities as the innermost axis
 
     def check_fast(self, key: str, values: np.ndarray) -> None:
         v = np.asarray(values, float)
         if not np.all(np.isfinite(v) & (v > 0)):
             raise InputError("impact.striking_velocity", "must be positive (m/s)")
-
-    def is_array_key(self, key: str) -> bool:
-        return False
-
-    def accepts_arrays(self, case: Case, keys) -> bool:
-        return False
-
-    def affects_resource(self, key: str) -> bool:
-        return False
-
-    def resource_key(self, case: Case):
-        return None
-
-    def prepare(self, case: Case):
-        return None  # per case (the plate tables are cached on disk by the perforation package)
 
     def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
         from semianalytic.perforation import residual_velocity
