@@ -217,3 +217,23 @@ def test_sweep_over_the_exponent_builds_a_table_per_design(tmp_path, monkeypatch
     d_cone = float(pd.read_csv(tmp_path / "cone" / "results.csv")["depth_rigid_m"].iloc[0])
     assert math.isclose(depth[1.0], d_cone, rel_tol=1e-5), (depth, d_cone)
     assert abs(depth[0.6] / depth[1.0] - 1) > 1e-3  # a different nose, a different depth
+
+
+@pytest.mark.parametrize("objective", ["ballistic_limit", "residual_velocity"])
+def test_plate_objectives_need_a_plate_case(tmp_path, capsys, objective):
+    # a half-space case (no [target] thickness): exit 2 naming --objective, nothing written
+    from semianalytic.cli import main
+
+    p = tmp_path / "case.toml"
+    p.write_text(POWER_CASE.format(n=0.6))
+    out = tmp_path / "o"
+    rc = main(["optimize", str(p), "--out", str(out), "--vary", "projectile.exponent=0.4:0.9", "--objective", objective,
+               "--scheduler", "inline", "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith("error: --objective:") and "plate" in err, err
+    assert not out.exists()
+    rc = main(["sweep", str(p), "--out", str(out), "--vary", "projectile.exponent=0.4,0.9", "--analysis", "perforation",
+               "--scheduler", "inline", "--no-progress"])
+    err = capsys.readouterr().err
+    assert rc == 2 and err.startswith(("error: target.thickness:", "error: --analysis:")), err
+    assert not out.exists()

@@ -273,11 +273,16 @@ def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int)
             "stopped at --maxfev polls", "success": bool(done)}
 
 
-FINER_BEM = (("bem.order", 10), ("bem.refinement", 0.6))  # the finer BEM of the optimum's check (order 8, 0.3 by default)
+def finer_bem(problem: Problem) -> tuple:
+    """The finer BEM of the optimum's check: two Gauss points more per panel and twice the panels
+    of the case's (order 8, refinement 0.3 by default: order 10, refinement 0.6)."""
+    bem = json.loads(problem.raw_json).get("bem") or {}
+    order, refinement = int(bem.get("order", 8)), float(bem.get("refinement") or 0.3)
+    return (("bem.order", min(order + 2, 16)), ("bem.refinement", min(2.0 * refinement, 8.0)))
 
 
 def finer_check(problem: Problem, best_x, low, high, cache_dir, n: int, half_width: float) -> dict | None:
-    """The optimum checked on a finer BEM (:data:`FINER_BEM`: order 10, twice the panels): the
+    """The optimum checked on a finer BEM (:func:`finer_bem`: order + 2, twice the panels): the
     objective at the optimum and at its neighbours one confirmation-grid step away along each
     variable, re-solved; confirmed when no neighbour beats the optimum there, and, along each
     variable, the vertex of the parabola through the three (the finer optimum, this project's own
@@ -286,13 +291,14 @@ def finer_check(problem: Problem, best_x, low, high, cache_dir, n: int, half_wid
 
     if problem.objective != "deep_drag":
         return None
-    fine = dataclasses.replace(problem, table_overrides=tuple(problem.table_overrides) + FINER_BEM)
+    extra = finer_bem(problem)
+    fine = dataclasses.replace(problem, table_overrides=tuple(problem.table_overrides) + extra)
     best_x = np.asarray(best_x, float)
     step = 2.0 * half_width * (np.asarray(high) - np.asarray(low)) / max(n - 1, 1)
     f0 = evaluate_design(fine, problem.overrides(best_x), cache_dir)
     if f0["status"] != "ok":
         return {"status": f0["status"], "message": f0["message"]}
-    out = {"bem": dict(FINER_BEM), "objective": f0["objective"], "variables": [], "confirmed": True}
+    out = {"bem": dict(extra), "objective": f0["objective"], "variables": [], "confirmed": True}
     for j in range(len(best_x)):
         fs, xs = [], []
         for sgn in (-1.0, 1.0):
