@@ -186,8 +186,19 @@ def singular_wetted_corners(dm: DomainMesh) -> list:
     return [c for c in dm.domain.corners if not c.on_axis and c.exponent < 1.0]
 
 
+BREAK_STEP = 0.02  # largest shape-difference step over the distance to a breakpoint (measured: 1e-6 in B)
+
+
+def _breakpoint_distance(nose: Nose, depth: float) -> float:
+    """Distance from P to the nearest breakpoint of the coefficients (inf if none)."""
+    from semianalytic.coefficients.table import breakpoints
+
+    return min((abs(depth - b) for b in breakpoints(nose)), default=math.inf)
+
+
 def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None = None,
-                           step: float = 2e-4, far_field: str = "monopole", g_source: str = "auto") -> HalfspaceCoefficients:
+                           step: float = 2e-4, far_field: str = "monopole", g_source: str = "auto",
+                           step_scale: float = 1.0) -> HalfspaceCoefficients:
     """A, B (three readings), C, dA/dP and phi_tip of Part I, eq. (12) by FEM at depth P.
 
     G = int |grad phi|^2 n_x dS two ways: ``G_surface`` from the FEM surface gradient, and
@@ -200,7 +211,12 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
     G_shape there and G_surface elsewhere (where |G_surface - G_shape| checks the identity).
 
     ``step``: the depth step of the shape finite difference, as a fraction of L_h (of the radius
-    for a flat nose, :func:`depth_scale`).
+    for a flat nose, :func:`depth_scale`), and at most BREAK_STEP of the distance to the nearest
+    breakpoint of the depth axis (a corner or joint of the nose, or the shoulder, reaching the free
+    surface: there A(P) goes like a non-integer power of the distance, and the O(eps^2) error of the
+    central difference is ~ (eps/distance)^2; issue 27: a cone at 1.001 L_h had eps = 0.2 of it and
+    B off by 8.7e-5).  ``step_scale`` multiplies the step so chosen (0.5: the same solve with half
+    the step, for an estimate of its error, :func:`fem_check.refinement.refinement_study`).
     """
     options = options or MeshOptions()
     t0 = time.perf_counter()
@@ -208,7 +224,8 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
     sol = solve_potential(dm, far_field)
     # the waterline vertex slides along x = 0 while the nose moves by eps: the elements at it shear by
     # about eps, so eps stays well below the smallest of them (graded waterline corners are tiny)
-    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm))
+    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm), BREAK_STEP * _breakpoint_distance(nose, depth))
+    eps *= step_scale
     plus, minus = moved_meshes(dm, [eps, -eps])
     Ap = solve_potential(plus, far_field).A
     Am = solve_potential(minus, far_field).A

@@ -21,9 +21,11 @@ from __future__ import annotations
 import hashlib
 import json
 import os
+import zipfile
 from pathlib import Path
 
-__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case"]
+__all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case",
+           "plate_table_key", "cached_plate_table"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 
@@ -80,6 +82,40 @@ def cached_coefficient_table(nose, cache_dir: str | os.PathLike | None = None, *
     table = coefficient_table(nose, **options)
     atomic_write_bytes(path, table.to_npz_bytes())
     return table
+
+
+def plate_table_key(nose, thickness: float, **options) -> str:
+    """Cache key of a plate table: as :func:`table_key`, with the plate's thickness H [m] and
+    the plate code's version (:data:`semianalytic.coefficients.plate.PLATE_VERSION`)."""
+    from semianalytic.coefficients.plate import PLATE_VERSION
+
+    if options.get("depths") is not None:
+        options = {**options, "depths": [float(P) for P in options["depths"]]}
+    payload = json.dumps(
+        {"nose": [nose.kind, nose.diameter, nose.length, _jsonable(nose.parameters)], "thickness": repr(float(thickness)),
+         "options": _jsonable(options), "plate_version": PLATE_VERSION},
+        sort_keys=True,
+    )
+    return "plate-" + hashlib.sha256(payload.encode()).hexdigest()[:20]
+
+
+def cached_plate_table(nose, thickness: float, cache_dir: str | os.PathLike | None = None, **options):
+    """:func:`semianalytic.coefficients.plate.plate_coefficient_table` of a nose in a plate of
+    thickness H [m], read from the cache when there, else built and stored (atomically) under
+    :func:`plate_table_key`.  ``reading`` is applied after reading (it is not part of the key)."""
+    from semianalytic.coefficients.plate import PlateCoefficientTable, plate_coefficient_table
+    from semianalytic.io import atomic_write_bytes
+
+    reading = options.pop("reading", "body")
+    path = table_dir(cache_dir) / f"{plate_table_key(nose, thickness, **options)}.npz"
+    if path.exists():
+        try:
+            return PlateCoefficientTable.from_npz(path).with_reading(reading)
+        except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile):
+            pass  # another version or a damaged file: rebuild
+    table = plate_coefficient_table(nose, thickness, **options)
+    atomic_write_bytes(path, table.to_npz_bytes())
+    return table.with_reading(reading)
 
 
 def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False, tolerance=None):

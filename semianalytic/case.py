@@ -24,6 +24,7 @@ from pydantic import BaseModel, Field, field_validator, model_validator
 
 from semianalytic.errors import InputError
 from semianalytic.penetration.case import ResistanceField
+from semianalytic.perforation.case import TargetLayerSection, check_target_layers
 from semianalytic.schema import Section, validate_section
 from semianalytic.schema import pydantic_message as _pydantic_message  # noqa: F401 (old name)
 from semianalytic.units import Angle, Density, Length, Mass, NonNegativeLength, Pressure, Velocity
@@ -199,11 +200,19 @@ class ProjectileSection(Section):
 
 
 class TargetSection(Section):
-    """``[target]``: the half-space target.  ``resistance``: the schema of
+    """``[target]``: the half-space target, or a plate (``thickness``) or layered target
+    (``[[target.layers]]``, :mod:`semianalytic.perforation.case`).  ``resistance``: the schema of
     :mod:`semianalytic.penetration.case` (a discriminated union on ``model``)."""
 
     density: Density
     resistance: ResistanceField | None = None
+    thickness: Length | None = None  # a plate (issue 23); absent: the half-space
+    layers: list[TargetLayerSection] | None = None  # a layered target (issue 23)
+
+    @model_validator(mode="after")
+    def _plate(self):
+        check_target_layers(self.thickness, self.layers)
+        return self
 
 
 # The generic physical bound of a striking velocity (each model warns about its own, lower
@@ -257,6 +266,7 @@ SECTIONS: dict[str, str] = {
     "data": "semianalytic.penetration.case:DataSection",
     "run": "semianalytic.run.case:RunSection",
     "calibration": "semianalytic.calibration.case:CalibrationSection",
+    "perforation": "semianalytic.perforation.case:PerforationSection",
 }
 
 _CORE = {

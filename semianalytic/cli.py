@@ -22,6 +22,7 @@ COMMANDS: dict[str, tuple[str, str]] = {
     "coefficients": ("semianalytic.coefficients.cli", "BEM drag coefficients A(P), B(P), C(P) (Part I, eqs. 12-15)"),
     "bench-bem": ("semianalytic.coefficients.bench", "benchmark the BEM against exact solutions; writes reports/bench_bem.md"),
     "penetrate": ("semianalytic.penetration.cli", "depth and time of penetration, critical impact velocity (Part I)"),
+    "perforate": ("semianalytic.perforation.cli", "perforation of plates: residual velocity, ballistic limit (Part I eq. 11, Part IV)"),
     "cavity": ("semianalytic.cavity.cli", "brittle spherical-cavity expansion (Part II)"),
     "ballistic-limit": ("semianalytic.ballistic_limit.cli", "ballistic limit velocity (Part IV)"),
     "fit-constants": ("semianalytic.ballistic_limit.fit_cli", "refit the empirical constants C1, C2, C3 (Part IV, eqs. 7-9)"),

@@ -570,14 +570,16 @@ def solve_panels(
     volume: float | None = None,
     neumann=None,
     plan: AssemblyPlan | None = None,
+    matrices: tuple[np.ndarray, np.ndarray] | None = None,
 ) -> SurfaceSolution:
     """Assemble and solve (**).
 
     ``neumann(x, r, nx, nr) -> g`` gives dphi/dn at the primary nodes; the default is
     unit motion in +x, g = -n_x (Part I, eq. (7)).  ``plan`` reuses the quadrature rules
-    of a panel set of the same topology.
+    of a panel set of the same topology; ``matrices`` = (Smat, Dmat) assembled elsewhere
+    (another Green's function: the plate of :mod:`semianalytic.bem.slab`).
     """
-    S, D = assemble(ps, plan)
+    S, D = assemble(ps, plan) if matrices is None else matrices
     N = S.shape[0]
     geo = ps.nodes
     n = ps.n_primary

@@ -37,6 +37,7 @@ ANALYSES = (
     "fem_field",  # fem_check potential field -> .vtu (when fem_check exposes it)
     "cavity",  # [material]: Part II
     "ballistic_limit",  # [ballistic_limit]: Part IV
+    "perforation",  # [target] thickness or layers: V_r against V_s, ballistic limit (issue 23)
     "nanostrength",  # [nanostrength]: Part III
 )
 Analysis = Literal[
@@ -49,6 +50,7 @@ Analysis = Literal[
     "fem_field",
     "cavity",
     "ballistic_limit",
+    "perforation",
     "nanostrength",
 ]
 

@@ -21,6 +21,7 @@ from semianalytic.errors import InputError
 from semianalytic.report.document import fmt
 from semianalytic.report.provenance import generated_by, version
 from semianalytic.run import bodies, fields, part1, part2, parts34  # noqa: F401 (steps register on import)
+from semianalytic.run import perforation  # noqa: F401 (issue 23: registers the perforation step)
 from semianalytic.run.context import Context
 from semianalytic.run.registry import Step, _mm, _projectile, select_steps
 

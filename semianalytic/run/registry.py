@@ -124,6 +124,7 @@ REQUIRES: dict[str, tuple[str, ...]] = {
     "fem_field": ("projectile", "target"),
     "cavity": ("material",),
     "ballistic_limit": ("ballistic_limit",),
+    "perforation": ("projectile", "target", "impact"),
     "nanostrength": ("nanostrength",),
 }
 

@@ -1,0 +1,63 @@
+"""``python -m semianalytic perforate CASE.toml [--json]``: perforation of the case's plate or
+layered target (``[target] thickness`` or ``[[target.layers]]``) by the rigid projectile of
+Part I, eq. (11): per striking velocity ``perforated``, ``residual_velocity_m_s`` (0 where it
+stops; then ``depth_m``), ``exit_time_s``; ``ballistic_limit_m_s`` by bisection with its error
+estimate; the Lambert-Jonas fit ``lambert_jonas``; Part IV's V_cr formulas ``part4_v_cr_m_s``.
+``--report DIR`` writes ``validation_perforation.md`` (:mod:`semianalytic.perforation.report`)
+for one or more cases."""
+
+from __future__ import annotations
+
+import json
+import math
+
+
+def add_arguments(parser) -> None:
+    from semianalytic.cli_types import output_dir
+
+    parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target] thickness or layers, [impact]")
+    parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
+    parser.add_argument("--no-ballistic-limit", action="store_true", help="skip the bisection for the ballistic limit")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
+    parser.add_argument("--report", metavar="DIR", default=None, type=output_dir,
+                        help="write validation_perforation.md (and its figure and CSV) into DIR")
+
+
+def _text(r: dict) -> str:
+    f = lambda v, s=1.0, n=1: "-" if v is None or not math.isfinite(v) else f"{v * s:.{n}f}"  # noqa: E731
+    lines = [f"case: {r['title']}  ({r['case']})", f"  target: {r['thickness_m'] * 1e3:.4g} mm in {len(r['layers'])} layer(s); "
+             f"back face: {r['back_face']}; failure: {r['failure']}", f"  coefficients: {r['coefficients']}",
+             f"  {'V_s m/s':>9} | {'perforated':>10} | {'V_r m/s':>9} | {'depth mm':>9} | {'exit us':>9}"]
+    for i, U in enumerate(r["striking_velocity_m_s"]):
+        lines.append(f"  {U:9.1f} | {str(r['perforated'][i]):>10} | {f(r['residual_velocity_m_s'][i]):>9} | "
+                     f"{f(r['depth_m'][i], 1e3, 2):>9} | {f(r['exit_time_s'][i], 1e6, 2):>9}")
+    if r["ballistic_limit_m_s"] is not None:
+        lines.append(f"  ballistic limit (bisection on eq. (11)): {r['ballistic_limit_m_s']:.2f} +- {r['ballistic_limit_error_m_s']:.2f} m/s")
+    lj = r["lambert_jonas"]
+    if lj:
+        lines.append(f"  Lambert-Jonas fit: a = {lj['a']:.4f}, p = {lj['p']:.3f}, V_bl = {lj['V_bl_m_s']:.1f} m/s")
+    if r["part4_v_cr_m_s"]:
+        lines.append("  Part IV V_cr: " + ", ".join(f"{k} {v:.0f}" for k, v in r["part4_v_cr_m_s"].items()) + " m/s")
+    return "\n".join(lines)
+
+
+def run(args) -> int:
+    from semianalytic.case import load_case
+    from semianalytic.perforation.evaluate import evaluate_case
+
+    cases = [load_case(p) for p in args.cases]
+    for c in cases:
+        for sec in ("projectile", "target", "impact"):
+            c.require(sec)
+    results = [evaluate_case(c, cache_dir=args.cache_dir, ballistic=not args.no_ballistic_limit) for c in cases]
+    if args.report:
+        from semianalytic.perforation.report import write_report
+
+        path = write_report(results, args.report, argv=["perforate", *args.cases, "--report", str(args.report)])
+        print(f"wrote {path}")
+        return 0
+    if args.json:
+        print(json.dumps(results[0] if len(results) == 1 else results, indent=1))
+    else:
+        print("\n\n".join(_text(r) for r in results))
+    return 0

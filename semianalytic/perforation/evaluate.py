@@ -1,0 +1,373 @@
+"""What ``perforate`` prints for one case: per striking velocity ``perforated``,
+``residual_velocity_m_s``, ``depth_m``, ``exit_time_s``; the ballistic limit by bisection with
+its error estimate; the Lambert-Jonas fit of the computed curve; Part IV's V_cr formulas; with
+``[perforation] data``, the measured residual velocities beside the predictions.
+
+The models are :mod:`semianalytic.perforation.model` (eq. (11) through the layers) and
+:mod:`semianalytic.ballistic_limit.shots` (Part IV); the plate coefficients come from ONE
+function, :func:`plate_coefficients`.
+"""
+
+from __future__ import annotations
+
+import math
+import warnings
+from dataclasses import dataclass
+from pathlib import Path
+
+import numpy as np
+
+from semianalytic.errors import InputError, ModelValidityWarning
+
+__all__ = ["PerforationSetup", "plate_coefficients", "perforation_setup", "evaluate_case", "part4_limits",
+           "load_perforation_data", "shot_table_validation", "JSON_KEYS"]
+
+JSON_KEYS = ("striking_velocity_m_s", "perforated", "residual_velocity_m_s", "depth_m", "exit_time_s",
+             "ballistic_limit_m_s", "ballistic_limit_error_m_s", "lambert_jonas", "part4_v_cr_m_s")
+
+PART4_NAMES = {"V_R1_m_s": "eq5_R1", "V_R2_m_s": "eq5_R2", "V_R3_m_s": "eq5_R3",
+               "V_eq7_m_s": "eq7", "V_eq8_m_s": "eq8", "V_eq9_m_s": "eq9"}
+
+
+def plate_coefficients(case, thickness: float, cache_dir=None, shift: str | None = None):
+    """(coefficients, description, approximate) of the case's nose in a plate of ``thickness``:
+    the one place that picks the table.  ``shift`` = "A", "B" or "C": that coefficient shifted by
+    its error estimate (:class:`semianalytic.penetration.accuracy.ShiftedCoefficients`).
+
+    The plate table of Part I with the back face (:func:`semianalytic.cache.cached_plate_table`,
+    :mod:`semianalytic.coefficients.plate`: phi = 0 on x = H), cached per nose and thickness.
+    With ``[perforation] coefficients = "half-space"`` (or a version lacking the plate module)
+    the half-space table stands in through
+    :class:`semianalytic.perforation.model.HalfSpaceDifference` (``approximate`` True)."""
+    from semianalytic.perforation.case import PerforationSection
+
+    opts = case.section("perforation") or PerforationSection()
+    try:
+        from semianalytic.cache import cached_plate_table
+        from semianalytic.geometry import nose_from_section
+    except ImportError:
+        return _half_space_stand_in(case, thickness, cache_dir, shift)
+    if opts.coefficients == "half-space":
+        return _half_space_stand_in(case, thickness, cache_dir, shift)
+    cs = case.coefficients
+    kwargs = dict(order=case.bem.order, tolerance=cs.tolerance, reading=cs.reading)
+    if case.bem.refinement is not None:
+        kwargs["refinement"] = case.bem.refinement
+    table = cached_plate_table(nose_from_section(case.require("projectile")), float(thickness), cache_dir, **kwargs)
+    desc = (f"plate BEM table (phi = 0 on the back face; order {case.bem.order}, {len(table.depth)} knots, tolerance "
+            f"{cs.tolerance:g}, 0 <= P <= H + L_h; B reading '{cs.reading}')")
+    if shift is not None:
+        from semianalytic.penetration.accuracy import ShiftedCoefficients
+
+        table = ShiftedCoefficients(table, shift)
+    return table, desc, False
+
+
+def _half_space_stand_in(case, thickness: float, cache_dir=None, shift: str | None = None):
+    from semianalytic.cache import coefficients_for_case
+    from semianalytic.perforation.model import HalfSpaceDifference
+
+    table, desc, _ = coefficients_for_case(case, "bem", cache_dir=cache_dir)
+    if shift is not None:
+        from semianalytic.penetration.accuracy import ShiftedCoefficients
+
+        table = ShiftedCoefficients(table, shift)
+    return (HalfSpaceDifference(table, thickness),
+            f"{desc}; APPROXIMATION: half-space table with the part of the nose past the back face removed "
+            "(X(P) - X(P - H)); the back face's effect on A and B is ignored", True)
+
+
+@dataclass(frozen=True, eq=False)
+class PerforationSetup:
+    """The model's inputs for one case (SI): the layered coefficients, the projectile's mass,
+    length, density, diameter, the total target thickness and the notes for the output."""
+
+    coefficients: object
+    mass: float
+    length: float
+    density: float
+    diameter: float
+    thickness: float
+    layers: tuple
+    description: str
+    approximate: bool
+    back_face: str
+    failure: str
+
+
+def _layer_inputs(case):
+    """[(name, gap, thickness, density, resistance model)] of the case's target."""
+    from semianalytic.penetration.resistance import resistance_from_case
+
+    t = case.require("target")
+    base = resistance_from_case(case)
+    if t.layers:
+        return [(ly.name or f"layer {k}", ly.gap or 0.0, ly.thickness, ly.density or t.density,
+                 ly.resistance.build() if ly.resistance is not None else base) for k, ly in enumerate(t.layers)]
+    if t.thickness is None:
+        raise InputError("target.thickness", "missing: perforate needs a plate ('thickness', e.g. '20 mm') or [[target.layers]]")
+    return [("plate", 0.0, t.thickness, t.density, base)]
+
+
+def perforation_setup(case, cache_dir=None, shift: str | None = None) -> PerforationSetup:
+    """Build :class:`~semianalytic.perforation.model.LayeredCoefficients` from the case."""
+    from semianalytic.geometry import projectile_from_section
+    from semianalytic.perforation.case import PerforationSection
+    from semianalytic.perforation.model import LayeredCoefficients, PlateLayer
+
+    psec = case.require("projectile")
+    opts = case.section("perforation") or PerforationSection()
+    proj = projectile_from_section(psec)
+    d = float(psec.diameter)
+    failure = opts.failure
+    if failure == "auto":
+        failure = "plug" if psec.nose == "flat" else "hole-growth"
+    layers, descs, approx = [], [], False
+    front = 0.0
+    for k, (name, gap, H, rho, res) in enumerate(_layer_inputs(case)):
+        front += gap
+        R = float(res.pressure(d))
+        where = f"target.layers.{k}.resistance" if case.target.layers else "target.resistance"
+        if not R > 0:
+            raise InputError(where, f"the resistance must be positive; got {R:g} Pa")
+        Y, E = getattr(res, "yield_stress", None), getattr(res, "youngs_modulus", None)
+        ratio = None
+        if opts.back_face == "finite-sphere" and failure != "plug":  # a plug is the back face's failure itself
+            if Y is None or E is None or np.ndim(Y) or not (2 * E / (3 * Y)) > 1:
+                raise InputError("perforation.back_face", f"'finite-sphere' needs the yield stress and Young's modulus of "
+                                 f"{where} (models elastic-plastic, hardening, part4); use back_face = 'constant'")
+            ratio = (2.0 * E / (3.0 * Y)) ** (1.0 / 3.0)
+        tau = None
+        if failure == "plug":
+            tau = opts.shear_strength
+            if tau is None:
+                if Y is None:
+                    raise InputError("perforation.shear_strength", "missing: the plug criterion needs the target's shear "
+                                     "strength (e.g. '230 MPa') or a resistance model with a yield stress")
+                tau = float(Y) / math.sqrt(3.0)
+        coef, desc, ap = plate_coefficients(case, H, cache_dir, shift)
+        approx |= ap
+        descs.append(desc)
+        layers.append(PlateLayer(front, float(H), float(rho), R, coef, ratio, tau))
+        front += H
+    lc = LayeredCoefficients(layers, proj.nose.length, d)
+    rho_p = psec.density if psec.density is not None else proj.mass / proj.volume()
+    return PerforationSetup(lc, float(proj.mass), float(proj.length), float(rho_p), d, front, tuple(layers),
+                            descs[0], approx, opts.back_face, failure)
+
+
+def part4_limits(case, setup: PerforationSetup) -> dict:
+    """{name: V_cr [m/s]} of every Part IV formula the case's inputs allow (eq. (5) with R(1),
+    R(2), R(3); eqs. (7)-(9)), through :mod:`semianalytic.ballistic_limit.shots`."""
+    from semianalytic.ballistic_limit.shots import Layer, Shot, empirical_limits, theoretical_limits
+    from semianalytic.perforation.case import PerforationSection
+    from semianalytic.penetration.resistance import resistance_from_case
+
+    opts = case.section("perforation") or PerforationSection()
+    res = resistance_from_case(case)
+    Y = opts.yield_stress if opts.yield_stress is not None else getattr(res, "yield_stress", None)
+    E = opts.youngs_modulus if opts.youngs_modulus is not None else getattr(res, "youngs_modulus", None)
+    layers = ()
+    if case.target.layers:
+        layers = tuple(Layer(f"layer {k}", ly.density, ly.thickness, opts.target_hardness or float("nan"),
+                             opts.target_delta_h or float("nan")) for k, ly in enumerate(setup.layers))
+    shot = Shot(
+        name=case.title, projectile_length=setup.length, projectile_density=setup.density,
+        target_density=None if layers else float(case.target.density), thickness=None if layers else setup.thickness,
+        target_hardness=opts.target_hardness, target_delta_H=opts.target_delta_h,
+        yield_stress=None if Y is None or np.ndim(Y) else float(Y),
+        youngs_modulus=None if E is None or Y is None or np.ndim(E) else float(E),
+        projectile_diameter=setup.diameter, projectile_mass=setup.mass,
+        projectile_hardness=opts.projectile_hardness, projectile_delta_H=opts.projectile_delta_h, layers=layers,
+    )
+    out = {}
+    for key, val in {**theoretical_limits(shot), **empirical_limits(shot)}.items():
+        if key in PART4_NAMES and val is not None and math.isfinite(val):
+            out[PART4_NAMES[key]] = float(val)
+    return out
+
+
+def load_perforation_data(case) -> list[dict] | None:
+    """Rows {Vs_m_s, Vr_m_s, ...} of the case's ``[perforation] data`` CSV ('#' lines are the
+    source notes), or None."""
+    import csv
+
+    opts = case.section("perforation")
+    if opts is None or opts.data is None:
+        return None
+    base = case.path.parent if case.path is not None else Path.cwd()
+    path = base / opts.data
+    if not path.is_file():
+        raise InputError("perforation.data", f"file {opts.data!r} not found next to the case file")
+    lines = [ln for ln in path.read_text(encoding="utf-8").splitlines() if ln.strip() and not ln.lstrip().startswith("#")]
+    rows = []
+    for k, r in enumerate(csv.DictReader(lines)):
+        try:
+            row = dict(r)
+            row["Vs_m_s"], row["Vr_m_s"] = float(r["Vs_m_s"]), float(r["Vr_m_s"])
+        except (KeyError, TypeError, ValueError):
+            raise InputError("perforation.data", f"{opts.data}: row {k + 1} needs numbers in columns Vs_m_s and Vr_m_s") from None
+        rows.append(row)
+    if not rows:
+        raise InputError("perforation.data", f"{opts.data}: no data rows")
+    return rows
+
+
+def _reach_warning(setup: PerforationSetup, curve) -> None:
+    """A plate thicker than the rod can ever reach: say so (the computation goes on).  'Ever'
+    = beyond both the depth at the case's largest velocity and the hydrodynamic limit
+    L sqrt(rho_p / rho_t) of an eroding rod (Birkhoff, MacDougall, Pugh & Taylor 1948)."""
+    if curve.perforated.any():
+        return
+    rho_t = setup.layers[0].density
+    hydro = setup.length * math.sqrt(setup.density / rho_t)
+    reach = max(float(np.nanmax(curve.depth)), hydro)
+    if setup.thickness > reach:
+        warnings.warn(
+            f"target.thickness: {setup.thickness * 1e3:.4g} mm is more than this rod can ever reach with nothing behind "
+            f"(largest depth {np.nanmax(curve.depth) * 1e3:.4g} mm at {curve.velocities.max():.0f} m/s; hydrodynamic "
+            f"limit L sqrt(rho_p/rho_t) = {hydro * 1e3:.4g} mm); computed anyway",
+            ModelValidityWarning, stacklevel=2)
+
+
+def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = True, error_estimate: bool = True) -> dict:
+    """The ``perforate`` JSON of one case (keys: :data:`JSON_KEYS` and the notes)."""
+    from semianalytic.perforation.case import PerforationSection
+    from semianalytic.perforation.model import ballistic_limit, lambert_jonas_fit, perforation_curve
+
+    opts = case.section("perforation") or PerforationSection()
+    setup = perforation_setup(case, cache_dir)
+    U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
+    curve = perforation_curve(setup.coefficients, setup.mass, U)
+    _reach_warning(setup, curve)
+    out: dict = {
+        "case": str(case.path.name) if case.path else case.title, "title": case.title,
+        "thickness_m": setup.thickness,
+        "layers": [{"front_m": ly.front, "thickness_m": ly.thickness, "density_kg_m3": ly.density,
+                    "resistance_Pa": ly.resistance} for ly in setup.layers],
+        "mass_kg": setup.mass, "exit_depth_m": curve.exit_depth,
+        "back_face": setup.back_face, "failure": setup.failure,
+        "coefficients": setup.description, "coefficients_approximate": setup.approximate,
+        "striking_velocity_m_s": U.tolist(),
+        "perforated": [bool(v) for v in curve.perforated],
+        "residual_velocity_m_s": curve.residual_velocity.tolist(),
+        "depth_m": [None if not math.isfinite(v) else float(v) for v in curve.depth],
+        "exit_time_s": [None if not math.isfinite(v) else float(v) for v in curve.exit_time],
+        "plug_layer": [None if k < 0 else int(k) for k in curve.plug],
+    }
+    out["ballistic_limit_m_s"] = None
+    out["ballistic_limit_error_m_s"] = None
+    if ballistic:
+        if not curve.perforated.any():
+            i = int(np.argmax(U))
+            raise InputError("impact.striking_velocities",
+                             f"no velocity perforates, so the ballistic limit cannot be bracketed: the largest, "
+                             f"{U[i]:.6g} m/s, stops at depth {curve.depth[i] * 1e3:.6g} mm of the {setup.thickness * 1e3:.6g} mm "
+                             "target; add a higher velocity (m/s)")
+        upper = float(U[curve.perforated].min())
+        shifted = []
+        if error_estimate:
+            for w in ("A", "B", "C"):
+                shifted.append(perforation_setup(case, cache_dir, shift=w).coefficients)
+        bl = ballistic_limit(setup.coefficients, setup.mass, upper, tolerance=opts.tolerance, shifted=shifted)
+        out["ballistic_limit_m_s"] = bl.value
+        out["ballistic_limit_error_m_s"] = bl.error
+        out["ballistic_limit_estimate"] = {"bracket_m_s": bl.bracket, "integration_m_s": bl.integration,
+                                           "coefficients_m_s": bl.coefficients, "tolerance_m_s": bl.tolerance,
+                                           "iterations": bl.iterations}
+    V_ref = out["ballistic_limit_m_s"] or curve.ballistic_limit_estimate
+    grid = np.linspace(0.5 * V_ref, max(float(U.max()), 2.0 * V_ref), 49)  # the figure's curve: 50 velocities
+    grid = np.sort(np.append(grid, V_ref * (1 + 1e-9)))  # with the limit itself (V_r rises like a square root)
+    dense = perforation_curve(setup.coefficients, setup.mass, grid)
+    out["curve"] = {"striking_velocity_m_s": grid.tolist(), "residual_velocity_m_s": dense.residual_velocity.tolist()}
+    lj = lambert_jonas_fit(U, curve.residual_velocity, out["ballistic_limit_m_s"])
+    out["lambert_jonas"] = None if lj is None else {k: lj[k] for k in ("a", "p", "V_bl_m_s")}
+    out["part4_v_cr_m_s"] = part4_limits(case, setup)
+    data = load_perforation_data(case)
+    if data is not None:
+        out["data"] = _compare_data(setup, data, opts)
+    shots = shot_table_validation(case, cache_dir)
+    if shots is not None:
+        out["shot_table"] = shots
+    return out
+
+
+def _compare_data(setup: PerforationSetup, rows: list[dict], opts) -> dict:
+    """Measured against predicted residual velocities; the Lambert-Jonas fit of the data."""
+    from semianalytic.perforation.model import lambert_jonas, lambert_jonas_fit, perforation_curve
+
+    Vs = np.array([r["Vs_m_s"] for r in rows])
+    Vr = np.array([r["Vr_m_s"] for r in rows])
+    pred = perforation_curve(setup.coefficients, setup.mass, Vs).residual_velocity
+    fit = lambert_jonas_fit(Vs, Vr)
+    return {
+        "source": opts.data_source, "file": opts.data,
+        "striking_velocity_m_s": Vs.tolist(), "measured_residual_velocity_m_s": Vr.tolist(),
+        "predicted_residual_velocity_m_s": pred.tolist(),
+        "mean_abs_error_residual_m_s": float(np.mean(np.abs(pred - Vr))),
+        "lambert_jonas_data": fit,
+        "mean_abs_error_residual_lambert_jonas_data_m_s": None if fit is None else float(
+            np.mean(np.abs(lambert_jonas(Vs, fit["a"], fit["p"], fit["V_bl_m_s"]) - Vr))),
+    }
+
+
+def shot_table_validation(case, cache_dir=None) -> dict | None:
+    """Measured ballistic limits of a Part IV shot table (the case's ``[ballistic_limit] table``,
+    e.g. Table 3) against eq. (11) through the plate, beside Part IV's formulas.
+
+    Per single-plate shot with an exactly measured V_cr: the case's nose shape (the tables give no
+    nose: an ASSUMPTION stated in the output) scaled to the shot's diameter, its length and mass,
+    the shot's target density and thickness, the resistance R(1) = HM delta_H of Part IV
+    (constant up to the exit: the tables give no Y and E for the finite-sphere back face), the
+    half-space stand-in coefficients (one table per diameter; ``coefficients = "half-space"``).
+    Part IV's values come from :func:`semianalytic.ballistic_limit.evaluate.evaluate_case` (its
+    constants C1-C3 were fitted on Table 3 itself: in-sample)."""
+    import copy
+
+    from semianalytic.ballistic_limit.evaluate import evaluate_case as part4_evaluate
+    from semianalytic.ballistic_limit.tables import load_shots
+    from semianalytic.ballistic_limit.theory import resistance_R1
+    from semianalytic.case import parse_case
+    from semianalytic.perforation.model import ballistic_limit
+
+    sec = case.section("ballistic_limit")
+    if sec is None or sec.table is None:
+        return None
+    base = case.path.parent if case.path is not None else Path.cwd()
+    shots = load_shots((base / sec.table).resolve())
+    part4 = part4_evaluate(case)["rows"][: len(shots)]
+    rows = []
+    for shot, p4 in zip(shots, part4):
+        if (shot.is_composite or shot.measured is None or shot.measured_qualifier or shot.projectile_mass is None
+                or shot.projectile_diameter is None or shot.HVdelta_t is None):
+            continue
+        raw = copy.deepcopy(dict(case.raw))
+        raw.pop("ballistic_limit", None)
+        proj = raw["projectile"]
+        for key in ("shank_length", "length", "density", "mass"):
+            proj.pop(key, None)
+        proj.update(diameter=f"{shot.projectile_diameter!r} m", length=f"{shot.projectile_length!r} m",
+                    mass=f"{shot.projectile_mass!r} kg")
+        R1 = float(resistance_R1(shot.target_hardness, shot.target_delta_H, sec.hardness))
+        raw["target"] = {"density": f"{shot.target_density!r} kg/m^3", "thickness": f"{shot.thickness!r} m",
+                         "resistance": {"model": "constant", "value": f"{R1!r} Pa"}}
+        raw["perforation"] = {"coefficients": "half-space", "back_face": "constant", "failure": "hole-growth"}
+        try:
+            setup = perforation_setup(parse_case(raw, case.path), cache_dir)
+        except InputError as exc:
+            rows.append({"name": shot.name, "skipped": exc.message})
+            continue
+        bl = ballistic_limit(setup.coefficients, setup.mass, 5000.0, tolerance=0.05)
+        row = {"name": shot.name, "measured_V_m_s": shot.measured, "model_V_m_s": bl.value, "R1_Pa": R1}
+        row.update({PART4_NAMES[k]: p4[k] for k in PART4_NAMES if p4.get(k) is not None})
+        rows.append(row)
+    used = [r for r in rows if "model_V_m_s" in r]
+    names = ["model_V_m_s", *PART4_NAMES.values()]
+    stats = {}
+    for n in names:
+        errs = [abs(r[n] - r["measured_V_m_s"]) for r in used if r.get(n) is not None]
+        if errs:
+            stats[n] = {"n": len(errs), "mean_abs_error_m_s": float(np.mean(errs)),
+                        "mean_abs_relative_error": float(np.mean([abs(r[n] / r["measured_V_m_s"] - 1) for r in used
+                                                                  if r.get(n) is not None]))}
+    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats}
