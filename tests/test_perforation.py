@@ -297,7 +297,7 @@ def test_run_gains_a_perforation_section(tmp_path):
 
 @pytest.mark.slow
 def test_thick_plate_with_the_plate_table_gives_the_penetrate_depth(tmp_path):
-    """The same identity on the plate BEM table (H = 20 rod lengths: a 319-knot table, about
+    """The same identity on the plate BEM table (H = 20 rod lengths: a 311-knot table, 2 to
     16 min of BEM solves on a loaded machine, then cached).  The plate is not the half-space: the
     image of the monopole lowers A by C^2 ln 2 / (2 pi H) (and B on the nose by C C' ln 2 / (pi H);
     semianalytic.coefficients.plate), which changes the stopping depth by at most
