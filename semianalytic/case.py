@@ -62,6 +62,8 @@ class BodySection(Section):
     diameter: Length | None = None
     points: list[tuple[float, float]] | None = None
     points_unit: LengthUnit | None = None
+    exponent: float | None = Field(default=None, description="power nose: r = (d/2) (x/L_h)^n, n in (0, 1]")
+    nose_length: Length | None = Field(default=None, description="power nose: nose length L_h")
 
     @model_validator(mode="after")
     def _complete(self):
@@ -91,10 +93,11 @@ class ProjectileSection(Section):
     in ``points_unit``, x measured back from the tip, from (0, 0) to the shoulder at r = d/2).
     Ogive and cone take an optional ``meplat_diameter`` (flat tip: truncated nose) or
     ``tip_radius`` (spherically blunted tip); a key a nose kind has no use for is an error.
+    power: r = (d/2) (x/L_h)^n from the tip, ``exponent`` n in (0, 1] and ``nose_length`` L_h.
     ``shank_length`` is the cylindrical part: total length = shank + nose.
     """
 
-    nose: Literal["ogive", "sphere", "cone", "flat", "table"]
+    nose: Literal["ogive", "sphere", "cone", "flat", "table", "power"]
     diameter: Length
     shank_length: NonNegativeLength | None = None
     length: Length | None = Field(default=None, description="total length L = shank + nose (instead of shank_length)")
@@ -107,6 +110,8 @@ class ProjectileSection(Section):
     tip_radius: NonNegativeLength | None = Field(default=None, description="ogive/cone: spherically blunted tip of this radius")
     points: list[tuple[float, float]] | None = None
     points_unit: LengthUnit | None = None
+    exponent: float | None = Field(default=None, description="power nose: r = (d/2) (x/L_h)^n, n in (0, 1]")
+    nose_length: Length | None = Field(default=None, description="power nose: nose length L_h")
     # material (Part I, section 2: elastic projectile and critical velocity)
     youngs_modulus: Pressure | None = None
     poisson_ratio: float | None = None
@@ -136,6 +141,13 @@ class ProjectileSection(Section):
                 raise InputError("projectile.dynamic_factor", f"must be a number >= 1 (dimensionless); got {f!r}")
             data = dict(data, yield_stress=f"{float(dynamic_yield_stress(parse_hardness(data['hardness']), float(f))):.9g} Pa")
         return data
+
+    @field_validator("exponent")
+    @classmethod
+    def _exponent(cls, v):
+        if v is not None and not (math.isfinite(v) and 0.0 < v <= 1.0):
+            raise ValueError(f"must lie in (0, 1] (r = (d/2) (x/L_h)^n); got {v!r}")
+        return v
 
     @field_validator("poisson_ratio")
     @classmethod
@@ -172,10 +184,14 @@ class ProjectileSection(Section):
 
         uses = {"crh": ("ogive",), "half_angle": ("cone",), "corner_radius": ("flat",),
                 "meplat_diameter": ("ogive", "cone"), "tip_radius": ("ogive", "cone"),
-                "points": ("table",), "points_unit": ("table",)}
+                "points": ("table",), "points_unit": ("table",), "exponent": ("power",), "nose_length": ("power",)}
         for key, kinds in uses.items():
             if getattr(self, key) is not None and self.nose not in kinds:
                 raise InputError(f"projectile.{key}", f"has no use for the '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")
+        if self.nose == "power":
+            for key, example in (("exponent", "0.6"), ("nose_length", "'11.8 mm'")):
+                if getattr(self, key) is None:
+                    raise InputError(f"projectile.{key}", f"a power nose r = (d/2) (x/L_h)^n needs it, e.g. {key} = {example}")
         nose = nose_from_section(self)
         if self.length is not None:
             shank = self.length - nose.length

@@ -175,7 +175,58 @@ class SplineCurve:
         return (sx(t, 2), sr(t, 2))
 
 
-Segment = Line | Arc | EllipseArc | SplineCurve
+@dataclass(frozen=True)
+class PowerCurve:
+    """Power-law nose meridian r = R (xi/L)^n, xi = distance back from the tip (this
+    project's own parametrisation: t = r/R in [0, 1], so x = -L t^(1/n), r = R t).
+
+    With t = r/R the speed |dy/dt| stays >= R at the tip, where dr/dxi is infinite for n < 1
+    (the tip is blunt: the tangent is normal to the axis); x(t) = -L t^(1/n) is then not
+    analytic at t = 0 (unless 1/n is an integer), which the BEM layout grades towards."""
+
+    length: float  # L_h
+    radius: float  # R = d/2
+    exponent: float  # n in (0, 1]
+    t0: float = 0.0
+    t1: float = 1.0
+
+    @property
+    def singular_at_t0(self) -> bool:
+        """x(t) is not analytic at the tip (1/n not an integer): the BEM grades panels there."""
+        p = 1.0 / self.exponent
+        return abs(p - round(p)) > 1e-12
+
+    def point(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.length * t ** (1.0 / self.exponent), self.radius * t)
+
+    def derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        p = 1.0 / self.exponent
+        with np.errstate(divide="ignore", invalid="ignore"):
+            dx = np.where(t > 0, -self.length * p * t ** np.maximum(p - 1.0, 0.0), -self.length if p == 1.0 else 0.0)
+        return (dx, self.radius * np.ones_like(t))
+
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t) (by difference: panels near the tip are anchored at t = 0,
+        where the difference is the point itself)."""
+        t, dt = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(dt, dtype=float))
+        p = 1.0 / self.exponent
+        with np.errstate(divide="ignore", invalid="ignore"):
+            # t^p expm1(p log1p(dt/t)): no cancellation for small dt at the shoulder or a cut
+            rel = np.where(t > 0, t**p * np.expm1(p * np.log1p(dt / np.where(t > 0, t, 1.0))), 0.0)
+        x = np.where(t == 0.0, -self.length * np.abs(dt) ** p * np.sign(dt), -self.length * rel)
+        return (x, self.radius * dt)
+
+    def second_derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        p = 1.0 / self.exponent
+        with np.errstate(divide="ignore", invalid="ignore"):
+            ddx = np.where(t > 0, -self.length * p * (p - 1.0) * t ** (p - 2.0), 0.0 if p != 2.0 else -2.0 * self.length)
+        return (ddx, np.zeros_like(t))
+
+
+Segment = Line | Arc | EllipseArc | SplineCurve | PowerCurve
 
 
 @functools.cache
@@ -386,6 +437,20 @@ def ogive_nose(diameter: float, crh: float, meplat_diameter: float = 0.0, tip_ra
     arc = Arc(center=(-L, R - s), radius=s, t0=theta_tip, t1=0.5 * math.pi)
     kind = "sphere" if crh == 0.5 else "ogive"
     return Nose(kind, diameter, L, (arc,), {"crh": crh})
+
+
+def power_nose(diameter: float, exponent: float, nose_length: float) -> Nose:
+    """Power-law nose r = (d/2) (xi/L_h)^n, xi measured back from the tip, 0 < n <= 1
+    (n = 1: the cone of half-angle atan(d/(2 L_h)); n = 1/2: the paraboloid).  Its volume is
+    pi (d/2)^2 L_h / (2n + 1) (the integral of pi r^2 dxi)."""
+    if not diameter > 0:
+        raise InputError("projectile.diameter", "must be positive")
+    if exponent is None or not (math.isfinite(exponent) and 0 < exponent <= 1):
+        raise InputError("projectile.exponent", f"must lie in (0, 1] (r = (d/2) (x/L_h)^n); got {exponent!r}")
+    if nose_length is None or not (math.isfinite(nose_length) and nose_length > 0):
+        raise InputError("projectile.nose_length", f"must be a positive length (e.g. '11.8 mm'); got {nose_length!r} m")
+    curve = PowerCurve(nose_length, 0.5 * diameter, float(exponent))
+    return Nose("power", diameter, nose_length, (curve,), {"exponent": exponent, "nose_length": nose_length})
 
 
 def _check_tip_options(diameter: float, meplat_diameter: float, tip_radius: float) -> None:
@@ -600,6 +665,8 @@ def nose_from_section(sec) -> Nose:
         return cone_nose(sec.diameter, sec.half_angle, meplat, tip)
     if sec.nose == "flat":
         return flat_nose(sec.diameter, sec.corner_radius or 0.0)
+    if sec.nose == "power":
+        return power_nose(sec.diameter, sec.exponent, sec.nose_length)
     return table_nose(sec.points_si(), sec.diameter)
 
 

@@ -589,6 +589,7 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
     cut_on_nose = depth < Lh
     scale = R if not cut_on_nose else max(min(R, depth), 1e-300)
     tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
+    tip_conical = tip_conical or getattr(segs[0], "singular_at_t0", False)  # a power-law tip, 1/n not an integer
     turning = Meridian(segs, closed=False).corners() if len(segs) > 1 else []
     joints = _joints(segs)
 

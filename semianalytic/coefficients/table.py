@@ -224,6 +224,9 @@ def depth_pieces(nose: Nose) -> tuple[list[Piece], list[float]]:
     # pointed one (A ~ P^3, B ~ P^2: polynomial in P; exactly so on a cone)
     pointed = nose.tip_half_angle() < 0.5 * math.pi - 1e-9 and not flat_tip(nose) and not near_round_tip(nose)
     pieces = [Piece("mid" if pointed else "root", 0.0, ends[1], ends[1])]
+    n = nose.parameters.get("exponent", 1.0) if nose.kind == "power" else 1.0
+    if n < 1.0:  # a power-law tip: the wetted radius (P/L_h)^n L_h-scaled is linear in v = (P/l)^n
+        pieces[0] = Piece("graded", 0.0, ends[1], ends[1], 0.0, 1.0 / n)
     corners = graded_breakpoints(nose, kinks)
     for a, b in zip(ends[1:-1], ends[2:]):
         pieces.append(Piece("graded", a, b, b - a, a, GRADED_POWER) if a in corners else Piece("mid", a, b, a))

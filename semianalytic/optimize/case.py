@@ -2,8 +2,10 @@
 
 ``--vary KEY=LOW:HIGH`` (repeatable) names a nose-shape parameter and its bounds, with units
 like case files (``projectile.half_angle=10 deg:40 deg``; ``crh`` is a bare number).  Allowed
-keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; and
-``projectile.meplat_diameter`` / ``projectile.tip_radius`` where the case schema has them.
+keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; power
+``projectile.exponent`` (in (0, 1]) and ``projectile.nose_length``; and
+``projectile.meplat_diameter`` / ``projectile.tip_radius`` (blunted or truncated ogives and
+cones) where the case schema has them.
 
 Every bound corner and the bounds' centre must make a valid case that meets the constraints,
 else exit 2 naming the flag (``--vary projectile.crh``, ``--constraint mass``); nothing is
@@ -20,7 +22,8 @@ from typing import Any, Mapping
 
 from semianalytic.case import Case, ProjectileSection, parse_case
 from semianalytic.errors import InputError
-from semianalytic.optimize.model import CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, Infeasible, shank_for_constraints
+from semianalytic.optimize.model import (CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, PLATE_OBJECTIVES, Infeasible,
+                                         shank_for_constraints)
 from semianalytic.sweep.spec import apply_overrides
 
 # key -> (nose kinds it applies to (None: any with the schema key), SI unit of its values, parse kind)
@@ -29,6 +32,8 @@ NOSE_KEYS: dict[str, tuple[tuple[str, ...] | None, str, str | None]] = {
     "projectile.half_angle": (("cone",), "rad", "angle"),
     "projectile.meplat_diameter": (None, "m", "length"),
     "projectile.tip_radius": (None, "m", "length"),
+    "projectile.exponent": (("power",), "", None),
+    "projectile.nose_length": (("power",), "m", "length"),
 }
 
 
@@ -114,6 +119,10 @@ def parse_variable(text: str) -> Variable:
     high, _ = _parse_bound(hi_t, kind, flag)
     if not high > low:
         raise InputError(flag, f"HIGH must be above LOW; got {rest!r}")
+    if key == "projectile.exponent" and not (low > 0.0 and high <= 1.0):
+        raise InputError(flag, f"the power-law exponent must lie in (0, 1]; got {rest!r}")
+    if key == "projectile.nose_length" and not low > 0.0:
+        raise InputError(flag, f"the nose length must be positive; got LOW = {low:g} m")
     if key == "projectile.crh" and low < 0.5:
         raise InputError(flag, f"crh must be >= 0.5 for a tangent ogive (0.5 is the hemisphere); got LOW = {low:g}")
     return Variable(key, low, high, unit)
@@ -156,11 +165,13 @@ def build_problem(
     depth_model: str = "rigid",
     table_depths: int | None = None,
     table_nose_lengths: float | None = None,
+    striking_velocity: str | None = None,
 ) -> Problem:
     """Parse and check everything the user gave (exit 2 naming the flag on bad input).
 
     ``table_depths`` / ``table_nose_lengths`` set every design's ``[coefficients] depths`` and
-    ``max_depth_nose_lengths`` (the design tables; None: the case's own)."""
+    ``max_depth_nose_lengths`` (the design tables; None: the case's own); ``striking_velocity``
+    (``--striking-velocity``, with units): the depth objective at that one velocity."""
     from semianalytic.geometry import projectile_from_section
 
     if objective not in OBJECTIVES:
@@ -198,16 +209,27 @@ def build_problem(
     if objective == "depth":
         if case.target is None or case.target.resistance is None:
             raise InputError("--objective", "depth needs a [target.resistance] in the case (the target's R_t)")
-        if case.impact is None:
-            raise InputError("--objective", "depth needs [impact] striking_velocities in the case")
-        velocities = tuple(case.impact.striking_velocities)
+        if case.impact is None and striking_velocity is None:
+            raise InputError("--objective", "depth needs [impact] striking_velocities in the case (or --striking-velocity)")
+        velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
         if depth_model == "exact-rod" and (psec.youngs_modulus is None or psec.density is None and psec.mass is None):
             raise InputError("--depth-model", "exact-rod needs projectile.youngs_modulus (e.g. '210 GPa')")
+    elif objective in PLATE_OBJECTIVES:
+        velocities = check_plate_objective(case, objective, striking_velocity)
     else:
         extra = [c for c in cons if c != "caliber"]
         if extra:
             raise InputError("--constraint", f"{extra[0]} is not defined for --objective deep_drag: the deep drag "
                                              "Bbar depends on the nose shape only, not on the mass or the length")
+    if striking_velocity is not None:
+        from semianalytic.units import parse_quantity
+
+        if objective not in ("depth", "residual_velocity"):
+            raise InputError("--striking-velocity", f"applies to --objective depth or residual_velocity, not {objective}")
+        v = parse_quantity(striking_velocity, "velocity", "--striking-velocity")
+        if not v > 0:
+            raise InputError("--striking-velocity", f"must be positive (m/s); got {striking_velocity!r}")
+        velocities = (float(v),)
     start = projectile_from_section(psec)
     fixed_mass = fixed_length = None
     if "mass" in cons:
@@ -233,6 +255,23 @@ def build_problem(
     )
     check_bounds(problem)
     return problem
+
+
+def check_plate_objective(case: Case, objective: str, striking_velocity: str | None) -> tuple[float, ...]:
+    """A plate objective needs a plate ([target] thickness or [[target.layers]]) and the perforation
+    model (:mod:`semianalytic.perforation`); residual_velocity also striking velocities.  Returns them."""
+    target = case.target
+    if target is None or (getattr(target, "thickness", None) is None and not getattr(target, "layers", None)):
+        raise InputError("--objective", f"{objective} needs a plate case: [target] thickness = '20 mm' (or "
+                                        "[[target.layers]]); this case is a half-space")
+    try:
+        import semianalytic.perforation.model  # noqa: F401
+    except ImportError:
+        raise InputError("--objective", f"{objective} needs the perforation model (issue 23), not in this version") from None
+    velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
+    if objective == "residual_velocity" and not velocities and striking_velocity is None:
+        raise InputError("--objective", "residual_velocity needs [impact] striking_velocities (or --striking-velocity)")
+    return velocities
 
 
 def check_bounds(problem: Problem) -> None:

@@ -24,8 +24,14 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--force", action="store_true", help="overwrite --out / --report")
     parser.add_argument("--vary", action="append", default=[], metavar="KEY=LOW:HIGH",
                         help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
-                             "projectile.meplat_diameter, projectile.tip_radius (repeatable)")
-    parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised) or deep_drag (Bbar, minimised)")
+                             "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
+                             "projectile.nose_length (repeatable)")
+    parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised), deep_drag (Bbar, "
+                        "minimised), ballistic_limit (a plate's V_bl, minimised) or residual_velocity (a plate's mean V_r, "
+                        "maximised)")
+    parser.add_argument("--striking-velocity", default=None, metavar="V",
+                        help="depth: the final depth at this one striking velocity (e.g. '800 m/s') instead of the mean "
+                             "over the case's [impact] striking_velocities")
     parser.add_argument("--depth-model", default="rigid", help="rigid or exact-rod (elastic projectile, errata item 5)")
     parser.add_argument("--constraint", action="append", default=[], help="mass, length or caliber (repeatable)")
     parser.add_argument("--method", default="grid-pattern",
@@ -46,7 +52,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--seed", type=int, default=0)
     parser.add_argument("--resolution", type=float, default=1e-3, help="designs rounded to this fraction of each range")
     parser.add_argument("--confirm", type=int, default=5, help="confirmation grid: points per variable (0: none)")
-    parser.add_argument("--scheduler", default=None, help="dask scheduler tcp://HOST:PORT, 'inline' or 'local' (default)")
+    parser.add_argument("--scheduler", default=None, help="dask scheduler tcp://HOST:PORT or its scheduler file FILE.json "
+                        "(docs/cluster.md), 'inline' or 'local' (default)")
     parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
     parser.add_argument("--no-progress", action="store_true")

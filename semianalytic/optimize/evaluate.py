@@ -49,11 +49,12 @@ import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.optimize.case import Problem, design_case
-from semianalytic.optimize.model import Infeasible, deep_drag, depth_objective, quantise, confirmation_grid
+from semianalytic.optimize.model import (PLATE_OBJECTIVES, Infeasible, confirmation_grid, deep_drag, depth_objective,
+                                         quantise)
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
 _SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
-               "projectile.tip_radius")
+               "projectile.tip_radius", "projectile.exponent", "projectile.nose_length")
 CLASSIC_NOSES: dict[str, dict[str, Any]] = {
     name: {**dict.fromkeys(_SHAPE_KEYS), **shape}  # None: the case's other shape keys removed (sharp tips)
     for name, shape in {
@@ -80,14 +81,23 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         case = design_case(problem, overrides)
         psec = case.require("projectile")
         proj = projectile_from_section(psec)
-        table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
-        _, B_deep, _ = table.deep_limit()
         rec.update(
-            nose=psec.nose, mass_kg=proj.mass, length_m=proj.length, shank_length_m=proj.shank_length,
-            nose_length_m=proj.nose_length, deep_drag_Bbar=deep_drag(B_deep, psec.diameter),
+            nose=psec.nose, mass_kg=proj.mass if (psec.density or psec.mass) else None, length_m=proj.length,
+            shank_length_m=proj.shank_length, nose_length_m=proj.nose_length,
             outline_m=np.asarray(proj.nose.meridian().sample(24)).round(12).tolist(),
         )
-        if problem.objective == "depth":
+        if problem.objective == "deep_drag":  # the deep limit alone: a few solves at depth, no table
+            lim = deep_limit_of_case(case, proj.nose)
+            rec["deep_drag_Bbar"] = deep_drag(lim.values[f"B_{case.coefficients.reading}"], psec.diameter)
+            rec["bem_depths_solved"] = lim.solves
+        elif problem.objective in PLATE_OBJECTIVES:  # the plate's tables only (no half-space table)
+            rec.update(plate_objective(problem, case, cache_dir))
+        else:
+            table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
+            rec["deep_drag_Bbar"] = deep_drag(table.deep_limit()[1], psec.diameter)
+        if problem.objective in PLATE_OBJECTIVES:
+            pass
+        elif problem.objective == "depth":
             from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
 
             exact = problem.depth_model == "exact-rod"
@@ -108,6 +118,50 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         rec.update(status="error", message=f"{type(exc).__name__}: {exc}")
     rec["seconds"] = time.perf_counter() - t0
     return rec
+
+
+def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
+    """``ballistic_limit``: V_bl by bisection on Part I, eq. (11) through the plate
+    (:func:`semianalytic.perforation.ballistic_limit`; the upper bracket doubled from the largest
+    striking velocity, or 500 m/s, until it perforates, at most 20 km/s), minimised;
+    ``residual_velocity``: minus the mean V_r over the striking velocities
+    (:func:`semianalytic.perforation.residual_velocity`)."""
+    from semianalytic.perforation import ballistic_limit, residual_velocity
+    from semianalytic.perforation.evaluate import perforation_setup
+
+    setup = perforation_setup(case, cache_dir)
+    out: dict = {"plate_thickness_m": setup.thickness}
+    if problem.objective == "residual_velocity":
+        vr = np.asarray(residual_velocity(setup.coefficients, setup.mass, np.asarray(problem.velocities, float)), float)
+        out["residual_velocities_m_s"] = vr.tolist()
+        out["objective"] = -float(np.mean(vr))
+        return out
+    upper = max(list(problem.velocities) + [500.0])
+    while True:
+        try:
+            bl = ballistic_limit(setup.coefficients, setup.mass, upper)
+            break
+        except ValueError:  # the upper bracket does not perforate
+            if upper >= 20e3:
+                raise InputError("--objective", "ballistic_limit: the plate is not perforated below 20 km/s") from None
+            upper = min(2.0 * upper, 20e3)
+    out.update(objective=float(bl.value), ballistic_limit_m_s=float(bl.value), ballistic_limit_error_m_s=float(bl.error))
+    return out
+
+
+def deep_limit_of_case(case, nose):
+    """:func:`~semianalytic.optimize.model.deep_limit` with the case's BEM and table options."""
+    from semianalytic.optimize.model import deep_limit
+
+    cs = case.coefficients
+    kw = dict(order=case.bem.order, tolerance=cs.tolerance, max_depth_nose_lengths=cs.max_depth_nose_lengths,
+              strict=cs.depths is None)
+    if getattr(case.bem, "refinement", None) is not None:
+        kw["refinement"] = case.bem.refinement
+    try:
+        return deep_limit(nose, **kw)
+    except ValueError as exc:
+        raise InputError("coefficients.max_depth_nose_lengths", str(exc)) from None
 
 
 @dataclass
@@ -219,6 +273,55 @@ def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int)
             "stopped at --maxfev polls", "success": bool(done)}
 
 
+def finer_bem(problem: Problem) -> tuple:
+    """The finer BEM of the optimum's check: two Gauss points more per panel and twice the panels
+    of the case's (order 8, refinement 0.3 by default: order 10, refinement 0.6)."""
+    bem = json.loads(problem.raw_json).get("bem") or {}
+    order, refinement = int(bem.get("order", 8)), float(bem.get("refinement") or 0.3)
+    return (("bem.order", min(order + 2, 16)), ("bem.refinement", min(2.0 * refinement, 8.0)))
+
+
+def finer_check(problem: Problem, best_x, low, high, cache_dir, n: int, half_width: float) -> dict | None:
+    """The optimum checked on a finer BEM (:func:`finer_bem`: order + 2, twice the panels): the
+    objective at the optimum and at its neighbours one confirmation-grid step away along each
+    variable, re-solved; confirmed when no neighbour beats the optimum there, and, along each
+    variable, the vertex of the parabola through the three (the finer optimum, this project's own
+    check).  Only for ``deep_drag`` (a few solves per design); None otherwise."""
+    import dataclasses
+
+    if problem.objective != "deep_drag":
+        return None
+    extra = finer_bem(problem)
+    fine = dataclasses.replace(problem, table_overrides=tuple(problem.table_overrides) + extra)
+    best_x = np.asarray(best_x, float)
+    step = 2.0 * half_width * (np.asarray(high) - np.asarray(low)) / max(n - 1, 1)
+    f0 = evaluate_design(fine, problem.overrides(best_x), cache_dir)
+    if f0["status"] != "ok":
+        return {"status": f0["status"], "message": f0["message"]}
+    out = {"bem": dict(extra), "objective": f0["objective"], "variables": [], "confirmed": True}
+    for j in range(len(best_x)):
+        fs, xs = [], []
+        for sgn in (-1.0, 1.0):
+            x = best_x.copy()
+            x[j] = float(np.clip(x[j] + sgn * step[j], low[j], high[j]))
+            if x[j] == best_x[j]:
+                continue
+            r = evaluate_design(fine, problem.overrides(x), cache_dir)
+            if r["status"] == "ok":
+                fs.append(r["objective"])
+                xs.append(x[j])
+        better = [f for f in fs if f < f0["objective"]]
+        vertex = None
+        if len(fs) == 2:
+            (a, c), (fa, fc), b, fb = xs, fs, best_x[j], f0["objective"]
+            den = (b - a) * (fb - fc) - (b - c) * (fb - fa)
+            if den != 0.0:
+                vertex = float(b - 0.5 * ((b - a) ** 2 * (fb - fc) - (b - c) ** 2 * (fb - fa)) / den)
+        out["variables"].append({"x": xs, "objective": fs, "parabola_vertex": vertex, "step": float(step[j])})
+        out["confirmed"] = out["confirmed"] and not better
+    return out
+
+
 def optimise(
     problem: Problem,
     *,
@@ -235,6 +338,7 @@ def optimise(
     confirm: int = 5,
     confirm_half_width: float = 0.04,
     classic_noses: bool = True,
+    finer_bem: bool = True,
     on_done: Callable[[int], None] | None = None,
 ) -> dict:
     """Search the problem's bounds (``method``: see the module docstring), then the confirmation
@@ -321,6 +425,7 @@ def optimise(
             own_tables = {"objective": own["objective"], "design_tables_objective": best["objective"],
                           "relative_difference": abs(best["objective"] - own["objective"]) / abs(own["objective"]),
                           "seconds": own["seconds"], "table_overrides": dict(problem.table_overrides)}
+    finer = finer_check(problem, best_x, low, high, cache_dir, max(confirm, 5), confirm_half_width) if finer_bem else None
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -335,6 +440,7 @@ def optimise(
         "striking_velocities_m_s": list(problem.velocities),
         "optimizer": info,
         "own_tables_check": own_tables,
+        "finer_check": finer,
         "optimum": {**best, "x": best_x.tolist()},
         "start": start_rec,
         "confirmation": grid,

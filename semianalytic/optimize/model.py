@@ -10,7 +10,11 @@ A design changes the nose; the shank then follows the constraint:
 
 Objectives (minimised): ``depth``: minus the mean final depth over the striking velocities
 (Part I, eq. (11); rigid, or the elastic projectile with the exact-rod energy, errata item 5);
-``deep_drag``: the deep-penetration drag Bbar = 4 B / (pi d^2) (Part I, eq. (13), deep limit).
+``deep_drag``: the deep-penetration drag Bbar = 4 B / (pi d^2) (Part I, eq. (13), deep limit),
+from :func:`deep_limit` alone (a few BEM solves at depth, not a table from first contact);
+``ballistic_limit``: the plate's ballistic limit V_bl (minimised); ``residual_velocity``: minus
+the mean residual velocity over the striking velocities (both by Part I, eq. (11) through the
+plate: :mod:`semianalytic.perforation`).
 """
 
 from __future__ import annotations
@@ -20,7 +24,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
-OBJECTIVES = ("depth", "deep_drag")
+OBJECTIVES = ("depth", "deep_drag", "ballistic_limit", "residual_velocity")
+PLATE_OBJECTIVES = ("ballistic_limit", "residual_velocity")  # need a plate ([target] thickness or layers)
 CONSTRAINTS = ("mass", "length", "caliber")
 DEPTH_MODELS = ("rigid", "exact-rod")
 
@@ -72,6 +77,76 @@ def shank_for_constraints(
                                      f"mass {mass * 1e3:.4g} g")
         return ShankChoice(shank, None)
     return ShankChoice(start_shank, None)
+
+
+@dataclass(frozen=True)
+class DeepLimit:
+    """A, B (three readings), C of the deep-penetration limit P -> infinity (SI), with the
+    extrapolation's error estimate per coefficient and the depths solved."""
+
+    values: dict
+    errors: dict
+    depths: tuple[float, ...]
+
+    @property
+    def solves(self) -> int:
+        return len(self.depths)
+
+
+def deep_limit(nose, *, order: int = 8, refinement: float = 0.3, levels: int = 6, tolerance: float = 1e-5,
+               max_depth_nose_lengths: float = 300.0, max_solves: int = 24, strict: bool = True) -> DeepLimit:
+    """The deep-penetration limit of A, B, C alone (Part I, eqs. (12)-(14) as P -> infinity).
+
+    The same rule as the deep piece of a certified table
+    (:mod:`semianalytic.coefficients.table`): direct solves at P = b / v past the last
+    breakpoint b, for v = 2^-3 .. 2^-6 (the table's four deepest initial knots, fewer when
+    ``max_depth_nose_lengths`` is shallower than 64 b), the limit
+    extrapolated to v = 0 by the polynomial through them, its error the change from dropping
+    the farthest point; deeper solves (v halved) until that error is within half the
+    tolerance of each coefficient's magnitude over these solves (the three readings of B
+    share one scale: B_bernoulli = dA/dP vanishes at depth).  Only these depths are solved (the objective
+    ``deep_drag`` reads nothing else); raises ValueError past ``max_depth_nose_lengths``
+    (``strict=False``, the case's fixed depth grid: stops there, the error estimate kept).
+    """
+    from semianalytic.bem.panels import LayoutOptions
+    from semianalytic.coefficients.table import CONTROLLED, _extrapolate_to_zero, depth_pieces, solve_depth
+
+    pieces, kinks = depth_pieces(nose)
+    deep = pieces[-1]
+    opts = LayoutOptions(order, refinement, levels)
+    P_max = max_depth_nose_lengths * nose.depth_unit
+    names = CONTROLLED + ("phi_tip",)
+    vs, rows = [], []
+
+    def solve(v: float) -> None:
+        P = float(deep.P(v))
+        if P > P_max * (1 + 1e-12):
+            raise ValueError(f"the deep limit needs solves to {P / nose.depth_unit:.4g} nose lengths, beyond "
+                             f"max_depth_nose_lengths = {max_depth_nose_lengths:g}")
+        d = solve_depth(nose, P, opts, kinks)
+        vs.append(v)
+        rows.append({k: getattr(d, k) for k in names})
+
+    # the table's initial deep knots: v = 1, 1/2, .., 2^-n with n = min(6, log2(P_max / b)); the four deepest
+    n = int(min(6, math.floor(math.log2(P_max / deep.P_lo)))) if P_max > deep.P_lo else 0
+    for k in range(max(n - 3, 0), n + 1):
+        solve(2.0**-k)
+    while True:
+        v = np.array(vs[-4:])
+        values, errors = {}, {}
+        for name in names:
+            val, err, _, _ = _extrapolate_to_zero(v, np.array([r[name] for r in rows[-4:]]))
+            values[name], errors[name] = val, err
+        values["C"], errors["C"] = math.pi * nose.radius**2, 0.0  # exact once the nose is in
+        scale = {q: max([abs(values[q])] + [abs(r[q]) for r in rows]) or 1.0 for q in CONTROLLED}
+        b_scale = max(scale[q] for q in CONTROLLED if q.startswith("B_"))  # B_bernoulli = dA/dP -> 0 at depth
+        scale.update({q: b_scale for q in CONTROLLED if q.startswith("B_")})
+        if all(errors[q] <= 0.5 * tolerance * scale[q] for q in CONTROLLED) or len(vs) >= max_solves:
+            break
+        if not strict and float(deep.P(0.5 * vs[-1])) > P_max * (1 + 1e-12):
+            break  # a fixed depth range (``strict=False``): the limit with its error estimate, as the table does
+        solve(0.5 * vs[-1])
+    return DeepLimit(values, errors, tuple(float(deep.P(v)) for v in vs))
 
 
 def depth_objective(depths) -> float:

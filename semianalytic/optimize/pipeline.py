@@ -35,7 +35,7 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     if args.method not in ("grid-pattern", "grid-nm", "de"):
         raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {args.method!r}")
     problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model,
-                            args.table_depths, args.table_nose_lengths)
+                            args.table_depths, args.table_nose_lengths, getattr(args, "striking_velocity", None))
     out = Path(args.out) if args.out else None
     report = Path(args.report) if args.report else None
     if out is not None:

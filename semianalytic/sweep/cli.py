@@ -36,13 +36,15 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "triangular(LOW,MODE,HIGH)")
     parser.add_argument("--samples", type=integer(0, 10_000_000), default=0, help="number of Monte-Carlo samples (with --sample)")
     parser.add_argument("--seed", type=integer(0, 2**63 - 1), default=0, help="seed of the Monte-Carlo draws (default 0)")
-    parser.add_argument("--analysis", choices=["penetration", "cavity"], default=None,
-                        help="what to compute per case (default: from the case's sections)")
+    parser.add_argument("--analysis", choices=["penetration", "cavity", "perforation"], default=None,
+                        help="what to compute per case (default: from the case's sections; perforation: residual "
+                             "velocity and ballistic limit of a plate case, e.g. --vary target.thickness=10:30:5 mm)")
     parser.add_argument("--full", action="store_true",
                         help="penetration: also quasi-rigid and elastic depths (slower, case by case)")
     parser.add_argument("--format", dest="fmt", choices=["csv", "parquet"], default="csv")
     parser.add_argument("--scheduler", default=None,
-                        help="dask scheduler address (tcp://HOST:PORT); 'inline' runs in this process, 'local' "
+                        help="dask scheduler address (tcp://HOST:PORT) or its scheduler file (FILE.json, written by "
+                             "'dask scheduler --scheduler-file'; docs/cluster.md); 'inline' runs in this process, 'local' "
                              "starts a local cluster; default: chosen from the work (inline for cheap cases, "
                              "a local cluster for geometry sweeps)")
     parser.add_argument("--workers", type=integer(1, 256), default=2, help="workers of the local cluster (default 2)")
@@ -57,7 +59,6 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from semianalytic.case import load_case
     from semianalytic.sweep.engine import run_sweep
-    from semianalytic.sweep.kernels import select_kernel
     from semianalytic.sweep.spec import build_spec
 
     if args.resume and args.force:
@@ -74,7 +75,7 @@ def run(args: argparse.Namespace) -> int:
     from semianalytic.guards import check_case
 
     check_case(case)  # refuse before any worker starts what would not fit in memory
-    kernel = select_kernel(case, args.analysis, cache_dir=args.cache_dir, full=args.full)
+    kernel = sweep_kernel(case, args.analysis, args.cache_dir, args.full)
     summary = run_sweep(
         args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
         scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size,
@@ -96,6 +97,24 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
                       f"(n = {st['n']})")
     return 0 if summary.n_error == 0 else 1
+
+
+def sweep_kernel(case, analysis, cache_dir, full):
+    """The kernel: ``perforation`` when asked for, or by default for a plate case (``[target]
+    thickness`` or layers, issue 23 item 6), else :func:`semianalytic.sweep.kernels.select_kernel`."""
+    from semianalytic.sweep.kernels import select_kernel
+    from semianalytic.sweep.perforation import PerforationKernel, has_plate
+
+    if analysis == "perforation" or (analysis is None and case.projectile is not None and has_plate(case)):
+        try:
+            import semianalytic.perforation.model  # noqa: F401
+        except ImportError:
+            raise InputError("--analysis", "perforation needs the perforation model (issue 23), not in this version") from None
+        if not has_plate(case):
+            raise InputError("target.thickness", "--analysis perforation needs a plate case: [target] thickness = "
+                                                 "'20 mm' (or [[target.layers]])")
+        return PerforationKernel(cache_dir=None if cache_dir is None else str(cache_dir))
+    return select_kernel(case, analysis, cache_dir=cache_dir, full=full)
 
 
 def check_axes(case, spec) -> None:

@@ -385,7 +385,9 @@ def own_session() -> int:
 
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
-    else a client of the scheduler at that address (InputError if it cannot be used)."""
+    else a client of the scheduler at that address, or of the one a scheduler file names
+    (``dask scheduler --scheduler-file F.json``: a path ending in ``.json``; docs/cluster.md);
+    InputError if it cannot be used."""
     sched = (scheduler or "local").strip()
     if sched == "inline":
         return None, None, "inline"
@@ -412,13 +414,20 @@ def connect(scheduler: str | None, workers: int):
         return client, cluster, "local"
     client = None
     try:
-        client = Client(sched, timeout="10s")
+        if sched.endswith(".json"):  # a scheduler file (dask scheduler --scheduler-file F): its address inside
+            try:
+                address = json.loads(Path(sched).expanduser().read_text())["address"]
+            except (OSError, ValueError, KeyError, TypeError) as exc:
+                raise ValueError(f"not a readable dask scheduler file (no 'address'): {exc}") from None
+        else:
+            address = sched
+        client = Client(address, timeout="10s")
         client.wait_for_workers(1, timeout=60)
     except (OSError, TimeoutError, ValueError) as exc:
         if client is not None:
             client.close()
         raise InputError("--scheduler", f"cannot use the dask scheduler {sched!r}: {exc}") from None
-    return client, None, sched
+    return client, None, address
 
 
 def run_sweep(

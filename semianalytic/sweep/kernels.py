@@ -32,6 +32,7 @@ _NOT_GEOMETRY = frozenset({
     "projectile.shank_length", "projectile.length", "projectile.density", "projectile.mass",
     "projectile.youngs_modulus", "projectile.poisson_ratio", "projectile.yield_stress",
     "projectile.dynamic_yield_stress", "projectile.buckling", "projectile.buckling_table",
+    "projectile.hardness", "projectile.dynamic_factor",
 })
 
 
