@@ -26,7 +26,7 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
 
     if args.steps is not None and args.steps < 50:
         raise InputError("--steps", f"must be at least 50; got {args.steps}")
-    check_output_dir(args.out, args.force)
+    check_output_dir(args.out, args.force, protect=(args.case,))
     if args.report is not None:
         from semianalytic.io import check_report_target
 
@@ -70,7 +70,7 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
 
     extra = (lambda d, f: diagnosis_blocks(d, diag)) if diag is not None else None
     doc, figs = build_report(result, command, cv, extra)
-    with StagedDir(args.out, args.force) as out:
+    with StagedDir(args.out, args.force, protect=(args.case,)) as out:
         out.write_json("posterior.json", result["posterior"])
         if cv is not None:
             out.write_json("cross_validation.json", cv)

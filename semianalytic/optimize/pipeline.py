@@ -39,7 +39,7 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     out = Path(args.out) if args.out else None
     report = Path(args.report) if args.report else None
     if out is not None:
-        check_output_dir(out, args.force)
+        check_output_dir(out, args.force, protect=(args.case,))
     if report is not None:
         check_report_target(report, args.force)
     cache_dir = str(table_dir(args.cache_dir))
