@@ -162,3 +162,20 @@ def _cache_entry_fault(data: bytes, key: str) -> str | None:
     if header.get("sha256") != hashlib.sha256(payload).hexdigest():
         return "checksum mismatch (damaged)"
     return None
+
+
+def case_input_path(case_path: str | os.PathLike | None, name: str, field: str) -> Path:
+    """The file ``name`` that a case file names (a data table, a shot table, another case), read
+    from the case file's folder or below it only (issue 27): an absolute path, a ``..`` or a
+    symbolic link leading out of that folder is refused naming ``field``, so that a case cannot
+    make a command read any file of the system.  Without a case path: the working folder."""
+    base = Path(case_path).parent if case_path is not None else Path(".")
+    try:
+        root = base.resolve()
+        candidate = (root / str(name)).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise InputError(field, f"cannot use the path {str(name)!r}: {exc}") from None
+    if Path(str(name)).is_absolute() or (candidate != root and root not in candidate.parents):
+        raise InputError(field, f"{str(name)!r} lies outside the case file's folder; a file named by a case is read "
+                                "only from that folder or below it (copy the file beside the case)")
+    return candidate

@@ -47,7 +47,10 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
         raise InputError("--transfer", "is used only with --cross-validate or --diagnose")
     if args.cross_validate or args.diagnose:
         sec = case.section("calibration")
-        paths = [Path(case.path).parent / p for p in (sec.transfer if sec else [])] + [Path(p) for p in args.transfer]
+        from semianalytic.io import case_input_path
+
+        paths = [case_input_path(case.path, p, "calibration.transfer") for p in (sec.transfer if sec else [])] + [
+            Path(p) for p in args.transfer]
         for p in paths:
             tcase = load_case(p)
             transfer.append((tcase, coefficients_for_case(tcase, args.coefficients, args.cache_dir)[0]))

@@ -102,8 +102,9 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     data = case.require("data")
     if data.file is None:
         return []
-    base = Path(case.path).parent if case.path is not None else Path.cwd()
-    path = (base / data.file).resolve()
+    from semianalytic.io import case_input_path
+
+    path = case_input_path(case.path, data.file, "data.file")
     if not path.is_file():
         raise InputError("data.file", f"{str(path)!r} does not exist")
     names, table = read_csv_rows(path)
