@@ -145,7 +145,9 @@ def _cache_entry_fault(data: bytes, key: str) -> str | None:
     if not data:
         return "empty file"
     if not data.startswith(CACHE_MAGIC):
-        return "not a verified cache entry (damaged or of an older version)"
+        if data.startswith(b"PK\x03\x04"):
+            return "a bare archive without key or checksum (an earlier version's, or copied there)"
+        return "not a verified cache entry (damaged)"
     head, sep, payload = data[len(CACHE_MAGIC):].partition(b"\n")
     if not sep:
         return "truncated header"

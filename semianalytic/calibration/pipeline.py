@@ -36,6 +36,14 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
     case = load_case(args.case)
     for sec in ("projectile", "target", "data"):
         case.require(sec)
+    from semianalytic.calibration.case import CalibrationSection
+    from semianalytic.guards import check_sampler
+
+    csec = case.section("calibration") or CalibrationSection()
+    n_models = len(args.model or csec.models or ["m"] * 2)
+    n_params = len(args.parameter or csec.parameters or ["p"] * 3)
+    check_sampler(csec.walkers, args.steps or csec.steps, n_params, n_models,
+                  "--steps" if args.steps else "calibration.steps")
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []
