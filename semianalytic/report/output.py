@@ -89,6 +89,18 @@ def _forbidden(resolved: Path, protect: Iterable[str | os.PathLike] = ()) -> str
     return None
 
 
+def forbidden_output(out: str | os.PathLike, field: str = "--out", protect: Iterable[str | os.PathLike] = ()) -> None:
+    """Refuse, outright, an output folder that is ``/``, the home folder, the working folder (or
+    above it) or the folder of a case file in ``protect`` (commands that write named files into
+    a folder instead of replacing it, e.g. ``sweep``)."""
+    try:
+        why = _forbidden(Path(out).resolve(), protect)
+    except (OSError, RuntimeError) as exc:
+        raise InputError(field, f"cannot use {str(out)!r}: {exc}") from None
+    if why is not None:
+        raise InputError(field, f"{str(out)!r} {why}; name a new folder (e.g. out/sweep1)")
+
+
 def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out",
                      protect: Iterable[str | os.PathLike] = ()) -> Path:
     """Refuse an existing non-empty ``out`` without ``force``; with ``force``, one holding any
