@@ -64,10 +64,17 @@ def contained_path(root: str | os.PathLike, relative: str, field: str) -> Path:
 
 
 def check_report_target(path: str | os.PathLike, force: bool) -> Path:
-    """A report path that may be written: refuse to overwrite an existing one without force."""
+    """A report path that may be written: refuse to overwrite an existing one without force, and
+    (issue 27) a report into ``/``, the home folder (or above it) or a folder above the working
+    folder (``--report OUT/../../..``)."""
     path = Path(path)
     try:
         exists = path.exists()
+        folder = path.parent.resolve()
+        cwd, home = Path.cwd().resolve(), Path.home().resolve()
+        if folder == Path(folder.anchor) or folder == home or folder in home.parents or folder in cwd.parents:
+            raise InputError("--report", f"{str(path.parent)!r} is the root or home folder or lies above the working "
+                                         "folder; write reports into a folder of their own")
     except OSError as exc:  # e.g. a name longer than the file system allows
         raise InputError("--report", f"cannot use {str(path)[:60]!r}: {exc.strerror}") from None
     if exists and not force:
