@@ -133,6 +133,8 @@ def output_dir(text: str) -> str:
         _fail("expected a folder; got an empty path")
     if "\x00" in text:
         _fail("a path may not contain a NUL character")
+    if not all(c.isprintable() for c in text):  # issue 27: a name that would break every line that shows it
+        _fail(f"a folder name may not contain control characters (newline, tab, ...); got {text!r}")
     path = Path(text).expanduser()
     _check_name_lengths(path, text)
     if path.exists() and not path.is_dir():

@@ -300,3 +300,27 @@ def test_time_and_memory_budgets_refuse_before_work(capsys, tmp_path):
         assert rc == 2 and err.startswith(f"error: {field}"), (argv, err)
         assert len(err.strip().splitlines()) == 1
     assert not (tmp_path / "c").exists() and not (tmp_path / "o").exists() and not (tmp_path / "s").exists()
+
+
+def test_posterior_with_string_samples_or_too_large_is_bad_input(tmp_path):
+    """A posterior whose draws are strings ("1.5e8" would convert silently) or a file of 100 MB
+    (no posterior of calibrate is: ~0.5 MB for 1000 draws) is refused naming the field."""
+    from semianalytic.calibration.case import read_posterior
+    from semianalytic.errors import InputError
+
+    good = json.loads((ROOT / "reports" / "calibration_piekutowski1999" / "posterior.json").read_text())
+    read_posterior(ROOT / "reports" / "calibration_piekutowski1999" / "posterior.json")  # the real one reads
+    bad = json.loads(json.dumps(good))
+    samples = bad["models"]["rigid"]["samples"]
+    samples["sigma"] = [str(v) for v in samples["sigma"]]
+    path = tmp_path / "strings.json"
+    path.write_text(json.dumps(bad))
+    with pytest.raises(InputError) as err:
+        read_posterior(path)
+    assert err.value.field == "models.rigid.samples.sigma"
+    huge = tmp_path / "huge.json"
+    with huge.open("wb") as fh:  # a sparse file of 100 MB: refused by its size, before it is read
+        fh.truncate(100 * 10**6)
+    with pytest.raises(InputError) as err:
+        read_posterior(huge)
+    assert err.value.field == "--posterior" and "100 MB" in err.value.message
