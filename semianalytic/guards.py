@@ -207,10 +207,10 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     # needed (building the deepest layout costs most of a second).
     rough = _arithmetic_unknowns(nose, order, ref, depth)
     if math.isfinite(rough) and bem_bytes(4.0 * rough) <= limit:
-        return bem_bytes(rough)
+        return check_table_time(case, bem_bytes(rough))
     need = need_for(nose)
     if need <= limit:
-        return need
+        return check_table_time(case, need)
     what = f"the BEM solve of the {nose.kind} nose (~{bem_halfspace_unknowns(nose, order, ref, depth):.3g} unknowns)"
     if ref > default_refinement and need_for(nose, r=default_refinement) <= limit:
         best = _largest(lambda r: need_for(nose, r=r) <= limit, default_refinement, ref)
@@ -338,6 +338,26 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
         check_body(case, order, refinement)
     if field:
         check_field_grid(case)
+
+
+# One adaptive coefficient table (~70 depths) costs about 1e-4 s per N^2 (N unknowns) on this
+# project's machine under load (N = 224: 5.2 s; N = 304: 9.7 s, load 7-10, both in one run);
+# 5e-5 s is taken (an idle core, about twice as fast), so that only what runs past the budget
+# on any core of this kind is refused.
+TABLE_SECONDS_PER_UNKNOWN2 = 5e-5
+
+
+def check_table_time(case, need_bytes: float) -> float:
+    """Refuse a coefficient table whose estimated time exceeds the time budget (issue 27); its
+    size is the BEM guard's (bytes = BEM_BYTES_PER_UNKNOWN2 N^2).  Returns ``need_bytes``."""
+    seconds = need_bytes / BEM_BYTES_PER_UNKNOWN2 * TABLE_SECONDS_PER_UNKNOWN2
+    psec = case.projectile
+    field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
+        psec.nose, "projectile")
+    check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(need_bytes / BEM_BYTES_PER_UNKNOWN2):.3g}"
+                      " unknowns)", seconds=seconds,
+               hint="make the nose less slender, give fewer points or a lower refinement (or raise the time budget)")
+    return need_bytes
 
 
 def _depth_unit(case) -> float:

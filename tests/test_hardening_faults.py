@@ -281,7 +281,11 @@ def test_case_named_files_stay_in_the_case_folder(tmp_path, capsys):
     assert rc == 2 and err.startswith("error: ballistic_limit.table") and "outside the case file's folder" in err, err
 
 
-def test_time_and_memory_budgets_refuse_before_work(capsys, tmp_path):
+def test_time_and_memory_budgets_refuse_before_work(capsys, tmp_path, monkeypatch):
+    monkeypatch.delenv("SEMIANALYTIC_TIME_LIMIT", raising=False)
+    monkeypatch.delenv("SEMIANALYTIC_MEMORY_LIMIT", raising=False)
+    flat = tmp_path / "crh3e5.toml"
+    flat.write_text(FIG15A.read_text().replace("crh = 3.0", "crh = 300000.0"))
     cases = [
         (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", tmp_path / "c", "--steps", "1000000000"],
          "--steps"),
@@ -294,6 +298,7 @@ def test_time_and_memory_budgets_refuse_before_work(capsys, tmp_path):
         (["sweep", FIG15A, "--out", tmp_path / "s", "--samples", "10000000", "--sample",
           "target.density=normal(2710 kg/m^3, 10 kg/m^3)", "--scheduler", "inline"], "--samples"),
         (["penetrate", FIG15A, "--memory-limit", "1e30"], "--memory-limit"),
+        (["penetrate", flat], "projectile.crh"),  # fits 4 GB, but its table would take about half an hour
     ]
     for argv, field in cases:
         rc, err = _run(capsys, *argv)
