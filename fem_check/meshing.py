@@ -18,8 +18,9 @@ nose tip, the nose-shank junction and the free-surface corner or waterline.  Qua
 meshes (``order=2``) carry curved (isoparametric) boundary edges; every node of a curved
 boundary is moved onto the exact meridian curve of :mod:`semianalytic.geometry`.
 
-Generated meshes are cached in ``meshes/cache/`` (git-ignored), keyed by a hash of the
-geometry and mesh parameters; a cache hit skips gmsh entirely.
+Generated meshes are cached in the per-user cache (``meshes`` under :func:`semianalytic.cache.cache_root`,
+or ``$FEM_CHECK_MESH_CACHE``), keyed by a hash of the geometry and mesh parameters, each entry
+with its key and checksum; a cache hit skips gmsh entirely.
 """
 
 from __future__ import annotations
@@ -396,31 +397,56 @@ def annulus_domain(a: float, outer: float, options: MeshOptions, interface: floa
 
 
 def cache_dir() -> Path:
-    """``meshes/cache`` of the repository (override with FEM_CHECK_MESH_CACHE)."""
+    """The mesh cache: ``$FEM_CHECK_MESH_CACHE``, else the folder ``meshes`` of the per-user cache
+    (:func:`semianalytic.cache.cache_root`: ``$SEMIANALYTIC_CACHE_DIR`` or platformdirs'
+    ``~/.cache/semianalytic``).  Never a folder of the project or the working directory."""
     env = os.environ.get("FEM_CHECK_MESH_CACHE")
-    path = Path(env) if env else Path(__file__).resolve().parents[1] / "meshes" / "cache"
-    path.mkdir(parents=True, exist_ok=True)
-    return path
+    if env:
+        return Path(env).expanduser()
+    from semianalytic.cache import cache_root
+
+    return cache_root() / "meshes"
+
+
+@contextlib.contextmanager
+def _private_home():
+    """``HOME`` and the XDG folders pointed at a temporary folder while gmsh runs (FLTK, linked into
+    gmsh, writes ``~/.fltk/fltk.org/fltk.prefs``; gmsh its option files): nothing of gmsh lands in
+    the user's home folder.  Restored, and the folder removed, afterwards."""
+    keys = ("HOME", "XDG_CONFIG_HOME", "XDG_CACHE_HOME", "XDG_DATA_HOME")
+    saved = {k: os.environ.get(k) for k in keys}
+    with tempfile.TemporaryDirectory(prefix="fem_check_gmsh_home-") as tmp:
+        try:
+            for k in keys:
+                os.environ[k] = tmp
+            yield tmp
+        finally:
+            for k, v in saved.items():
+                if v is None:
+                    os.environ.pop(k, None)
+                else:
+                    os.environ[k] = v
 
 
 @contextlib.contextmanager
 def _gmsh_session():
     import gmsh
 
-    started = not gmsh.isInitialized()
-    if started:
-        gmsh.initialize(readConfigFiles=False)
-    gmsh.option.setNumber("General.Terminal", 0)
-    gmsh.option.setNumber("General.NumThreads", 1)
-    gmsh.option.setNumber("General.Verbosity", 1)
-    name = f"fem_check_{os.getpid()}_{id(object())}"
-    gmsh.model.add(name)
-    try:
-        yield gmsh
-    finally:
-        gmsh.model.remove()
+    with _private_home():
+        started = not gmsh.isInitialized()
         if started:
-            gmsh.finalize()
+            gmsh.initialize(readConfigFiles=False)
+        gmsh.option.setNumber("General.Terminal", 0)
+        gmsh.option.setNumber("General.NumThreads", 1)
+        gmsh.option.setNumber("General.Verbosity", 1)
+        name = f"fem_check_{os.getpid()}_{id(object())}"
+        gmsh.model.add(name)
+        try:
+            yield gmsh
+        finally:
+            gmsh.model.remove()
+            if started:
+                gmsh.finalize()
 
 
 def _generate(domain: Domain, options: MeshOptions, path: Path) -> None:
@@ -624,56 +650,70 @@ def _snap_curved(dm: DomainMesh) -> DomainMesh:
 
 
 def build_mesh(domain: Domain, options: MeshOptions, use_cache: bool = True) -> DomainMesh:
-    """The scikit-fem mesh of ``domain`` (from the cache when possible)."""
-    path = cache_dir() / f"{domain.kind}_{domain.key(options)}.msh"
-    if not (use_cache and path.exists()):
-        _generate(domain, options, path)
-    arrays = _read_arrays(path) if use_cache else None
+    """The scikit-fem mesh of ``domain``: from the cache when a verified entry is there, else gmsh
+    (into a temporary folder), meshio and the facet matching, stored in the cache."""
+    key = f"{domain.kind}_{domain.key(options)}"
+    path = _arrays_path(cache_dir() / f"{key}.msh")
+    arrays = _read_arrays(path, key) if use_cache else None
     if arrays is None:
-        with contextlib.redirect_stdout(io.StringIO()):  # meshio prints an empty line for msh 4.1
-            msh = meshio.read(path)
+        with tempfile.TemporaryDirectory(prefix="fem_check_mesh-") as tmp:
+            msh_path = Path(tmp) / f"{key}.msh"
+            _generate(domain, options, msh_path)
+            with contextlib.redirect_stdout(io.StringIO()):  # meshio prints an empty line for msh 4.1
+                msh = meshio.read(msh_path)
         mesh, boundaries, pieces = _to_skfem(msh, domain, options.order)
         if use_cache:
-            _write_arrays(path, mesh, boundaries, pieces)
+            _write_arrays(path, key, mesh, boundaries, pieces)
     else:
         mesh, boundaries, pieces = arrays
-    return _snap_curved(DomainMesh(domain, options, mesh, boundaries, pieces, path))
+    return _snap_curved(DomainMesh(domain, options, mesh, boundaries, pieces, path if use_cache else None))
 
 
-# The scikit-fem arrays of a cached .msh file (nodes in scikit-fem's order, elements, tagged facets),
-# stored beside it: reading them back is several times faster than parsing the .msh with meshio and
-# matching its tagged lines to facets again, and gives the same arrays.  Bumped when _to_skfem changes.
-ARRAYS_VERSION = 1
+# The cache holds, per mesh, the scikit-fem arrays (nodes in scikit-fem's order, elements, tagged
+# facets) of the gmsh mesh as a self-verifying entry (semianalytic.io.write_cache_entry: key and
+# checksum, written atomically): reading them back is several times faster than parsing a .msh with
+# meshio and matching its tagged lines to facets again, and gives the same arrays.  A damaged,
+# truncated or mismatched entry is discarded with a warning and the mesh made again.  Bumped when
+# _to_skfem changes.
+ARRAYS_VERSION = 2
 
 
 def _arrays_path(path: Path) -> Path:
     return path.with_name(f"{path.stem}.skfem{ARRAYS_VERSION}.npz")
 
 
-def _write_arrays(path: Path, mesh, boundaries: dict, pieces: dict) -> None:
-    from semianalytic.io import atomic_write_bytes
+def _write_arrays(path: Path, key: str, mesh, boundaries: dict, pieces: dict) -> None:
+    from semianalytic.io import write_cache_entry
 
     buf = io.BytesIO()
     np.savez(buf, order=np.array(2 if isinstance(mesh, MeshTri2) else 1), doflocs=mesh.doflocs, t=mesh.t,
              **{f"boundary:{k}": v for k, v in boundaries.items()}, **{f"piece:{k}": v for k, v in pieces.items()})
     try:
-        atomic_write_bytes(_arrays_path(path), buf.getvalue())
+        write_cache_entry(path, key, buf.getvalue(), what="fem_check mesh arrays", version=ARRAYS_VERSION)
     except OSError:
-        pass  # a read-only cache: the .msh is read each time, as before
+        pass  # a read-only cache: the mesh is made each time
 
 
-def _read_arrays(path: Path):
-    """(mesh, boundaries, pieces) from the arrays beside ``path``, or None (absent, older than the
-    .msh or unreadable: the .msh is read instead)."""
-    sidecar = _arrays_path(path)
+def _read_arrays(path: Path, key: str):
+    """(mesh, boundaries, pieces) of the verified entry ``path`` stored under ``key``, or None
+    (absent; damaged or mismatched: removed with a warning)."""
+    import warnings
+
+    from semianalytic.io import CacheWarning, read_cache_entry
+
+    payload = read_cache_entry(path, key, "fem_check mesh cache")
+    if payload is None:
+        return None
     try:
-        if sidecar.stat().st_mtime < path.stat().st_mtime:
-            return None
-        with np.load(sidecar) as z:
+        with np.load(io.BytesIO(payload), allow_pickle=False) as z:
             cls = MeshTri2 if int(z["order"]) == 2 else MeshTri1
             mesh = cls(np.ascontiguousarray(z["doflocs"]), np.ascontiguousarray(z["t"]))
             boundaries = {k.split(":", 1)[1]: z[k] for k in z.files if k.startswith("boundary:")}
             pieces = {int(k.split(":", 1)[1]): z[k] for k in z.files if k.startswith("piece:")}
-    except (OSError, ValueError, KeyError):
+    except Exception as exc:  # noqa: BLE001 - an entry that cannot be read is made again, never trusted
+        warnings.warn(f"fem_check mesh cache: discarded the entry {path.name!r}: unreadable ({type(exc).__name__}); "
+                      "it is rebuilt", CacheWarning, stacklevel=2)
+        with contextlib.suppress(OSError):
+            path.unlink()
         return None
     return mesh, boundaries, pieces

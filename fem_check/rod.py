@@ -288,6 +288,10 @@ def run(args) -> int:
     if not sigma0 > 0:
         raise InputError("--sigma0", "must be positive (a compressive end stress, e.g. '1 GPa')")
     case = load_case(args.case) if args.case else None
+    if case is not None and case.projectile is not None:  # the driven study builds the nose's BEM table
+        from semianalytic.guards import check_case
+
+        check_case(case)
     rod = rod_from_case(case)[0] if case else DEFAULT_ROD
     report = None if args.no_report else Report(Path(args.out), args.name, args.force)
     if report:

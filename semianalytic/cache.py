@@ -11,7 +11,8 @@ so a changed nose, option or numerics never reads a stale table.  The folder is,
 an explicit ``cache_dir`` (the commands' ``--cache-dir``), ``$SEMIANALYTIC_CACHE_DIR``, or
 the per-user cache folder of platformdirs (``~/.cache/semianalytic`` on Linux), sub-folder
 ``coefficients``.  Commands never write a cache into the working directory.  Files are
-written atomically; an unreadable or other-version file is rebuilt.
+written atomically and carry their key and a checksum (:func:`semianalytic.io.write_cache_entry`);
+a damaged, truncated, other-version or other-nose file is discarded with a warning and rebuilt.
 
 Used alike by the ``run`` pipeline, the sweeps, the ``penetrate`` command and fem_check.
 """
@@ -69,18 +70,18 @@ def table_key(nose, **options) -> str:
 
 def cached_coefficient_table(nose, cache_dir: str | os.PathLike | None = None, **options):
     """:func:`semianalytic.coefficients.table.coefficient_table`, read from the cache when there,
-    else built and stored (atomically) under :func:`table_key`."""
-    from semianalytic.coefficients.table import CoefficientTable, coefficient_table
-    from semianalytic.io import atomic_write_bytes
+    else built and stored (atomically) under :func:`table_key`.  Each entry carries its key and a
+    checksum (:func:`read_table_entry`): a damaged or mismatched one is discarded with a warning
+    and rebuilt."""
+    from semianalytic.coefficients.table import coefficient_table
 
-    path = table_dir(cache_dir) / f"{table_key(nose, **{k: v for k, v in options.items() if k != 'progress'})}.npz"
-    if path.exists():
-        try:
-            return CoefficientTable.from_npz(path)
-        except (ValueError, KeyError, OSError):
-            pass  # another version or a damaged file: rebuild
+    key = table_key(nose, **{k: v for k, v in options.items() if k != 'progress'})
+    path = table_dir(cache_dir) / f"{key}.npz"
+    table = read_table_entry(path, key, nose)
+    if table is not None:
+        return table
     table = coefficient_table(nose, **options)
-    atomic_write_bytes(path, table.to_npz_bytes())
+    write_table_entry(path, key, table)
     return table
 
 
@@ -103,19 +104,71 @@ def cached_plate_table(nose, thickness: float, cache_dir: str | os.PathLike | No
     """:func:`semianalytic.coefficients.plate.plate_coefficient_table` of a nose in a plate of
     thickness H [m], read from the cache when there, else built and stored (atomically) under
     :func:`plate_table_key`.  ``reading`` is applied after reading (it is not part of the key)."""
+    import io
+    import warnings
+
     from semianalytic.coefficients.plate import PlateCoefficientTable, plate_coefficient_table
-    from semianalytic.io import atomic_write_bytes
+    from semianalytic.io import CacheWarning, read_cache_entry, write_cache_entry
 
     reading = options.pop("reading", "body")
-    path = table_dir(cache_dir) / f"{plate_table_key(nose, thickness, **options)}.npz"
-    if path.exists():
+    key = plate_table_key(nose, thickness, **options)
+    path = table_dir(cache_dir) / f"{key}.npz"
+    payload = read_cache_entry(path, key, "plate-table cache")  # key and checksum verified
+    if payload is not None:
         try:
-            return PlateCoefficientTable.from_npz(path).with_reading(reading)
-        except (ValueError, KeyError, OSError, EOFError, zipfile.BadZipFile):
-            pass  # another version or a damaged file: rebuild
+            return PlateCoefficientTable.from_npz(io.BytesIO(payload)).with_reading(reading)
+        except Exception as exc:  # noqa: BLE001 - an unreadable entry is rebuilt, never trusted
+            warnings.warn(f"plate-table cache: discarded the entry {path.name!r}: unreadable ({type(exc).__name__}); "
+                          "it is rebuilt", CacheWarning, stacklevel=2)
     table = plate_coefficient_table(nose, thickness, **options)
-    atomic_write_bytes(path, table.to_npz_bytes())
+    try:
+        write_cache_entry(path, key, table.to_npz_bytes(), thickness=float(thickness))
+    except OSError:
+        pass  # a cache that cannot be written: the table is rebuilt next time
     return table.with_reading(reading)
+
+
+def read_table_entry(path: Path, key: str, nose=None):
+    """The table stored in ``path`` under ``key``, or None (absent; or damaged, truncated, of
+    another version or of another nose: then removed with a warning).  With ``nose``, the
+    table's own nose (kind, diameter, nose length) must be that nose."""
+    import io
+    import math
+    import warnings
+
+    from semianalytic.coefficients.table import CoefficientTable
+    from semianalytic.io import CacheWarning, read_cache_entry
+
+    payload = read_cache_entry(path, key, "coefficient-table cache")
+    if payload is None:
+        return None
+    why = None
+    try:
+        table = CoefficientTable.from_npz(io.BytesIO(payload))
+    except Exception as exc:  # noqa: BLE001 - any unreadable entry is rebuilt, never trusted
+        table, why = None, f"unreadable ({type(exc).__name__})"
+    if table is not None and nose is not None and not (
+            table.nose_kind == nose.kind and math.isclose(table.diameter, nose.diameter, rel_tol=1e-12)
+            and math.isclose(table.nose_length, nose.length, rel_tol=1e-12, abs_tol=1e-300)):
+        table, why = None, f"a table of another nose ({table.nose_kind}, diameter {table.diameter:g} m)"
+    if table is None:
+        warnings.warn(f"coefficient-table cache: discarded the entry {path.name!r}: {why}; it is rebuilt",
+                      CacheWarning, stacklevel=2)
+        try:
+            path.unlink()
+        except OSError:
+            pass
+    return table
+
+
+def write_table_entry(path: Path, key: str, table) -> None:
+    """Store ``table`` under ``key`` with its checksum (atomically; a read-only cache is skipped)."""
+    from semianalytic.io import write_cache_entry
+
+    try:
+        write_cache_entry(path, key, table.to_npz_bytes(), nose=[table.nose_kind, table.diameter, table.nose_length])
+    except OSError:
+        pass  # a cache that cannot be written: the table is rebuilt next time
 
 
 def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: bool = False, tolerance=None):

@@ -242,6 +242,12 @@ class TargetSection(Section):
 # and every model of Part I assumes a projectile that stays intact, which it does not at
 # hypervelocity.  Above 12 km/s a case is refused (exit status 2) rather than warned.
 MAX_STRIKING_VELOCITY = 12e3
+# Issue 27 (this project's own limits): below 1 mm/s an impact is a quasi-static indentation
+# (and the ODE of the motion has no resolvable time scale: U_s = 1e-9 m/s overflowed a spline);
+# above 6 km/s the shock pressure of a metal-on-metal impact exceeds ~100 GPa, the projectile
+# melts or vaporises, and no model here (each assumes a solid projectile) reaches: warned.
+MIN_STRIKING_VELOCITY = 1e-3
+SOLID_STRIKING_VELOCITY = 6e3
 
 
 class ImpactSection(Section):
@@ -258,6 +264,21 @@ class ImpactSection(Section):
                     f"item {k}: {u / 1e3:.4g} km/s is above {MAX_STRIKING_VELOCITY / 1e3:.0f} km/s, faster than any "
                     "launcher (two-stage light-gas guns reach ~10 km/s) and far past every model here (intact projectile)"
                 )
+            if u < MIN_STRIKING_VELOCITY:
+                raise ValueError(
+                    f"item {k}: {u:.3g} m/s is below {MIN_STRIKING_VELOCITY * 1e3:g} mm/s: a quasi-static indentation, "
+                    "not an impact (the penetration models are dynamic)"
+                )
+        fast = [u for u in v if u > SOLID_STRIKING_VELOCITY]
+        if fast:
+            import warnings
+
+            from semianalytic.errors import ModelValidityWarning
+
+            warnings.warn(
+                f"impact.striking_velocities: {max(fast) / 1e3:.4g} km/s is above {SOLID_STRIKING_VELOCITY / 1e3:g} km/s, "
+                "beyond the reach of every model here: they assume a solid projectile, which melts or vaporises "
+                "at these shock pressures (> ~100 GPa)", ModelValidityWarning, stacklevel=2)
         return v
 
 

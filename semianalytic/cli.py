@@ -83,10 +83,12 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         warnings.showwarning = collect
         for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning, ResourceWarning):
             warnings.simplefilter("ignore", category)  # the libraries' business, not the user's
+        restore = _terminate_as_interrupt()
         try:
             rc = _run_command(prog, name, module_name, help_, rest)
         finally:
-            set_memory_limit(None)  # the flag holds for one command (tests call main() repeatedly)
+            set_memory_limit(None)
+            restore()  # the flag holds for one command (tests call main() repeatedly)
     if rc != 2:  # bad input: the one line naming the field is all that is printed
         shown: dict[str, int] = {}
         for text in notes:  # a sweep may warn once per value: the first few of each kind
@@ -98,6 +100,30 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
             if n > MAX_WARNINGS_PER_KIND:
                 print(f"warning: {kind}: {n - MAX_WARNINGS_PER_KIND} more warnings like the above", file=sys.stderr)
     return rc
+
+
+def _terminate_as_interrupt():
+    """SIGTERM and SIGHUP raise KeyboardInterrupt during a command (as Ctrl-C does), so that every
+    staging folder and temporary file is removed on the way out (issue 27).  Returns the undo."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
+
+    old = {}
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+        if sig is not None and signal.getsignal(sig) in (signal.SIG_DFL, None):
+            old[sig] = signal.signal(sig, interrupt)
+
+    def restore():
+        for sig, handler in old.items():
+            signal.signal(sig, handler)
+
+    return restore
 
 
 def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:
@@ -119,8 +145,11 @@ def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[
     except RecursionError:
         print(f"error: input: nested too deeply for {prog} {name}", file=sys.stderr)
         return 2
-    except KeyboardInterrupt:
-        print("interrupted", file=sys.stderr)
+    except KeyboardInterrupt as exc:
+        from semianalytic.errors import one_line
+
+        why = one_line(str(exc)) or "Ctrl-C"
+        print(f"interrupted ({why}): unfinished output removed (a sweep keeps its finished cases for --resume)", file=sys.stderr)
         return 1
     except BrokenPipeError:  # the reader went away (`... | head`): nothing more to say, no traceback
         try:

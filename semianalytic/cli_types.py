@@ -133,6 +133,8 @@ def output_dir(text: str) -> str:
         _fail("expected a folder; got an empty path")
     if "\x00" in text:
         _fail("a path may not contain a NUL character")
+    if not all(c.isprintable() for c in text):  # issue 27: a name that would break every line that shows it
+        _fail(f"a folder name may not contain control characters (newline, tab, ...); got {text!r}")
     path = Path(text).expanduser()
     _check_name_lengths(path, text)
     if path.exists() and not path.is_dir():
@@ -173,7 +175,18 @@ def memory_size(text: str) -> float:
     value = _parse_float(match.group(1)) * _BYTES[match.group(2).lower()]
     if not value >= MIN_MEMORY:
         _fail(f"must be at least 64MB; got {text!r}")
+    physical = physical_memory()
+    if not value <= physical:  # a budget the machine cannot give would let an allocation fail mid-run
+        _fail(f"must be at most this machine's memory ({physical / 1e9:.3g} GB); got {text!r}")
     return value
+
+
+def physical_memory() -> float:
+    """Bytes of physical memory of this machine (1 TB where the system does not say)."""
+    try:
+        return float(os.sysconf("SC_PAGE_SIZE") * os.sysconf("SC_PHYS_PAGES"))
+    except (ValueError, OSError, AttributeError):
+        return 1e12
 
 
 def quantity(kind: str, positive: bool = True):

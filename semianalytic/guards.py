@@ -217,10 +217,10 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     # needed (building the deepest layout costs most of a second).
     rough = _arithmetic_unknowns(nose, order, ref, depth)
     if math.isfinite(rough) and bem_bytes(4.0 * rough) <= limit:
-        return bem_bytes(rough)
+        return check_table_time(case, bem_bytes(rough))
     need = need_for(nose)
     if need <= limit:
-        return need
+        return check_table_time(case, need)
     what = f"the BEM solve of the {nose.kind} nose (~{bem_halfspace_unknowns(nose, order, ref, depth):.3g} unknowns)"
     if ref > default_refinement and need_for(nose, r=default_refinement) <= limit:
         best = _largest(lambda r: need_for(nose, r=r) <= limit, default_refinement, ref)
@@ -238,8 +238,10 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
         best = _largest(lambda a: need_for(nose_from_section(psec.model_copy(update={"half_angle": a}))) <= limit,
                         math.radians(60), worst)
         _refuse("projectile.half_angle", what, need, limit, f"the smallest half_angle that fits is {math.degrees(best):.4g} deg")
-    field = "projectile.points" if psec.nose == "table" else "projectile"
-    _refuse(field, what, need, limit, "make the nose less slender or lower the refinement")
+    if psec.nose == "table":
+        _refuse("projectile.points", what, need, limit, f"use fewer points ({len(psec.points)} given: each adds panels; "
+                                                         "a few dozen describe a smooth nose) or lower the refinement")
+    _refuse("projectile", what, need, limit, "make the nose less slender or lower the refinement")
     return need
 
 
@@ -348,8 +350,118 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
         check_field_grid(case)
 
 
+# One adaptive coefficient table (~70 depths) costs about 1e-4 s per N^2 (N unknowns) on this
+# project's machine under load (N = 224: 5.2 s; N = 304: 9.7 s, load 7-10, both in one run);
+# 5e-5 s is taken (an idle core, about twice as fast), so that only what runs past the budget
+# on any core of this kind is refused.
+TABLE_SECONDS_PER_UNKNOWN2 = 5e-5
+
+
+def check_table_time(case, need_bytes: float) -> float:
+    """Refuse a coefficient table whose estimated time exceeds the time budget (issue 27); its
+    size is the BEM guard's (bytes = BEM_BYTES_PER_UNKNOWN2 N^2).  Returns ``need_bytes``."""
+    seconds = need_bytes / BEM_BYTES_PER_UNKNOWN2 * TABLE_SECONDS_PER_UNKNOWN2
+    psec = case.projectile
+    field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
+        psec.nose, "projectile")
+    check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(need_bytes / BEM_BYTES_PER_UNKNOWN2):.3g}"
+                      " unknowns)", seconds=seconds,
+               hint="make the nose less slender, give fewer points or a lower refinement (or raise the time budget)")
+    return need_bytes
+
+
 def _depth_unit(case) -> float:
     """The tables' depth unit of the case's nose (L_h, or the radius of a nose shorter than it)."""
     from semianalytic.geometry import nose_from_section
 
     return nose_from_section(case.projectile).depth_unit
+
+
+# ------------------------------------------------------------------------------------
+# Work counted before it starts (issue 27): sample and step counts, optimiser sizes.  The time
+# estimate uses the cheapest measured cost of one unit of work (so that it refuses only what
+# would certainly run long); the memory estimate the bytes each unit keeps.
+
+DEFAULT_TIME_LIMIT = 600.0  # s: 10 minutes
+TIME_ENV = "SEMIANALYTIC_TIME_LIMIT"
+# seconds per unit of work, lower bounds measured on this project's machine (2 cores, loaded):
+DESIGN_SECONDS = 1.0  # one optimiser design: one BEM coefficient table (sweep.engine.GEOMETRY_SECONDS)
+LIKELIHOOD_SECONDS = 2e-5  # one emcee log-posterior evaluation over a few dozen shots
+SWEEP_CASE_SECONDS = 1e-6  # one vectorised sweep case (a few microseconds)
+# bytes each unit keeps until the end:
+CHAIN_BYTES_PER_DRAW = 8.0  # one float of an emcee chain (per walker, step and parameter + log-prob)
+SWEEP_BYTES_PER_CASE = 1000.0  # one case of a sweep: its draws, results row, data-frame and file copies
+
+
+def time_limit() -> float:
+    """The time budget in seconds: ``$SEMIANALYTIC_TIME_LIMIT`` (seconds), else 10 minutes."""
+    env = os.environ.get(TIME_ENV)
+    if env:
+        try:
+            value = float(env)
+        except ValueError:
+            raise InputError(TIME_ENV, f"expected seconds, e.g. 3600; got {env!r}") from None
+        if not (math.isfinite(value) and value > 0):
+            raise InputError(TIME_ENV, f"expected a positive number of seconds; got {env!r}")
+        return value
+    return DEFAULT_TIME_LIMIT
+
+
+def format_seconds(s: float) -> str:
+    if s >= 86400 * 365:
+        return f"{s / (86400 * 365):.3g} years"
+    if s >= 86400:
+        return f"{s / 86400:.3g} days"
+    if s >= 3600:
+        return f"{s / 3600:.3g} h"
+    if s >= 60:
+        return f"{s / 60:.3g} min"
+    return f"{s:.3g} s"
+
+
+def check_work(field: str, what: str, *, seconds: float = 0.0, nbytes: float = 0.0, hint: str = "") -> None:
+    """Refuse ``what`` (exit status 2 naming ``field``) when its estimated time or memory exceeds
+    the budgets; ``hint`` says what to change."""
+    limit = memory_limit()
+    if not nbytes <= limit:
+        _refuse(field, what, nbytes, limit, hint)
+    budget = time_limit()
+    if not seconds <= budget:
+        raise InputError(field, f"{what} takes at least {format_seconds(seconds)}, above the time budget of "
+                                f"{format_seconds(budget)} (${TIME_ENV}, seconds); {hint}")
+
+
+def check_optimiser(n_variables: int, *, method: str, coarse: int, confirm: int, popsize: int, maxiter: int,
+                    maxfev: int = 15) -> float:
+    """Refuse an optimisation whose design count (each design one BEM table) exceeds the time
+    budget; returns the number of designs."""
+    n = max(int(n_variables), 1)
+    if method == "de":
+        search, field, hint = float(popsize) * n * (maxiter + 1), "--popsize", "lower --popsize or --maxiter"
+    else:
+        search = float(coarse) ** n + min(maxfev, 15) * (2 * n if method == "grid-pattern" else 1)
+        field, hint = "--coarse", "lower --coarse"
+    grid = float(confirm) ** n if confirm else 0.0
+    if grid > search:
+        field, hint = "--confirm", "lower --confirm"
+    designs = search + grid
+    check_work(field, f"the optimisation ({designs:.3g} designs of {n} variable(s), each a BEM table)",
+               seconds=designs * DESIGN_SECONDS, hint=hint)
+    return designs
+
+
+def check_sampler(walkers: int, steps: int, n_parameters: int, n_models: int = 1, field: str = "--steps") -> None:
+    """Refuse an emcee run whose chains would not fit in memory or would run past the time budget."""
+    draws = float(walkers) * float(steps) * max(n_models, 1)
+    check_work(field, f"the sampler ({walkers} walkers x {steps} steps x {n_models} model(s))",
+               seconds=draws * LIKELIHOOD_SECONDS, nbytes=draws * (n_parameters + 2) * CHAIN_BYTES_PER_DRAW * 2,
+               hint="lower --steps (the reports use 1000 to 5000)")
+
+
+def check_sweep_size(n_cases: int, n_geometries: int = 1, field: str = "--samples") -> None:
+    """Refuse a sweep whose cases would not fit in memory, or whose coefficient tables (one per
+    geometry) would run past the time budget."""
+    check_work(field, f"the sweep ({n_cases} cases, {n_geometries} geometries)",
+               seconds=n_cases * SWEEP_CASE_SECONDS + max(n_geometries - 1, 0) * DESIGN_SECONDS,
+               nbytes=n_cases * SWEEP_BYTES_PER_CASE,
+               hint="use fewer samples or values (or raise the budgets if the machine has them)")

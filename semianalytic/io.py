@@ -64,10 +64,17 @@ def contained_path(root: str | os.PathLike, relative: str, field: str) -> Path:
 
 
 def check_report_target(path: str | os.PathLike, force: bool) -> Path:
-    """A report path that may be written: refuse to overwrite an existing one without force."""
+    """A report path that may be written: refuse to overwrite an existing one without force, and
+    (issue 27) a report into ``/``, the home folder (or above it) or a folder above the working
+    folder (``--report OUT/../../..``)."""
     path = Path(path)
     try:
         exists = path.exists()
+        folder = path.parent.resolve()
+        cwd, home = Path.cwd().resolve(), Path.home().resolve()
+        if folder == Path(folder.anchor) or folder == home or folder in home.parents or folder in cwd.parents:
+            raise InputError("--report", f"{str(path.parent)!r} is the root or home folder or lies above the working "
+                                         "folder; write reports into a folder of their own")
     except OSError as exc:  # e.g. a name longer than the file system allows
         raise InputError("--report", f"cannot use {str(path)[:60]!r}: {exc.strerror}") from None
     if exists and not force:
@@ -88,3 +95,96 @@ def extract_revision(revision: str, dest: str | os.PathLike, *paths: str, field:
     dest.mkdir(parents=True, exist_ok=True)
     subprocess.run(["tar", "-x", "-C", str(dest)], input=got.stdout, check=True)
     return dest
+
+
+# ------------------------------------------------------------------------------------------
+# Self-verifying cache entries (issue 27; this project's own format): a file is
+#   b"SEMIANALYTIC-CACHE 1\n" + one JSON line {"key", "sha256", "size", ...} + b"\n" + payload,
+# written atomically (temporary file + rename: concurrent writers of one key each rename a
+# whole file, the last one wins, a reader never sees a mix).  On read the key, the size and the
+# SHA-256 of the payload are checked; a damaged, truncated, empty, old-format or mismatched
+# entry (another key's file copied under this name) is removed with a warning and the caller
+# rebuilds it.
+
+CACHE_MAGIC = b"SEMIANALYTIC-CACHE 1\n"
+
+
+class CacheWarning(UserWarning):
+    """A cache entry was found damaged or mismatched and is rebuilt."""
+
+
+def write_cache_entry(path: str | os.PathLike, key: str, payload: bytes, **describe: Any) -> Path:
+    """Store ``payload`` under ``key`` in ``path`` with its checksum (atomically)."""
+    import hashlib
+
+    header = {"key": key, "sha256": hashlib.sha256(payload).hexdigest(), "size": len(payload), **describe}
+    line = json.dumps(header, sort_keys=True, default=str).encode("utf-8")
+    return atomic_write_bytes(path, CACHE_MAGIC + line + b"\n" + payload)
+
+
+def read_cache_entry(path: str | os.PathLike, key: str, what: str = "cache") -> bytes | None:
+    """The payload stored under ``key`` in ``path``; None when absent.  A damaged or mismatched
+    entry is removed with a :class:`CacheWarning` naming what was wrong (then None)."""
+    import warnings
+
+    path = Path(path)
+    try:
+        data = path.read_bytes()
+    except FileNotFoundError:
+        return None
+    except OSError as exc:
+        why = f"unreadable ({exc.strerror or exc})"
+    else:
+        why = _cache_entry_fault(data, key)
+        if why is None:
+            return data[len(CACHE_MAGIC):].partition(b"\n")[2]
+    warnings.warn(f"{what}: discarded the entry {path.name!r}: {why}; it is rebuilt", CacheWarning, stacklevel=2)
+    try:
+        path.unlink()
+    except OSError:
+        pass
+    return None
+
+
+def _cache_entry_fault(data: bytes, key: str) -> str | None:
+    import hashlib
+
+    if not data:
+        return "empty file"
+    if not data.startswith(CACHE_MAGIC):
+        if data.startswith(b"PK\x03\x04"):
+            return "a bare archive without key or checksum (an earlier version's, or copied there)"
+        return "not a verified cache entry (damaged)"
+    head, sep, payload = data[len(CACHE_MAGIC):].partition(b"\n")
+    if not sep:
+        return "truncated header"
+    try:
+        header = json.loads(head.decode("utf-8"))
+        if not isinstance(header, dict):
+            raise ValueError
+    except (UnicodeDecodeError, ValueError):
+        return "damaged header"
+    if header.get("key") != key:
+        return f"stored under key {str(header.get('key'))[:24]!r}, not {key[:24]!r} (an entry of something else)"
+    if header.get("size") != len(payload):
+        return f"truncated ({len(payload)} of {header.get('size')} bytes)"
+    if header.get("sha256") != hashlib.sha256(payload).hexdigest():
+        return "checksum mismatch (damaged)"
+    return None
+
+
+def case_input_path(case_path: str | os.PathLike | None, name: str, field: str) -> Path:
+    """The file ``name`` that a case file names (a data table, a shot table, another case), read
+    from the case file's folder or below it only (issue 27): an absolute path, a ``..`` or a
+    symbolic link leading out of that folder is refused naming ``field``, so that a case cannot
+    make a command read any file of the system.  Without a case path: the working folder."""
+    base = Path(case_path).parent if case_path is not None else Path(".")
+    try:
+        root = base.resolve()
+        candidate = (root / str(name)).resolve()
+    except (OSError, RuntimeError, ValueError) as exc:
+        raise InputError(field, f"cannot use the path {str(name)!r}: {exc}") from None
+    if Path(str(name)).is_absolute() or (candidate != root and root not in candidate.parents):
+        raise InputError(field, f"{str(name)!r} lies outside the case file's folder; a file named by a case is read "
+                                "only from that folder or below it (copy the file beside the case)")
+    return candidate

@@ -46,6 +46,17 @@ class Section(BaseModel):
                 raise ValueError(problem)
         return value
 
+    @field_validator("*", mode="after")
+    @classmethod
+    def _plausible(cls, value: Any, info: ValidationInfo) -> Any:
+        """The field's plausible range (:data:`semianalytic.units.PLAUSIBLE_RANGES`, issue 27)."""
+        from semianalytic.units import plausibility_problem
+
+        problem = plausibility_problem(info.field_name or "", value)
+        if problem:
+            raise ValueError(problem)
+        return value
+
 
 _NUMBER_TYPES = (float, int)
 

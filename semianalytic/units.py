@@ -60,6 +60,39 @@ PHYSICAL_BOUNDS: dict[str, tuple[float, float, str]] = {
 }
 
 
+# field name -> (smallest, largest SI value, reason): the plausible range of a material or
+# plate quantity wherever a case section names it (issue 27; this project's own limits, wider
+# than any material in the bundled cases and the literature it reproduces, far narrower than
+# PHYSICAL_BOUNDS).  Checked by schema.Section for every section, so each field has its range
+# and its reason in one place.  Outside: exit status 2 naming the field.
+_STRENGTH = (1e3, 1e12, "1 kPa (softer than wet clay: a fluid for these solid-mechanics models) to 1 TPa "
+                        "(ten times the theoretical strength of diamond)")
+_MODULUS = (1e5, 1e13, "0.1 MPa (softer than rubber) to 10 TPa (ten times diamond's 1.2 TPa)")
+_DENSITY = (50.0, 3e4, "50 kg/m^3 (the lightest rigid foams; a gas or an aerogel is not a target or projectile "
+                       "of these models) to 30 000 kg/m^3 (above osmium, 22 590)")
+PLAUSIBLE_RANGES: dict[str, tuple[float, float, str]] = {
+    **{name: _STRENGTH for name in (
+        "yield_stress", "dynamic_yield_stress", "cavity_yield_stress", "tensile_strength", "compressive_strength",
+        "hardness", "target_hardness", "projectile_hardness", "resistance", "eroding_resistance")},
+    **{name: _MODULUS for name in ("youngs_modulus", "bulk_modulus", "shear_modulus")},
+    **{name: _DENSITY for name in ("density", "target_density", "projectile_density")},
+    "thickness": (1e-6, 10.0, "1 um (a film, not a plate: Part IV's plates are millimetres thick) to 10 m "
+                              "(thicker than any armour plate)"),
+}
+
+
+def plausibility_problem(name: str, value: Any) -> str | None:
+    """Why the SI ``value`` of the field ``name`` lies outside :data:`PLAUSIBLE_RANGES`, or None."""
+    bounds = PLAUSIBLE_RANGES.get(name)
+    if bounds is None or isinstance(value, bool) or not isinstance(value, float) or value == 0:
+        return None
+    low, high, why = bounds
+    if low <= abs(value) <= high:
+        return None
+    unit = {"thickness": "m"}.get(name, "kg/m^3" if "density" in name else "Pa")
+    return f"{value:.4g} {unit} lies outside the plausible range {why}"
+
+
 def _import_pint():
     """pint without its optional dask support: pint.compat imports dask.base whenever dask is
     installed (about 80 ms at every start-up), and the product never hands dask arrays to pint.
@@ -108,7 +141,14 @@ def parse_quantity(value: Any, kind: str, field: str = "") -> float:
         raise InputError(field, f"expected a {kind} as a number and a unit, e.g. '{example}'; got {value!r}")
     out = _common_unit_si(value, kind)
     if out is None:  # anything but a plain number and one of the common units: pint decides
-        out = _pint_si(value, kind, field, example, si)
+        try:
+            out = _pint_si(value, kind, field, example, si)
+        except (OverflowError, ZeroDivisionError, ArithmeticError, TypeError, ValueError) as exc:
+            if isinstance(exc, InputError):
+                raise
+            # e.g. '2**2000 mm': an integer too large for a float (or 1/0) inside pint's arithmetic
+            raise InputError(field, f"{value!r} is not a finite {kind} ({type(exc).__name__}); "
+                                    f"expected e.g. '{example}'") from None
     if not math.isfinite(out):
         raise InputError(field, f"{value!r} is not a finite {kind}")
     low, high, text = PHYSICAL_BOUNDS[kind]

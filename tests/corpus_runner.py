@@ -8,6 +8,7 @@ Shared by ``tests/test_corpus.py`` (assertions in ``make test``) and ``tests/har
   ``error: FIELD...`` (the field written by hand, independent of the code);
 - ``# expect: warn FIELD``: exit 0 with a ``warning: FIELD`` line on stderr;
 - ``# expect: ok``: exit 0;
+- ``# expect-text: TEXT``: where the field is a whole section, the key the message must name;
 - ``# commands: NAME ...``: the primary commands (default: coefficients, penetrate, run).
 
 Binary and non-UTF-8 files carry the same ASCII header before their bytes.
@@ -37,7 +38,7 @@ def corpus_files() -> list[Path]:
 def headers(path: Path) -> dict[str, str]:
     out = {}
     for line in path.read_bytes().split(b"\n")[:6]:
-        m = re.match(rb"# (expect|commands|why): (.*)", line)
+        m = re.match(rb"# (expect-text|expect|commands|why): (.*)", line)
         if m:
             out[m.group(1).decode()] = m.group(2).decode("utf-8", "replace").strip()
     return out

@@ -1,4 +1,4 @@
-"""Tally of the hardening corpus (issue 13) -> ``reports/hardening.md``.
+"""Tally of the hardening corpus (issues 13 and 27) and the fault tests -> ``reports/hardening.md``.
 
     .venv/bin/python tests/hardening_tally.py --out reports
 
@@ -60,7 +60,68 @@ OPTIONS = [
                       "--vary", "impact.striking_velocity=400:500:10 m/s"]),
     ("semianalytic", ["bench-bem"]),
     ("semianalytic", ["nosuchcommand"]),
+    # issue 27: bounds before work, flags accepted silently before, output folders refused outright
+    ("semianalytic", ["penetrate", OGIVE, "--memory-limit", "1e30"]),
+    ("semianalytic", ["calibrate", str(ROOT / "cases/piekutowski1999_var4340.toml"), "--out", "{tmp}/c",
+                      "--steps", "1000000000", "--quiet"]),
+    ("semianalytic", ["optimize", str(ROOT / "cases/optimize_fig5_into_fig15a.toml"), "--out", "{tmp}/o",
+                      "--vary", "projectile.crh=1:6", "--coarse", "1000", "--no-progress"]),
+    ("semianalytic", ["optimize", str(ROOT / "cases/optimize_fig5_into_fig15a.toml"), "--out", "{tmp}/o",
+                      "--vary", "projectile.crh=1:6", "--confirm", "1000", "--no-progress"]),
+    ("semianalytic", ["optimize", str(ROOT / "cases/optimize_fig5_into_fig15a.toml"), "--out", "{tmp}/o",
+                      "--vary", "projectile.crh=1:6", "--method", "de", "--popsize", "1000", "--maxiter", "1000",
+                      "--no-progress"]),
+    ("semianalytic", ["optimize", str(ROOT / "cases/optimize_fig5_into_fig15a.toml"), "--out", "{tmp}/o",
+                      "--vary", "projectile.crh=2:1e6", "--no-progress"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s",
+                      "--vary", "projectile.crh=3,1000000", "--scheduler", "inline"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s", "--samples",
+                      "10000000", "--sample", "target.density=normal(2710 kg/m^3, 10 kg/m^3)", "--scheduler", "inline"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s", "--samples", "10",
+                      "--sample", "target.resistance.yield_stress=normal(400 MPa, 400 MPa)", "--scheduler", "inline"]),
+    ("semianalytic", ["sweep", str(ROOT / "cases/fig15a_ogive_6061T651.toml"), "--out", "{tmp}/s",
+                      "--vary", "impact.striking_velocity=400:500:100 m/s", "--scheduler", ""]),
+    ("semianalytic", ["run", OGIVE, "--out", "/", "--force"]),
+    ("semianalytic", ["run", OGIVE, "--out", ".", "--force"]),
+    ("semianalytic", ["run", OGIVE, "--out", str(ROOT / "cases"), "--force"]),
 ]
+
+
+# issue 27: the class of each of its corpus files (by name prefix), as the issue groups its findings
+I27_CLASSES = {
+    "i27_quantity": "traceback ('2**2000' overflow)",
+    "i27_velocity_1e-9": "traceback (U_s = 1e-9 m/s)",
+    "i27_velocity_11p9": "nonsense accepted (above the models' reach)",
+    "i27_target_density": "nonsense accepted (a gas target)",
+    "i27_projectile_density": "nonsense accepted (density)",
+    "i27_resistance": "nonsense accepted (strength, modulus)",
+    "i27_plate": "nonsense accepted or traceback (plate thickness)",
+    "i27_ballistic_table": "files outside the asked folders (a path leaving the case folder)",
+    "i27_data_file": "files outside the asked folders (a path leaving the case folder)",
+    "i27_data_nan": "bad input accepted (NaN in a data CSV)",
+    "i27_nanostrength": "out of memory or traceback (nanostrength study size)",
+    "i27_table_nose": "out of memory (a table nose of many points)",
+}
+
+
+def i27_class(stem: str) -> str:
+    return next((c for prefix, c in I27_CLASSES.items() if stem.startswith(prefix)), "other")
+
+
+def fault_tests() -> list[tuple[str, str]]:
+    """(test, outcome) of tests/test_hardening_faults.py, run by pytest in a subprocess."""
+    import re
+    import subprocess
+
+    proc = subprocess.run([sys.executable, "-m", "pytest", "-q", "-rA", "-p", "no:randomly", "-p", "no:cacheprovider",
+                           str(Path(__file__).with_name("test_hardening_faults.py"))],
+                          capture_output=True, text=True, cwd=ROOT, timeout=1800)
+    rows = []
+    for line in proc.stdout.splitlines():
+        m = re.match(r"(PASSED|FAILED|ERROR|SKIPPED) \S*::(\S+)", line)
+        if m:
+            rows.append((m.group(2), m.group(1).lower()))
+    return rows
 
 
 def run_option(package: str, argv: list[str], tmp: Path) -> Outcome:
@@ -97,6 +158,7 @@ def main(argv=None) -> int:
     tally: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
     by_command: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
     bad_rows, guard_rows, stray = [], [], []
+    i27: dict[str, collections.Counter] = collections.defaultdict(collections.Counter)
     files = corpus_files()
     with tempfile.TemporaryDirectory() as tmp_root:
         tmp_root = Path(tmp_root)
@@ -111,6 +173,8 @@ def main(argv=None) -> int:
                 kind = classify(res)
                 tally[group][kind] += 1
                 by_command[command][kind] += 1
+                if path.stem.startswith("i27_"):
+                    i27[path.name][kind] += 1
                 if kind not in ("rejected", "warned", "accepted"):
                     bad_rows.append((f"{group}/{path.name}", command, kind, res.err.strip().splitlines()[-1:] or [""]))
                 if {p.name for p in work.iterdir()} - {"out"}:
@@ -128,14 +192,16 @@ def main(argv=None) -> int:
                 res = run_option(package, argv_, tmp)
             kind = classify(res)
             options[kind] += 1
+            shown = (res.err.strip().splitlines() or [""])[-1].replace(str(tmp), "{tmp}").replace(str(ROOT) + "/", "")
             option_rows.append((f"{'python -m ' + package} {' '.join(a if a else repr(a) for a in argv_)}".replace(str(ROOT) + "/", ""),
-                                res.rc, (res.err.strip().splitlines() or [""])[-1]))
+                                res.rc, shown))
+    faults = fault_tests()
     peak_mb = resource.getrusage(resource.RUSAGE_SELF).ru_maxrss / 1024
     seconds = time.time() - started
 
     kinds = ["rejected", "warned", "accepted", "traceback", "rejected, not one line"]
     lines = [
-        "# Hardening: bad inputs, tallied (issue 13)",
+        "# Hardening: bad inputs and faults, tallied (issues 13 and 27)",
         "",
         "Generated by `.venv/bin/python tests/hardening_tally.py --out reports` "
         f"({seconds:.0f} s, peak memory of the whole run {peak_mb:.0f} MB).",
@@ -167,6 +233,21 @@ def main(argv=None) -> int:
         lines += ["Runs that were neither rejected cleanly, warned nor accepted:", ""]
         lines += [f"- `{f}` `{c}`: {k}: {e[0][:200]}" for f, c, k, e in bad_rows]
         lines.append("")
+    lines += ["## Issue 27: the new corpus files by class", "",
+              "Each file states what it expects in its header (`# expect:`); the counts are over the eight commands.", "",
+              "| file | class | expects | " + " | ".join(kinds) + " |", "|---|---|---|" + "---|" * len(kinds)]
+    for name in sorted(i27):
+        stem = name.rsplit(".", 1)[0]
+        expect = headers(next(f for f in files if f.name == name)).get("expect", "")
+        lines.append(f"| `{name}` | {i27_class(stem)} | `{expect}` | " + " | ".join(str(i27[name][k]) for k in kinds) + " |")
+    lines += ["", "## Issue 27: fault tests", "",
+              "`tests/test_hardening_faults.py` (part of `make test`): `--force` and foreign files, folders refused "
+              "outright, SIGTERM/SIGINT, a second writer of one `--out`, damaged and foreign cache entries, gmsh's "
+              "home files, damaged sweep stores, escaped file names, time and memory budgets.", "",
+              "| test | outcome |", "|---|---|"]
+    lines += [f"| `{name}` | {outcome} |" for name, outcome in faults]
+    n_pass = sum(1 for _, o in faults if o == "passed")
+    lines += ["", f"Fault tests: {n_pass} of {len(faults)} passed.", ""]
     lines += ["## The memory guard on the three cases of the issue", "",
               "Budget 4 GB (the default; `--memory-limit SIZE` or `$SEMIANALYTIC_MEMORY_LIMIT`). Refused before any "
               "allocation, by the commands that would solve them (the others stop earlier, at a missing section):", ""]
@@ -187,7 +268,8 @@ def main(argv=None) -> int:
         print(f"wrote {path}")
     else:
         print(text)
-    return 0 if not bad_rows and not stray and not options.get("traceback") else 1
+    failed_faults = any(o != "passed" for _, o in faults)
+    return 0 if not bad_rows and not stray and not options.get("traceback") and not failed_faults else 1
 
 
 if __name__ == "__main__":

@@ -54,6 +54,8 @@ def test_corpus_file(path, tmp_path, monkeypatch):
                 continue
             assert res.rc == 2, (command, res.out[:200], res.err)
             assert res.err.startswith(f"error: {expect}"), (command, res.err)
+            if "expect-text" in head:  # the field is a whole section: the key the message names
+                assert head["expect-text"] in res.err, (command, res.err)
             # nothing written anywhere: not in the cwd, not under --out
             assert not any(work.iterdir()), (command, sorted(map(str, work.rglob("*"))))
     # whatever ran, nothing appeared outside the asked --out folders (no ./.cache, no ./reports)

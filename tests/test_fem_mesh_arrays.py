@@ -1,19 +1,17 @@
-"""fem_check's mesh cache keeps the scikit-fem arrays beside each .msh (verify speed, issue 14).
+"""fem_check's mesh cache keeps the scikit-fem arrays of each gmsh mesh (verify speed, issue 14;
+self-verifying entries, issue 27).
 
 The reference is the .msh file read by meshio and matched to facets (the path the arrays
 replace): the mesh read from the arrays has the same nodes, elements, tagged facets and pieces,
-exactly, and the potential solved on it the same A, bit for bit.  A stale or damaged arrays file
-is ignored.
+exactly, and the potential solved on it the same A, bit for bit.  A damaged, truncated, empty or
+mismatched entry is discarded with a warning and the mesh made again.
 """
 
 from __future__ import annotations
 
-import os
-
 import numpy as np
 import pytest
 
-from fem_check import meshing
 from fem_check.coefficients import halfspace_mesh
 from fem_check.meshing import MeshOptions
 from fem_check.potential import solve_potential
@@ -39,10 +37,12 @@ def test_cached_arrays_give_the_msh_mesh(tmp_path, monkeypatch, order):
     _same(from_msh, from_arrays)
     assert solve_potential(from_msh, "monopole").A == solve_potential(from_arrays, "monopole").A
 
-    # a damaged arrays file, or one older than its .msh, is not read (the .msh is)
-    sidecars[0].write_bytes(b"not an npz")
-    _same(from_msh, halfspace_mesh(nose, 0.5, opts))
-    msh = sorted(tmp_path.glob("*.msh"))[0]
-    stat = msh.stat()
-    os.utime(sidecars[0], (stat.st_atime, stat.st_mtime - 10))
-    assert meshing._read_arrays(msh) is None
+    # a damaged, truncated, empty or foreign entry is discarded with a warning and made again
+    good = sidecars[0].read_bytes()
+    for bad in (b"not an npz", good[: len(good) // 2], b"", good.replace(b'"key": "', b'"key": "x', 1)):
+        sidecars[0].write_bytes(bad)
+        with pytest.warns(UserWarning, match="mesh cache: discarded"):
+            again = halfspace_mesh(nose, 0.5, opts)
+        _same(from_msh, again)
+        assert sidecars[0].read_bytes() == good  # rebuilt and stored again
+    assert not list(tmp_path.glob("*.msh"))  # gmsh's file stays in a temporary folder

@@ -196,7 +196,7 @@ def test_memory_guard_never_admits_over_budget(crh, refinement, order):
         need = guards.check_coefficients(case)
     except InputError as exc:
         assert exc.field in ("projectile.crh", "bem.refinement", "bem.order", "projectile")
-        assert "memory budget" in exc.message
+        assert "memory budget" in exc.message or "time budget" in exc.message  # issue 27: the table's time too
     else:
         # independent of the estimate that admitted it: the real panel layout at the deepest
         # depth, with the guard's options, must fit the budget (an under-estimate would not)
@@ -232,6 +232,7 @@ def test_guard_answer_fits(monkeypatch):
 
     from semianalytic import guards
 
+    monkeypatch.setenv(guards.TIME_ENV, "1e12")  # the memory bisection alone (the time budget is checked apart)
     data = copy.deepcopy(BASE)
     data["projectile"]["crh"] = 1e12
     with pytest.raises(InputError) as err:
@@ -259,3 +260,44 @@ def test_random_bytes_in_a_subprocess(tmp_path_factory, data):
     assert proc.returncode == 2, proc.stderr
     assert "Traceback" not in proc.stderr and len(proc.stderr.strip().splitlines()) == 1
     assert sorted(p.name for p in work.iterdir()) == ["case.toml"]
+
+
+_NAME = st.text(alphabet="abcxyz_.-0", min_size=1, max_size=6).filter(lambda s: s not in (".", "..")
+                                                                      and not s.startswith(".semianalytic"))
+
+
+@FAST
+@given(ours=st.sets(st.lists(_NAME, min_size=1, max_size=2).map("/".join), max_size=5),
+       theirs=st.sets(st.lists(_NAME, min_size=1, max_size=2).map("/".join), max_size=3))
+def test_force_never_deletes_a_file_it_did_not_write(tmp_path_factory, ours, theirs):
+    """Issue 27: a folder holding files its manifest lists (``ours``) and others (``theirs``):
+    ``StagedDir(force=True)`` replaces it only when there are no others; else InputError naming
+    one of them, and every file is still there with its content."""
+    import json
+
+    from semianalytic.report.output import MANIFEST, StagedDir
+
+    base = tmp_path_factory.mktemp("force")
+    out = base / "out"
+    out.mkdir()
+    written = {}
+    for name in sorted(ours | theirs):
+        p = out / name
+        if any(q.is_file() for q in [*p.parents][: len(Path(name).parts) - 1]) or p.is_dir():
+            continue  # a name that is a folder of another name: not both
+        p.parent.mkdir(parents=True, exist_ok=True)
+        p.write_text(name)
+        written[name] = name in ours and name not in theirs
+    (out / MANIFEST).write_text(json.dumps({"files": sorted(n for n, mine in written.items() if mine)}))
+    foreign = sorted(n for n, mine in written.items() if not mine)
+    if foreign:
+        with pytest.raises(InputError) as err:
+            with StagedDir(out, force=True, field="--out") as d:
+                d.write_text("new.txt", "new")
+        assert err.value.field == "--out" and any(repr(f) in err.value.message for f in foreign)
+        assert all((out / n).read_text() == n for n in written)
+    else:
+        with StagedDir(out, force=True, field="--out") as d:
+            d.write_text("new.txt", "new")
+        assert sorted(p.name for p in out.iterdir()) == sorted(["new.txt", MANIFEST])
+    assert [p.name for p in base.iterdir()] == ["out"]  # no staging folder left

@@ -118,9 +118,11 @@ def test_existing_folder_and_force(report, capsys):
     assert main(["run", str(case), "--out", str(out), "--no-render"]) == 2
     assert capsys.readouterr().err.startswith("error: --out")
     assert (out / "results.json").read_text() == before
-    (out / "stale.txt").write_text("old")
+    (out / "stale.txt").write_text("old")  # a file the tool did not write: --force refuses (issue 27)
+    assert main(["run", str(case), "--out", str(out), "--no-render", "--only", "critical_velocity", "--force"]) == 2
+    assert "'stale.txt'" in capsys.readouterr().err and (out / "stale.txt").read_text() == "old"
+    (out / "stale.txt").unlink()
     assert main(["run", str(case), "--out", str(out), "--no-render", "--only", "critical_velocity", "--force"]) == 0
-    assert not (out / "stale.txt").exists()  # the folder was replaced as a whole
     assert "critical_velocity" in json.loads((out / "results.json").read_text())["analyses"]
 
 

@@ -115,7 +115,11 @@ def test_invalid_samples_reported_like_the_case_by_case_path(tmp_path):
     # a normal yield stress crossing zero: the batch's corners are invalid, the samples go case by case
     p = tmp_path / "case.toml"
     p.write_text(CASE.format(resistance=MODELS["elastic-plastic"][0]))
-    spec = build_spec([], ["target.resistance.yield_stress=normal(100 MPa, 120 MPa)"], 40, 2)
+    # built directly: the command line refuses such a sample of a positive quantity (issue 27)
+    from semianalytic.sweep.spec import Sampler, SweepSpec
+
+    spec = SweepSpec(samplers=(Sampler("target.resistance.yield_stress", "normal", (100e6, 120e6), "Pa"),), n_samples=40,
+                     seed=2)
     s_vec, vec = _run(p, spec, tmp_path / "vec", True)
     s_ref, ref = _run(p, spec, tmp_path / "ref", False)
     assert s_vec.n_invalid == s_ref.n_invalid > 0

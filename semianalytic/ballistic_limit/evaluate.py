@@ -7,7 +7,6 @@ Used by the ``ballistic-limit`` command and by the ``run`` pipeline alike.
 
 from __future__ import annotations
 
-from pathlib import Path
 
 __all__ = ["evaluate_case"]
 
@@ -21,8 +20,9 @@ def evaluate_case(case) -> dict:
     section = case.require("ballistic_limit")
     shots = []
     if section.table is not None:
-        base = case.path.parent if case.path is not None else Path.cwd()
-        path = (base / section.table).resolve()
+        from semianalytic.io import case_input_path
+
+        path = case_input_path(case.path, section.table, "ballistic_limit.table")
         if not path.is_file():
             raise InputError("ballistic_limit.table", f"file {section.table!r} not found next to the case file")
         shots += load_shots(path)

@@ -227,6 +227,11 @@ def _need(obj, key, typ, field):
 
 def _samples(obj, key, field, n=None) -> np.ndarray:
     arr = _need(obj, key, list, field)
+    if len(arr) > MAX_POSTERIOR_DRAWS:
+        raise InputError(f"{field}.{key}", f"{len(arr)} draws; a posterior written by calibrate holds at most "
+                                           f"{MAX_POSTERIOR_DRAWS}")
+    if not all(isinstance(v, (int, float)) and not isinstance(v, bool) for v in arr):  # "1.5" is not a draw
+        raise InputError(f"{field}.{key}", "expected a list of numbers (JSON numbers, not strings or booleans)")
     try:
         out = np.asarray(arr, float)
     except (TypeError, ValueError):
@@ -236,6 +241,12 @@ def _samples(obj, key, field, n=None) -> np.ndarray:
     return out
 
 
+# A posterior.json of calibrate holds a few thousand draws (~0.5 MB); these bounds (this project's
+# own, issue 27) stop a file that is no posterior of calibrate before it is parsed into memory.
+MAX_POSTERIOR_BYTES = 20e6
+MAX_POSTERIOR_DRAWS = 200_000
+
+
 def read_posterior(path) -> dict:
     """Read and validate a posterior.json written by ``calibrate``; returns
     {"target": ..., "parameters": [keys], "models": {name: {"theta": (n, p), "sigma": (n,)}}, "raw": obj}."""
@@ -243,6 +254,13 @@ def read_posterior(path) -> dict:
     path = Path(path)
     if not path.is_file():
         raise InputError(field, f"file {str(path)!r} does not exist")
+    try:
+        size = path.stat().st_size
+    except OSError as exc:
+        raise InputError(field, f"cannot read {str(path)!r}: {exc.strerror or exc}") from None
+    if size > MAX_POSTERIOR_BYTES:
+        raise InputError(field, f"{path.name} is {size / 1e6:.0f} MB; a posterior.json written by calibrate is at most "
+                                f"{MAX_POSTERIOR_BYTES / 1e6:.0f} MB (this project's own bound)")
     try:
         obj = json.loads(path.read_text())
     except (OSError, UnicodeDecodeError, json.JSONDecodeError) as exc:

@@ -18,7 +18,9 @@ def check_outputs_and_load(args):
     from semianalytic.case import load_case
     from semianalytic.report.output import check_output_dir
 
-    check_output_dir(args.out, args.force)
+    if args.steps is not None and args.steps < 50:
+        raise InputError("--steps", f"must be at least 50; got {args.steps}")
+    check_output_dir(args.out, args.force, protect=(args.case,))
     if args.report is not None:
         from semianalytic.io import check_report_target
 
@@ -43,9 +45,15 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
     from semianalytic.report.html import to_html
     from semianalytic.report.output import StagedDir
 
-    if args.steps is not None and args.steps < 50:
-        raise InputError("--steps", f"must be at least 50; got {args.steps}")
     case = check_outputs_and_load(args)
+    from semianalytic.calibration.case import CalibrationSection
+    from semianalytic.guards import check_sampler
+
+    csec = case.section("calibration") or CalibrationSection()
+    n_models = len(args.model or csec.models or ["m"] * 2)
+    n_params = len(args.parameter or csec.parameters or ["p"] * 3)
+    check_sampler(csec.walkers, args.steps or csec.steps, n_params, n_models,
+                  "--steps" if args.steps else "calibration.steps")
     if case.target.resistance is None:
         raise InputError("target.resistance", "missing; add [target.resistance] with a 'model'")
     transfer = []
@@ -57,7 +65,10 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
         raise InputError("--transfer", "is used only with --cross-validate or --diagnose")
     if args.cross_validate or args.diagnose:
         sec = case.section("calibration")
-        paths = [Path(case.path).parent / p for p in (sec.transfer if sec else [])] + [Path(p) for p in args.transfer]
+        from semianalytic.io import case_input_path
+
+        paths = [case_input_path(case.path, p, "calibration.transfer") for p in (sec.transfer if sec else [])] + [
+            Path(p) for p in args.transfer]
         for p in paths:
             tcase = load_case(p)
             transfer.append((tcase, coefficients_for_case(tcase, args.coefficients, args.cache_dir)[0]))
@@ -80,7 +91,7 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
 
     extra = (lambda d, f: diagnosis_blocks(d, diag)) if diag is not None else None
     doc, figs = build_report(result, command, cv, extra)
-    with StagedDir(args.out, args.force) as out:
+    with StagedDir(args.out, args.force, protect=(args.case,)) as out:
         out.write_json("posterior.json", result["posterior"])
         if cv is not None:
             out.write_json("cross_validation.json", cv)

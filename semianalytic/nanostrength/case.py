@@ -82,6 +82,12 @@ class CrystalSpec(Section):
         )
 
 
+# Issue 27 (this project's own bounds): the largest bar and basis a study may name.  The
+# report's largest are l = 1200 and m = n = 2500.
+MAX_PLANES = 2000
+MAX_MN = 10**9
+
+
 class StudySection(Section):
     """``[[nanostrength.study]]``: a grid of nanoparticle geometries (Part III, eqs. (21)-(29))."""
 
@@ -107,7 +113,13 @@ class StudySection(Section):
         for l in self.l:
             if l != "inf" and (isinstance(l, bool) or l < 2):
                 raise ValueError(f"'l' entries must be integers >= 2 (atomic planes) or \"inf\"; got {l!r}")
+            if l != "inf" and l > MAX_PLANES:  # issue 27: 2^(j + 2) of eq. (20) overflows a double beyond j ~ 1020
+                raise ValueError(f"'l' entries must be at most {MAX_PLANES} planes (the mesolayer sums overflow beyond; a bar "
+                                 f"that long is bulk: use \"inf\"); got {l!r}")
         for mn in self.mn:
+            if mn != "inf" and not isinstance(mn, bool) and mn > MAX_MN:
+                raise ValueError(f"'mn' entries must be at most {MAX_MN} lattice vectors (a basis that wide is a plate: use "
+                                 f"basis \"none\" with mn = [\"inf\"]); got {mn!r}")
             if mn != "inf" and (isinstance(mn, bool) or mn < 2):
                 raise ValueError(f"'mn' entries must be integers >= 2 (m = n lattice vectors) or \"inf\"; got {mn!r}")
         for b in self.basis:

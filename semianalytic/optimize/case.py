@@ -280,7 +280,9 @@ def check_bounds(problem: Problem) -> None:
     corners.append(tuple(0.5 * (v.low + v.high) for v in problem.variables))
     for x in corners:
         try:
-            design_case(problem, problem.overrides(x))
+            from semianalytic.guards import check_case
+
+            check_case(design_case(problem, problem.overrides(x)))  # and its BEM table fits the budget
         except Infeasible as exc:
             shown = ", ".join(f"{v.key.split('.', 1)[1]} = {xi:g} {v.unit}".rstrip() for v, xi in zip(problem.variables, x))
             raise InputError(f"--constraint {exc.constraint}", f"cannot be met at the bounds' corner {shown}: {exc}") from None

@@ -36,10 +36,14 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
         raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {args.method!r}")
     problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model,
                             args.table_depths, args.table_nose_lengths, getattr(args, "striking_velocity", None))
+    from semianalytic.guards import check_optimiser
+
+    check_optimiser(len(problem.variables), method=args.method, coarse=args.coarse, confirm=args.confirm,
+                    popsize=args.popsize, maxiter=args.maxiter, maxfev=args.maxfev)
     out = Path(args.out) if args.out else None
     report = Path(args.report) if args.report else None
     if out is not None:
-        check_output_dir(out, args.force)
+        check_output_dir(out, args.force, protect=(args.case,))
     if report is not None:
         check_report_target(report, args.force)
     cache_dir = str(table_dir(args.cache_dir))

@@ -103,6 +103,7 @@ class _Input(BaseModel):
     # strict numbers as in every Section (a "*" validator would touch the discriminator 'model')
     _strict = field_validator("poisson_ratio", "alpha", "hardening_exponent", "initial_porosity",
                               mode="before", check_fields=False)(Section._strict_numbers.__func__)
+    _plausible = field_validator("*", mode="after")(Section._plausible.__func__)  # ranges of issue 27
 
 
 def _nu(v):

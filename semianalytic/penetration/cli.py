@@ -227,7 +227,9 @@ def run(args) -> int:
         descs.append(desc)
         _warn_separation(results[-1])
         for line in results[-1]["warnings"]:
-            print(f"{line} [{case.path or case.title}]", file=sys.stderr)
+            from semianalytic.errors import one_line
+
+            print(one_line(f"{line} [{case.path or case.title}]"), file=sys.stderr)  # a file name may hold a newline
     if args.json:
         from semianalytic.report.output import json_safe  # strict JSON: a non-finite number is null
 

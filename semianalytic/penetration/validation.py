@@ -102,8 +102,9 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     data = case.require("data")
     if data.file is None:
         return []
-    base = Path(case.path).parent if case.path is not None else Path.cwd()
-    path = (base / data.file).resolve()
+    from semianalytic.io import case_input_path
+
+    path = case_input_path(case.path, data.file, "data.file")
     if not path.is_file():
         raise InputError("data.file", f"{str(path)!r} does not exist")
     names, table = read_csv_rows(path)
@@ -128,6 +129,8 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
             m = float(row[data.mass_column]) * m_scale if data.mass_column else None
         except ValueError:
             raise InputError("data.file", f"row {i + 1} of {path.name} has a non-numeric value") from None
+        if not all(math.isfinite(x) for x in (V, *(() if no_depth else (P,)), *(() if m is None else (m,)))):
+            raise InputError("data.file", f"row {i + 1} of {path.name} has a value that is not a finite number (NaN or inf)")
         if not (V > 0 and (P > 0 or no_depth) and (m is None or m > 0)):
             raise InputError("data.file", f"row {i + 1} of {path.name}: velocity, depth and mass must be positive")
         shot_id = str(row[data.id_column]) if data.id_column else str(i + 1)

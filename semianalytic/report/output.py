@@ -1,9 +1,14 @@
 """The output folder of a run: built in a staging folder, swapped in at the end.
 
 Nothing appears under ``DIR`` until every file is written; a failure (bad input found late,
-an exception, Ctrl-C) leaves ``DIR`` exactly as it was.  An existing ``DIR`` is replaced only
-with ``force``; every relative path goes through :func:`semianalytic.io.contained_path`, so
-no name taken from a case file can escape the folder.
+an exception, Ctrl-C, SIGTERM) leaves ``DIR`` exactly as it was and removes the staging folder.
+Every folder written this way carries a manifest (:data:`MANIFEST`) of the files the command
+wrote: ``--force`` replaces a folder only when it holds nothing else (this project's own rule,
+issue 27: a file the tool did not write is never deleted).  The home folder, ``/``, the working
+folder, any folder above it and any folder holding a case file are refused outright.  Every
+relative path goes through :func:`semianalytic.io.contained_path`, so no name taken from a case
+file can escape the folder.  Two commands writing into one ``DIR`` at once: the second stops
+with exit status 2 (each staging folder names its owner's host and process id).
 """
 
 from __future__ import annotations
@@ -13,28 +18,114 @@ import os
 import shutil
 import tempfile
 from pathlib import Path
-from typing import Any
+from typing import Any, Iterable
 
 from semianalytic.errors import InputError
 from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path
 
+MANIFEST = ".semianalytic-manifest.json"
 
-def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out") -> Path:
-    """Refuse an existing ``out`` without ``force``, a path that is a file, and the working
-    folder or any folder above it: the output folder is replaced as a whole (``StagedDir``),
-    so ``--out .`` or ``--out ''`` with ``--force`` would delete the user's files."""
+
+def manifest_files(folder: Path) -> set[str] | None:
+    """The files (POSIX paths relative to ``folder``) listed in its manifest; None when the
+    folder has no readable manifest."""
+    try:
+        data = json.loads((folder / MANIFEST).read_text(encoding="utf-8"))
+        files = data["files"]
+        if not isinstance(files, list) or not all(isinstance(f, str) for f in files):
+            return None
+        return set(files)
+    except (OSError, ValueError, KeyError, TypeError):
+        return None
+
+
+def first_foreign(folder: Path) -> str | None:
+    """The first entry (sorted walk) of ``folder`` that its manifest does not list, or None when
+    every file was written by this tool.  Folders count as ours when they hold only our files."""
+    listed = manifest_files(folder)
+    for dirpath, dirnames, filenames in os.walk(folder):
+        dirnames.sort()
+        rel_dir = Path(dirpath).relative_to(folder)
+        for name in sorted(filenames) + [d for d in dirnames if os.path.islink(os.path.join(dirpath, d))]:
+            rel = (rel_dir / name).as_posix()
+            if rel == MANIFEST and listed is not None:
+                continue
+            if listed is None or rel not in listed:
+                return rel
+    return None
+
+
+def write_manifest(folder: Path, command: str | None = None) -> None:
+    """List every file now under ``folder`` in its manifest (called on the staging folder)."""
+    files = sorted((Path(d) / f).relative_to(folder).as_posix() for d, _, fs in os.walk(folder) for f in fs
+                   if not (Path(d) == folder and f == MANIFEST))
+    payload = {"tool": "semianalytic", "what": "files written by the command; --force replaces only these",
+               "files": files}
+    if command:
+        payload["command"] = command
+    atomic_write_json(folder / MANIFEST, payload)
+
+
+def _forbidden(resolved: Path, protect: Iterable[str | os.PathLike] = ()) -> str | None:
+    """Why ``resolved`` may never be an output folder, or None."""
+    if resolved == Path(resolved.anchor):
+        return "is the root folder"
+    try:
+        home = Path.home().resolve()
+    except (RuntimeError, OSError):
+        home = None
+    if home is not None and (resolved == home or resolved in home.parents):
+        return "is the home folder or contains it"
+    cwd = Path.cwd().resolve()
+    if resolved == cwd or resolved in cwd.parents:
+        return "is the working folder or contains it"
+    for p in protect:
+        try:
+            parent = Path(p).resolve().parent
+        except (OSError, RuntimeError):
+            continue
+        if resolved == parent or resolved in parent.parents:
+            return f"holds the case file {Path(p).name!r}"
+    return None
+
+
+def forbidden_output(out: str | os.PathLike, field: str = "--out", protect: Iterable[str | os.PathLike] = ()) -> None:
+    """Refuse, outright, an output folder that is ``/``, the home folder, the working folder (or
+    above it) or the folder of a case file in ``protect`` (commands that write named files into
+    a folder instead of replacing it, e.g. ``sweep``)."""
+    try:
+        why = _forbidden(Path(out).resolve(), protect)
+    except (OSError, RuntimeError) as exc:
+        raise InputError(field, f"cannot use {str(out)!r}: {exc}") from None
+    if why is not None:
+        raise InputError(field, f"{str(out)!r} {why}; name a new folder (e.g. out/sweep1)")
+
+
+def check_output_dir(out: str | os.PathLike, force: bool, field: str = "--out",
+                     protect: Iterable[str | os.PathLike] = ()) -> Path:
+    """Refuse an existing non-empty ``out`` without ``force``; with ``force``, one holding any
+    file its manifest does not list (naming the first); a path that is a file; and, outright,
+    ``/``, the home folder, the working folder (or a folder above it) and the folder of any
+    case file in ``protect`` (or a folder above it)."""
     if not str(out).strip():
         raise InputError(field, "expected a folder; got an empty path")
     out = Path(out)
     try:
-        resolved, cwd = out.resolve(), Path.cwd().resolve()
-        if resolved == cwd or resolved in cwd.parents:
-            raise InputError(field, f"{str(out)!r} is the working folder or contains it; the output folder is "
-                                    "replaced as a whole, so name a new folder (e.g. out/run1)")
+        resolved = out.resolve()
+        why = _forbidden(resolved, protect)
+        if why is not None:
+            raise InputError(field, f"{str(out)!r} {why}; the output folder is replaced as a whole, "
+                                    "so name a new folder (e.g. out/run1)")
         if out.exists() and not out.is_dir():
             raise InputError(field, f"{str(out)!r} exists and is not a folder")
-        if out.exists() and not force and any(out.iterdir()):
-            raise InputError(field, f"{str(out)!r} exists; pass --force to overwrite it")
+        if out.exists() and any(out.iterdir()):
+            if not force:
+                raise InputError(field, f"{str(out)!r} exists; pass --force to overwrite it")
+            foreign = first_foreign(out)
+            if foreign is not None:
+                raise InputError(field, f"{str(out)!r} holds {foreign!r}, which this tool did not write (not in "
+                                        f"{MANIFEST}); --force replaces only the tool's own files: move it or "
+                                        "choose another folder")
     except OSError as exc:
         raise InputError(field, f"cannot use {str(out)!r}: {exc.strerror or exc}") from None
     return out
@@ -94,20 +185,55 @@ def remove_stale_staging(final: Path, now: float | None = None) -> list[Path]:
     return removed
 
 
+class OutputBusy(InputError):
+    """Another live command is writing into the same output folder."""
+
+
+def _live_rivals(final: Path, mine: Path) -> list[Path]:
+    """Staging folders of ``final`` (other than ``mine``) whose owner is a live process of this
+    host, that were made before ``mine`` (ties: by name): the earlier writer goes on."""
+    import re
+    import socket
+
+    host = "".join(c for c in socket.gethostname() if c.isalnum() or c == "-")[:40] or "host"
+    pattern = re.compile(re.escape(f".{final.name}.partial-") + r"(?P<host>[A-Za-z0-9-]+)\.(?P<pid>\d+)-[^/]*")
+    try:
+        me = (mine.stat().st_mtime_ns, mine.name)
+        siblings = list(final.parent.iterdir())
+    except OSError:
+        return []
+    rivals = []
+    for path in siblings:
+        m = pattern.fullmatch(path.name)
+        if path == mine or not m or m.group("host") != host or int(m.group("pid")) == os.getpid():
+            continue
+        try:
+            when = (path.stat().st_mtime_ns, path.name)
+        except OSError:
+            continue
+        if _process_alive(int(m.group("pid"))) and when < me:
+            rivals.append(path)
+    return rivals
+
+
 class StagedDir:
     """``with StagedDir(out, force) as d: d.write_text("report.md", ...)``.
 
-    Files go to a hidden sibling folder; on a clean exit it replaces ``out`` (the old folder is
-    moved aside first and removed after the swap).  On an exception the staging folder is
-    removed and ``out`` is untouched.
+    Files go to a hidden sibling folder; on a clean exit the manifest is written and the folder
+    replaces ``out`` (the old folder, checked to hold only the tool's files, is moved aside first
+    and removed after the swap).  On an exception, Ctrl-C or SIGTERM the staging folder is
+    removed and ``out`` is untouched.  ``protect``: case files whose folders may not be replaced.
     """
 
-    def __init__(self, out: str | os.PathLike, force: bool = False, field: str = "--out"):
-        self.final = check_output_dir(out, force, field).absolute()
+    def __init__(self, out: str | os.PathLike, force: bool = False, field: str = "--out",
+                 protect: Iterable[str | os.PathLike] = ()):
+        self.protect = tuple(protect)
+        self.final = check_output_dir(out, force, field, self.protect).absolute()
         self.force = force
         self.field = field
         self.root: Path | None = None
         self.files: list[str] = []
+        self._signals: dict = {}
 
     # -- context -------------------------------------------------------------------------
     def __enter__(self) -> "StagedDir":
@@ -117,22 +243,64 @@ class StagedDir:
             self.root = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.partial-{_owner()}-", dir=self.final.parent))
         except OSError as exc:
             raise InputError(self.field, f"cannot create {str(self.final)!r}: {exc.strerror or exc}") from None
+        rivals = _live_rivals(self.final, self.root)
+        if rivals:
+            shutil.rmtree(self.root, ignore_errors=True)
+            pid = rivals[0].name.split("partial-", 1)[1].split("-")[0].rsplit(".", 1)[-1]
+            raise OutputBusy(self.field, f"another command (process {pid}) is writing into {str(self.final)!r}; "
+                                         "wait for it to finish or choose another folder")
         from semianalytic.io import _umask
 
         os.chmod(self.root, 0o777 & ~_umask())  # mkdtemp makes 0700; the report folder is for reading
+        self._trap_signals()
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:
-        if exc_type is not None:
-            shutil.rmtree(self.root, ignore_errors=True)
+        try:
+            if exc_type is not None:
+                shutil.rmtree(self.root, ignore_errors=True)
+                return False
+            self._commit()
             return False
-        self._commit()
-        return False
+        finally:
+            self._restore_signals()
+
+    def _trap_signals(self) -> None:
+        """SIGTERM (and SIGHUP) raise KeyboardInterrupt while the folder is staged, so that the
+        staging folder is removed as on Ctrl-C (only in the main thread, where Python can)."""
+        import signal
+        import threading
+
+        if threading.current_thread() is not threading.main_thread():
+            return
+
+        def interrupt(signum, frame):
+            raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
+
+        for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+            if sig is None:
+                continue
+            try:
+                if signal.getsignal(sig) in (signal.SIG_DFL, None):
+                    self._signals[sig] = signal.signal(sig, interrupt)
+            except (ValueError, OSError):
+                pass
+
+    def _restore_signals(self) -> None:
+        import signal
+
+        for sig, old in self._signals.items():
+            try:
+                signal.signal(sig, old)
+            except (ValueError, OSError):
+                pass
+        self._signals = {}
 
     def _commit(self) -> None:
+        write_manifest(self.root)
         old = None
         if self.final.exists():
-            check_output_dir(self.final, self.force)  # it may have appeared meanwhile
+            check_output_dir(self.final, self.force, self.field, self.protect)  # it may have changed meanwhile
             old = Path(tempfile.mkdtemp(prefix=f".{self.final.name}.old-{_owner()}-", dir=self.final.parent))
             os.replace(self.final, old / "previous")
         try:

@@ -53,10 +53,10 @@ def run_case(case_path, out, *, force: bool = False, only=None, render: bool = T
         case = override_coefficients(case, contact=contact, tolerance=tolerance)
     run_section = case.section("run") or RunSection()
     steps, skipped = select_steps(case, run_section, only)
-    check_output_dir(out, force)
+    check_output_dir(out, force, protect=(case_path,))
     for step in steps:  # every input check before any output
         step.preflight(case, run_section)
-    with StagedDir(out, force) as staged:
+    with StagedDir(out, force, protect=(case_path,)) as staged:
         title = case.title or Path(case_path).stem
         ctx = Context(case, staged, run_section, Document(f"Report: {title}"), render=render, cache_dir=cache_dir)
         introduction(ctx, identity, steps, skipped, command)

@@ -69,12 +69,20 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--batch-size", "must be at least 1")
     if args.samples < 0:
         raise InputError("--samples", "must not be negative")
+    if args.scheduler is not None and not args.scheduler.strip():
+        raise InputError("--scheduler", "empty; give 'inline', 'local' or a dask scheduler address (host:port)")
     spec = build_spec(args.vary, args.sample, args.samples, args.seed)
     case = load_case(args.case)
     check_axes(case, spec)
-    from semianalytic.guards import check_case
+    from semianalytic.guards import check_case, check_sweep_size
 
     check_case(case)  # refuse before any worker starts what would not fit in memory
+    geometries = 1
+    for axis in spec.axes:
+        if axis.key.startswith(GEOMETRY_PREFIXES):
+            geometries *= len(axis.values)
+    geometries *= args.samples if any(s.key.startswith(GEOMETRY_PREFIXES) for s in spec.samplers) else 1
+    check_sweep_size(spec.n_cases, geometries, "--samples" if spec.samplers else "--vary")
     kernel = sweep_kernel(case, args.analysis, args.cache_dir, args.full)
     summary = run_sweep(
         args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
@@ -117,6 +125,10 @@ def sweep_kernel(case, analysis, cache_dir, full):
     return select_kernel(case, analysis, cache_dir=cache_dir, full=full)
 
 
+GEOMETRY_PREFIXES = ("projectile.crh", "projectile.half_angle", "projectile.diameter", "projectile.meplat",
+                     "projectile.tip_radius", "projectile.nose", "projectile.exponent", "projectile.points", "bem.", "coefficients.")
+
+
 def check_axes(case, spec) -> None:
     """Refuse (exit status 2) an axis whose every value the case rejects for that key, e.g.
     ``impact.striking_velocity=400:500:10 kg`` (a mass where a velocity belongs): checked at
@@ -129,8 +141,18 @@ def check_axes(case, spec) -> None:
         errors = []
         for value in {axis.values[0], axis.values[-1]}:
             try:
-                parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}), case.path)
+                varied = parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}),
+                                    case.path)
+                if axis.key.startswith(GEOMETRY_PREFIXES):  # the BEM table of the first and last geometry fits
+                    from semianalytic.guards import check_case
+
+                    try:
+                        check_case(varied)
+                    except InputError as exc:
+                        raise InputError(f"--vary {axis.key}", f"the value {value:g}: {exc}") from None
             except InputError as exc:
+                if exc.field.startswith("--vary"):
+                    raise
                 if exc.field == target or exc.field.startswith(target + "."):
                     errors.append(exc)
                     continue

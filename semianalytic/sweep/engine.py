@@ -315,13 +315,27 @@ def check_output(out: Path, fmt: str, resume: bool, force: bool, manifest: dict)
     man = out / MANIFEST
     if out.exists() and not out.is_dir():
         raise InputError("--out", f"{str(out)!r} exists and is not a folder")
+    if out.is_dir():  # issue 27: a sweep writes only into an empty folder or its own earlier sweep's
+        from semianalytic.report.output import forbidden_output
+
+        forbidden_output(out)
+        own = {"results.csv", "results.parquet", MANIFEST, STATISTICS}
+        foreign = sorted(p.name for p in out.iterdir() if p.name not in own)
+        if foreign:
+            raise InputError("--out", f"{str(out)!r} holds {foreign[0]!r}, which no sweep wrote; use a new or empty "
+                                      "folder (a sweep never writes beside other files, --force replaces only its own)")
     has_results = res.exists() or man.exists()
     if resume:
         if not has_results:
             return True
         if not man.exists():
             raise InputError("--resume", f"{str(out)!r} has results but no {MANIFEST}; cannot tell which sweep they belong to")
-        old = json.loads(man.read_text())
+        try:  # a damaged store (issue 27): exit 2 naming it, never a traceback
+            old = json.loads(man.read_text())
+            if not isinstance(old, dict):
+                raise ValueError("not a JSON object")
+        except (OSError, UnicodeDecodeError, ValueError) as exc:
+            raise InputError("--resume", f"{str(man)!r} is damaged ({exc}); pass --force to start the sweep over") from None
         if old.get("fingerprint") != manifest["fingerprint"]:
             raise InputError(
                 "--resume",
@@ -469,7 +483,13 @@ def run_sweep(
     fresh = check_output(out, fmt, resume, force, manifest)
     columns = list(BASE_COLUMNS) + list(spec.columns.values()) + list(kernel.columns)
     store = ResultStore(out, fmt, columns)
-    done = set() if fresh else store.finished_ids()
+    try:
+        done = set() if fresh else store.finished_ids()
+    except InputError:
+        raise
+    except Exception as exc:  # noqa: BLE001 - a damaged results file of an earlier run (issue 27)
+        raise InputError("--resume", f"the results in {str(out)!r} are damaged ({type(exc).__name__}); "
+                                     "pass --force to start the sweep over") from None
     all_ids = np.arange(spec.n_cases, dtype=np.int64)
     pending = all_ids[~np.isin(all_ids, np.fromiter(done, dtype=np.int64, count=len(done)))] if done else all_ids
     summary = SweepSummary(out, store.path, spec.n_cases, len(done), len(pending))

@@ -209,7 +209,21 @@ def parse_sample(text: str, option: str = "--sample") -> Sampler:
         raise InputError(field, "lognormal(MEDIAN,SIGMA) needs MEDIAN > 0 and SIGMA > 0")
     if dist == "triangular" and not (params[0] <= params[1] <= params[2] and params[0] < params[2]):
         raise InputError(field, "triangular(LOW,MODE,HIGH) needs LOW <= MODE <= HIGH and LOW < HIGH")
+    if unit:  # issue 27: a quantity with a unit (strength, density, velocity, length) is positive
+        if dist == "normal" and params[0] < NORMAL_SIGMAS * params[1]:
+            import math
+
+            p_neg = 0.5 * math.erfc(params[0] / (params[1] * math.sqrt(2)))
+            raise InputError(field, f"normal(MEAN,SD) draws values <= 0 with probability {p_neg:.2g}, and the quantity "
+                                    f"is positive: give SD <= MEAN/{NORMAL_SIGMAS:g} or use lognormal(MEDIAN,SIGMA)")
+        if dist in ("uniform", "triangular") and not params[0] > 0:
+            raise InputError(field, f"{dist}(...) reaches values <= 0, and the quantity is positive: give LOW > 0")
     return Sampler(key, dist, tuple(params), unit)
+
+
+# A normal distribution of a positive quantity must keep its mean this many standard deviations
+# above zero (P(x <= 0) < 3e-5; this project's own rule, issue 27).
+NORMAL_SIGMAS = 4.0
 
 
 # --------------------------------------------------------------------------------------
