@@ -80,6 +80,6 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force
 	$(PY) -m semianalytic.run.benchmark --force
 	$(PY) -m semianalytic.sweep.benchmark --force
-	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340.toml --cross-validate --diagnose --out reports/calibration_piekutowski1999 --report reports/validation.md --force --quiet
+	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340.toml --cross-validate --diagnose --steps 12000 --out reports/calibration_piekutowski1999 --report reports/validation.md --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_eroding.toml --cross-validate --out reports/calibration_piekutowski1999_eroding --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_hardness_regimes.toml --model regimes --cross-validate --transfer cases/piekutowski1999_aermet100_hardness_regimes.toml --out reports/calibration_piekutowski1999_regimes --report reports/validation_regimes.md --force

@@ -22,7 +22,6 @@ from __future__ import annotations
 import hashlib
 import json
 import os
-import zipfile
 from pathlib import Path
 
 __all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case",
