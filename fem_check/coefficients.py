@@ -225,7 +225,9 @@ def halfspace_coefficients(nose: Nose, depth: float, options: MeshOptions | None
     sol = solve_potential(dm, far_field)
     # the waterline vertex slides along x = 0 while the nose moves by eps: the elements at it shear by
     # about eps, so eps stays well below the smallest of them (graded waterline corners are tiny)
-    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm), BREAK_STEP * _breakpoint_distance(nose, depth))
+    # (at a breakpoint itself the distance is 0: the derivative is one-sided there, the cap does not apply)
+    to_break = _breakpoint_distance(nose, depth)
+    eps = min(step * depth_scale(nose), 0.05 * _waterline_edge(dm), BREAK_STEP * to_break if to_break > 0 else math.inf)
     eps *= step_scale
     plus, minus = moved_meshes(dm, [eps, -eps])
     Ap = solve_potential(plus, far_field).A

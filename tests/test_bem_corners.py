@@ -17,7 +17,7 @@ import pytest
 from semianalytic.bem import solve_body, solve_halfspace, unknowns_body, unknowns_halfspace
 from semianalytic.bem.panels import LayoutOptions, corner_exponent, corner_power
 from semianalytic.coefficients.depth import coefficients_at_depth
-from semianalytic.errors import InputError
+from semianalytic.errors import InputError, ModelError
 from semianalytic.geometry import (
     cone_nose,
     cylinder_body,
@@ -194,7 +194,7 @@ def test_non_finite_solve_names_nose_and_depth(monkeypatch):
     import semianalytic.bem.solve as solve_mod
 
     monkeypatch.setattr(solve_mod.scipy.linalg, "solve", lambda a, b, **kw: np.full(b.shape, np.nan))
-    with pytest.raises(InputError) as err:
+    with pytest.raises(ModelError) as err:  # a model error (the CLI turns it into exit 2), not the case layer's
         solve_halfspace(NOSES["cone30"](), 5e-3, 8, 0.3, 4)
     assert err.value.field == "projectile"
     assert "cone nose" in str(err.value) and "5 mm" in str(err.value)

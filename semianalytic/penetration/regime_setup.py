@@ -207,13 +207,15 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         valid["eroding"] = (reg == "eroding").tolist()
         valid["regime_aware"] = (reg != "deforming").tolist()  # depth_m: no model holds in the deforming band
     warnings = []
-    if rule == "nose_length" and U_y == math.inf and setup.rod is not None:  # eq. (33) without a real root
+    U_sC = float(curve["critical_velocity_m_s"][0])
+    if U_sC == math.inf and setup.rod is not None:  # eq. (33) without a real root
         from semianalytic.penetration.critical import no_real_root_reason
 
         reason = no_real_root_reason(setup.critical_inputs())
         if reason is not None:
-            warnings.append(f"U_sC: {reason}; every striking velocity is labelled rigid, which only reflects this "
-                            "reading, not the projectile")
+            warnings.append(f"U_sC: {reason}" + ("; every striking velocity is labelled rigid, which only reflects "
+                                                  "this reading, not the projectile" if rule == "nose_length" else
+                                                  "; the regimes (Tate's criterion) do not use U_sC"))
     if np.any(~rigid_ok):
         why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))" if rule == "nose_length" else
                f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches 3 Y_p (Tate 1967, Tabor 1951): "
