@@ -77,3 +77,76 @@ def test_field_report_matches_a_fresh_solve(name):
     # the same deterministic solver: equal to round-off of the dense solve (1e-9 relative)
     np.testing.assert_allclose([field["A_m3"], field["C_m2"], field["phi_tip_m"]], [sol.A, sol.C, sol.phi_tip],
                                rtol=1e-9)
+
+
+# ------------------------------------------------------------------------------------------
+# Reports that regenerate in a few seconds are rebuilt here (in-process, from the committed
+# case files) and compared line by line with the committed text, modulo the lines that
+# legitimately vary: the version stamp (a clean checkout adds "(git <rev>)"), wall times, and
+# the path the command was asked to write to.  A stale report (a number changed by a code or
+# case change since it was generated) fails.  The other reports are checked only through
+# their command line above (test_report_names_its_command), the Part IV report, and the
+# velocity-field reports' fresh solve; their generators take minutes (BEM/FEM benchmarks,
+# calibration samplers, the optimiser, the sweep and run benchmarks, the hardening tally of
+# ~100 s), see reports/mutation_check.md.
+
+_TIMED_HEADERS = re.compile(r"time|elapsed|wall", re.I)
+
+
+def _normalise(text: str) -> list[str]:
+    """Non-blank lines of a report with its varying parts masked: the ``Version:`` line, the cells of any
+    Markdown-table column whose header names a time, and "in N s" elapsed times."""
+    out, timed = [], set()
+    for line in text.splitlines():
+        if line.startswith("Version: ") or not line.strip():  # the stamp and the blank line it adds
+            continue
+        if line.startswith("|") and not set(line) <= set("|-: "):
+            cells = line.strip().strip("|").split("|")
+            if any(_TIMED_HEADERS.search(c) for c in cells) and not any(re.fullmatch(r"\s*-?[\d.e+-]+\s*", c)
+                                                                        for c in cells):
+                timed = {i for i, c in enumerate(cells) if _TIMED_HEADERS.search(c)}
+            else:
+                cells = ["<time>" if i in timed else c for i, c in enumerate(cells)]
+            line = "|" + "|".join(cells) + "|"
+        elif not line.startswith("|"):
+            timed = set()
+        out.append(re.sub(r"\bin \d+(?:\.\d+)? s\b", "in <t> s", line))
+    return out
+
+
+def _assert_same_report(fresh: str, committed: str, name: str):
+    a, b = _normalise(fresh), _normalise(committed)
+    diff = [f"line {i + 1}: committed {y!r}\n        fresh     {x!r}" for i, (x, y) in enumerate(zip(a, b)) if x != y]
+    assert not diff and len(a) == len(b), (f"reports/{name} is stale (regenerate it with the command at its top):\n"
+                                           + "\n".join(diff[:8]) + f"\n({len(a)} vs {len(b)} lines)")
+
+
+def test_normalise_masks_only_what_varies():
+    """The mask itself: a time column and "in N s" are masked, a changed number elsewhere is not."""
+    table = "| material | sigma [GPa] | time [ms] |\n|---|---|---|\n| A | {} | {} |\n\nmade in {} s.\n"
+    assert _normalise(table.format("1.5", "0.11", "2.4")) == _normalise(table.format("1.5", "0.93", "7.0"))
+    assert _normalise(table.format("1.5", "0.11", "2.4")) != _normalise(table.format("1.6", "0.11", "2.4"))
+
+
+def test_part2_cavity_report_regenerates_identically(tmp_path):
+    """`python -m semianalytic.cavity.report` (about 2 s in-process): every number but the solver
+    timings equals the committed report."""
+    from semianalytic.cavity.report import build
+
+    text, _ = build(tmp_path)
+    _assert_same_report(text, (ROOT / "reports" / "part2_cavity.md").read_text(), "part2_cavity.md")
+
+
+def test_part3_nanostrength_report_regenerates_identically():
+    """`python -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force`
+    (a few seconds in-process): the same analysis and text, but for the elapsed time."""
+    from semianalytic.nanostrength.analysis import analyse_section
+    from semianalytic.nanostrength.report import build_report
+
+    committed = (ROOT / "reports" / "part3_nanostrength.md").read_text()
+    command = _command(committed)
+    case_path = re.search(r"nanostrength (\S+\.toml)", command).group(1)
+    section = load_case(ROOT / case_path).require("nanostrength")
+    text, _ = build_report(analyse_section(section), case_path=case_path, stem=Path(case_path).stem, elapsed=0.0,
+                           command=command)
+    _assert_same_report(text, committed, "part3_nanostrength.md")
