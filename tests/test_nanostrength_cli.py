@@ -121,7 +121,12 @@ def test_report_written_and_not_overwritten(tmp_path, capsys):
     md.write_text("keep me")
     assert main(["nanostrength", str(case), "--report", str(out_dir)]) == 2  # exists, no --force
     assert md.read_text() == "keep me" and len(list(out_dir.iterdir())) == 1
-    assert main(["nanostrength", str(case), "--report", str(out_dir), "--force"]) == 0
+    # a file the tool did not write is not replaced, not even with --force (issue 27)
+    assert main(["nanostrength", str(case), "--report", str(out_dir), "--force"]) == 2
+    assert md.read_text() == "keep me" and len(list(out_dir.iterdir())) == 1
+    md.unlink()
+    assert main(["nanostrength", str(case), "--report", str(out_dir)]) == 0
+    assert main(["nanostrength", str(case), "--report", str(out_dir), "--force"]) == 0  # its own: replaced
     text = md.read_text()
     assert text.startswith("# Part III")
     assert "## 3. Fracture quantities (Table 3)" in text and "Closing note" in text
