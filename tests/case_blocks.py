@@ -19,3 +19,20 @@ refinement = 0.2
 depths = 16
 max_depth_nose_lengths = 30.0
 """
+
+
+def copy_case(tmp_path, name: str, edit=None, data: str = "piekutowski1999_ogive_6061T6511.csv"):
+    """Copy ``cases/NAME`` (and its data CSV) into ``tmp_path``, applying ``edit(text) -> text``
+    (which must change something: an edit that no longer matches fails loudly)."""
+    import shutil
+    from pathlib import Path
+
+    cases = Path(__file__).resolve().parent.parent / "cases"
+    text = (cases / name).read_text()
+    if edit is not None:
+        new = edit(text)
+        assert new != text
+        text = new
+    (tmp_path / name).write_text(text)
+    shutil.copy(cases / data, tmp_path / data)
+    return tmp_path / name

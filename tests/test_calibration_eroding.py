@@ -9,11 +9,11 @@ issue's leave-one-out target), through the command line; bad input exits 2 namin
 
 import json
 import math
-import shutil
 from pathlib import Path
 
 import numpy as np
 import pytest
+from case_blocks import copy_case
 
 from semianalytic.cli import main
 
@@ -33,14 +33,7 @@ def _run(capsys, *argv):
 
 
 def _copy(tmp_path, name=ERODING_CASE, edit=None):
-    text = (CASES / name).read_text()
-    if edit is not None:
-        new = edit(text)
-        assert new != text
-        text = new
-    (tmp_path / name).write_text(text)
-    shutil.copy(CASES / CSV, tmp_path / CSV)
-    return tmp_path / name
+    return copy_case(tmp_path, name, edit, CSV)
 
 
 @pytest.mark.parametrize("Y_p, R_t, rho_p", [(8.5e9, 5.6e9, 7830.0), (1.2e9, 3.0e9, 7830.0), (2.0e9, 2.0e9, 2710.0)])

@@ -12,13 +12,13 @@ posterior against emcee (a second method).
 import csv
 import json
 import math
-import shutil
 import subprocess
 import sys
 from pathlib import Path
 
 import numpy as np
 import pytest
+from case_blocks import copy_case
 
 from semianalytic.cli import main
 
@@ -43,14 +43,7 @@ def _run(capsys, *argv):
 
 
 def _copy(tmp_path, name, edit=None):
-    text = (CASES / name).read_text()
-    if edit is not None:
-        new = edit(text)
-        assert new != text
-        text = new
-    (tmp_path / name).write_text(text)
-    shutil.copy(CASES / CSV, tmp_path / CSV)
-    return tmp_path / name
+    return copy_case(tmp_path, name, edit, CSV)
 
 
 # --- hardness -> strength -----------------------------------------------------------------

@@ -50,6 +50,7 @@ import numpy as np
 
 from semianalytic.coefficients import READINGS
 from semianalytic.coefficients.table import (
+    CoefficientAccessors,
     BREAK_OFFSET,
     FLAT_TIP_DEPTH,
     NEAR_BREAK,
@@ -326,7 +327,7 @@ class _Knots:
 
 
 @dataclass(frozen=True, eq=False)
-class PlateCoefficientTable:
+class PlateCoefficientTable(CoefficientAccessors):
     """A(P) [m^3], B(P) [m^2] (three readings), C(P) [m^2], phi_tip [m] of a nose in a plate of
     thickness H, 0 <= P < infinity (zero for P >= H + L_h), with error estimates; the interface
     of :class:`semianalytic.coefficients.table.CoefficientTable` (no deep limit: a plate has none).
@@ -392,25 +393,6 @@ class PlateCoefficientTable:
             raise ValueError("depth P must be >= 0")
         out = np.array([self._eval1(name, float(p), deriv) for p in arr.ravel()]).reshape(arr.shape)
         return out[()]
-
-    def A(self, P):
-        """Added-mass volume A(P) = integral phi n_x dS [m^3] (Part I, eq. (12)) in the plate."""
-        return self._eval("A", P)
-
-    def B(self, P, reading: str | None = None):
-        """Drag area B(P) [m^2] in the given reading (Part I, eq. (12); errata item 2a)."""
-        reading = reading or self.reading
-        if reading not in READINGS:
-            raise ValueError(f"reading must be one of {READINGS}; got {reading!r}")
-        return self._eval(f"B_{reading}", P)
-
-    def C(self, P):
-        """Contact area C(P) = integral n_x dS [m^2] over the wetted surface (Part I, eq. (12))."""
-        return self._eval("C", P)
-
-    def phi_tip(self, P):
-        """phi at the nose tip [m] (0 once the tip has left the plate)."""
-        return self._eval("phi_tip", P)
 
     def dA_dP(self, P):
         """dA/dP [m^2]: the derivative of the interpolant of A."""

@@ -402,8 +402,33 @@ def _evaluate_splines(splines: dict, v: np.ndarray) -> dict:
 # the table
 
 
+class CoefficientAccessors:
+    """A(P), B(P), C(P) and phi at the tip of a table that interpolates by ``self._eval(name, P)``
+    (the half-space :class:`CoefficientTable` and the plate table of
+    :mod:`semianalytic.coefficients.plate`); ``self.reading`` is the default B reading."""
+
+    def A(self, P):
+        """Added-mass volume A(P) = integral phi n_x dS [m^3] (Part I, eq. (12))."""
+        return self._eval("A", P)
+
+    def B(self, P, reading: str | None = None):
+        """Drag area B(P) [m^2] in the given reading (Part I, eq. (12); errata item 2a)."""
+        reading = reading or self.reading
+        if reading not in READINGS:
+            raise ValueError(f"reading must be one of {READINGS}; got {reading!r}")
+        return self._eval(f"B_{reading}", P)
+
+    def C(self, P):
+        """Contact area C(P) = integral n_x dS [m^2] over the wetted surface (Part I, eq. (12))."""
+        return self._eval("C", P)
+
+    def phi_tip(self, P):
+        """phi at the nose tip [m] (Fig. 6; 0 once a plate's back face is passed)."""
+        return self._eval("phi_tip", P)
+
+
 @dataclass(frozen=True, eq=False)
-class CoefficientTable:
+class CoefficientTable(CoefficientAccessors):
     """A(P) [m^3], B(P) [m^2] in three readings, C(P) [m^2] and phi at the tip [m], with
     error estimates.
 
@@ -483,25 +508,6 @@ class CoefficientTable:
         for i in range(1, 6):
             out = out * h + c[..., i]
         return out[()]
-
-    def A(self, P):
-        """Added-mass volume A(P) = integral phi n_x dS [m^3] (Part I, eq. (12))."""
-        return self._eval("A", P)
-
-    def B(self, P, reading: str | None = None):
-        """Drag area B(P) [m^2] in the given reading (Part I, eq. (12); errata item 2a)."""
-        reading = reading or self.reading
-        if reading not in READINGS:
-            raise ValueError(f"reading must be one of {READINGS}; got {reading!r}")
-        return self._eval(f"B_{reading}", P)
-
-    def C(self, P):
-        """Contact area C(P) = integral n_x dS [m^2] (Part I, eq. (12))."""
-        return self._eval("C", P)
-
-    def phi_tip(self, P):
-        """phi at the nose tip [m] (Fig. 6)."""
-        return self._eval("phi_tip", P)
 
     def dA_dP(self, P):
         """dA/dP [m^2]: the derivative of the interpolant of A (equals B_bernoulli)."""
