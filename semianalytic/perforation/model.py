@@ -446,10 +446,21 @@ class BallisticLimit:
     iterations: int
 
 
+def _bisected(lo0, hi0, lo, hi, tol, n):
+    """The midpoint, half-bracket and step count of a finished bisection; RuntimeError when it
+    did not converge (200 steps) or one end never moved (the bracket held no sign change)."""
+    if hi - lo > tol:
+        raise RuntimeError(f"ballistic-limit bisection: bracket {hi - lo:g} m/s > tolerance {tol:g} after {n} steps")
+    if n and (lo == lo0 or hi == hi0):
+        raise RuntimeError(f"ballistic-limit bisection: no change of 'perforates' inside [{lo0:g}, {hi0:g}] m/s")
+    return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+
+
 def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
     """Bisection on 'perforates' between lo (stops) and hi: w(P_exit) = exp(-F) (V^2 - G(P_exit)) > 0
     of eq. (11) in P, integrated once (the integration does not depend on V below ``hi``); with a
     plug criterion, the full :func:`perforation_curve` at every step."""
+    lo0, hi0 = lo, hi
     if any(ly.shear_strength is not None for ly in coef.layers):
         n = 0
         while hi - lo > tol and n < 200:
@@ -459,7 +470,7 @@ def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
             else:
                 lo = mid
             n += 1
-        return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+        return _bisected(lo0, hi0, lo, hi, tol, n)
     prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
     Pe = coef.exit_depth
     G_e = float(prof.G(Pe))
@@ -471,7 +482,7 @@ def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
         else:
             lo = mid
         n += 1
-    return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+    return _bisected(lo0, hi0, lo, hi, tol, n)
 
 
 def ballistic_limit(coefficients: LayeredCoefficients, mass: float, upper: float, *, tolerance: float = 0.05,
