@@ -456,10 +456,11 @@ def _bisected(lo0, hi0, lo, hi, tol, n):
     return 0.5 * (lo + hi), 0.5 * (hi - lo), n
 
 
-def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
+def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0, prof=None):
     """Bisection on 'perforates' between lo (stops) and hi: w(P_exit) = exp(-F) (V^2 - G(P_exit)) > 0
     of eq. (11) in P, integrated once (the integration does not depend on V below ``hi``); with a
-    plug criterion, the full :func:`perforation_curve` at every step."""
+    plug criterion, the full :func:`perforation_curve` at every step.  ``prof``: that integration,
+    if already done (:func:`_profile_to_exit` at ``hi`` and ``panel_scale``)."""
     lo0, hi0 = lo, hi
     if any(ly.shear_strength is not None for ly in coef.layers):
         n = 0
@@ -471,7 +472,8 @@ def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
                 lo = mid
             n += 1
         return _bisected(lo0, hi0, lo, hi, tol, n)
-    prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
+    if prof is None:
+        prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
     Pe = coef.exit_depth
     G_e = float(prof.G(Pe))
     n = 0
@@ -491,9 +493,10 @@ def ballistic_limit(coefficients: LayeredCoefficients, mass: float, upper: float
     dynamics of eq. (11) until the bracket is below ``tolerance`` [m/s]; the error estimate adds
     the integration's and the coefficients' parts (``shifted``: coefficient objects with A, B
     or C shifted by its error estimate, see :class:`semianalytic.penetration.accuracy.ShiftedCoefficients`)."""
-    if not perforation_curve(coefficients, mass, [upper]).perforated[0]:
+    top = perforation_curve(coefficients, mass, [upper])
+    if not top.perforated[0]:
         raise ValueError(f"the upper bracket {upper:g} m/s does not perforate")
-    V, half, n = _bisect(coefficients, mass, float(lower), float(upper), tolerance)
+    V, half, n = _bisect(coefficients, mass, float(lower), float(upper), tolerance, prof=top.profile)
     hi = min(upper, V + 50 * tolerance + 5.0)
     lo = max(lower, V - 50 * tolerance - 5.0)
     V2, _, _ = _bisect(coefficients, mass, lo, hi, tolerance, panel_scale=0.5)
