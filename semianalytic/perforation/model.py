@@ -517,7 +517,10 @@ def lambert_jonas(Vs, a: float, p: float, V_bl: float):
 
 def lambert_jonas_fit(Vs, Vr, V_bl_guess: float | None = None) -> dict | None:
     """Least-squares fit of :func:`lambert_jonas` to (V_s, V_r) pairs (all pairs; V_r = 0 for a
-    stop).  Needs at least three perforating pairs; returns {a, p, V_bl_m_s, rms_m_s} or None."""
+    stop).  Needs at least three perforating pairs; returns {a, p, V_bl_m_s, rms_m_s}, or None
+    (too few pairs, or the least-squares solver did not converge: a RuntimeWarning says so)."""
+    import warnings
+
     from scipy.optimize import least_squares
 
     Vs = np.asarray(Vs, float)
@@ -536,6 +539,10 @@ def lambert_jonas_fit(Vs, Vr, V_bl_guess: float | None = None) -> dict | None:
 
     x0 = [1.0, 2.0, V_bl_guess / scale]
     sol = least_squares(resid, x0, bounds=([0.05, 1.0, 0.0], [1.5, 10.0, 1.0]), x_scale=[1.0, 1.0, 0.1])
+    if not sol.success:
+        warnings.warn(f"Lambert-Jonas fit: least_squares did not converge ({sol.message}); no fit reported",
+                      RuntimeWarning, stacklevel=2)
+        return None
     a, p, vb = sol.x
     return {"a": float(a), "p": float(p), "V_bl_m_s": float(vb * scale),
             "rms_m_s": float(np.sqrt(np.mean((sol.fun * scale) ** 2)))}
