@@ -159,6 +159,17 @@ def test_ballistic_limit_against_time_integration(demo_setup):
     assert below.final_depth < Pe < above.final_depth
 
 
+def test_ballistic_limit_bracket_without_the_limit_raises(demo_setup):
+    """A ``lower`` bracket that already perforates holds no change of sign: the bisection says so
+    instead of returning the bracket's end as the limit."""
+    from semianalytic.perforation.model import ballistic_limit
+
+    _, s = demo_setup
+    V = ballistic_limit(s.coefficients, s.mass, 400.0, tolerance=0.05).value
+    with pytest.raises(RuntimeError, match="no change"):
+        ballistic_limit(s.coefficients, s.mass, V + 20.0, lower=V + 10.0, tolerance=0.05)
+
+
 def test_residual_velocity_and_exit_time_against_time_integration(demo_setup):
     """V_r and the exit time of the P-form against the time integration's dense output at the
     exit depth; 1e-5 relative covers the dense output's interpolation (rtol 1e-10 steps)."""

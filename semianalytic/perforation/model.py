@@ -446,10 +446,22 @@ class BallisticLimit:
     iterations: int
 
 
-def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
+def _bisected(lo0, hi0, lo, hi, tol, n):
+    """The midpoint, half-bracket and step count of a finished bisection; RuntimeError when it
+    did not converge (200 steps) or one end never moved (the bracket held no sign change)."""
+    if hi - lo > tol:
+        raise RuntimeError(f"ballistic-limit bisection: bracket {hi - lo:g} m/s > tolerance {tol:g} after {n} steps")
+    if n and (lo == lo0 or hi == hi0):
+        raise RuntimeError(f"ballistic-limit bisection: no change of 'perforates' inside [{lo0:g}, {hi0:g}] m/s")
+    return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+
+
+def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0, prof=None):
     """Bisection on 'perforates' between lo (stops) and hi: w(P_exit) = exp(-F) (V^2 - G(P_exit)) > 0
     of eq. (11) in P, integrated once (the integration does not depend on V below ``hi``); with a
-    plug criterion, the full :func:`perforation_curve` at every step."""
+    plug criterion, the full :func:`perforation_curve` at every step.  ``prof``: that integration,
+    if already done (:func:`_profile_to_exit` at ``hi`` and ``panel_scale``)."""
+    lo0, hi0 = lo, hi
     if any(ly.shear_strength is not None for ly in coef.layers):
         n = 0
         while hi - lo > tol and n < 200:
@@ -459,8 +471,9 @@ def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
             else:
                 lo = mid
             n += 1
-        return 0.5 * (lo + hi), 0.5 * (hi - lo), n
-    prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
+        return _bisected(lo0, hi0, lo, hi, tol, n)
+    if prof is None:
+        prof = _profile_to_exit(coef, float(mass), float(hi), panel_scale)
     Pe = coef.exit_depth
     G_e = float(prof.G(Pe))
     n = 0
@@ -471,7 +484,7 @@ def _bisect(coef, mass, lo, hi, tol, panel_scale=1.0):
         else:
             lo = mid
         n += 1
-    return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+    return _bisected(lo0, hi0, lo, hi, tol, n)
 
 
 def ballistic_limit(coefficients: LayeredCoefficients, mass: float, upper: float, *, tolerance: float = 0.05,
@@ -480,9 +493,10 @@ def ballistic_limit(coefficients: LayeredCoefficients, mass: float, upper: float
     dynamics of eq. (11) until the bracket is below ``tolerance`` [m/s]; the error estimate adds
     the integration's and the coefficients' parts (``shifted``: coefficient objects with A, B
     or C shifted by its error estimate, see :class:`semianalytic.penetration.accuracy.ShiftedCoefficients`)."""
-    if not perforation_curve(coefficients, mass, [upper]).perforated[0]:
+    top = perforation_curve(coefficients, mass, [upper])
+    if not top.perforated[0]:
         raise ValueError(f"the upper bracket {upper:g} m/s does not perforate")
-    V, half, n = _bisect(coefficients, mass, float(lower), float(upper), tolerance)
+    V, half, n = _bisect(coefficients, mass, float(lower), float(upper), tolerance, prof=top.profile)
     hi = min(upper, V + 50 * tolerance + 5.0)
     lo = max(lower, V - 50 * tolerance - 5.0)
     V2, _, _ = _bisect(coefficients, mass, lo, hi, tolerance, panel_scale=0.5)
@@ -503,7 +517,10 @@ def lambert_jonas(Vs, a: float, p: float, V_bl: float):
 
 def lambert_jonas_fit(Vs, Vr, V_bl_guess: float | None = None) -> dict | None:
     """Least-squares fit of :func:`lambert_jonas` to (V_s, V_r) pairs (all pairs; V_r = 0 for a
-    stop).  Needs at least three perforating pairs; returns {a, p, V_bl_m_s, rms_m_s} or None."""
+    stop).  Needs at least three perforating pairs; returns {a, p, V_bl_m_s, rms_m_s}, or None
+    (too few pairs, or the least-squares solver did not converge: a RuntimeWarning says so)."""
+    import warnings
+
     from scipy.optimize import least_squares
 
     Vs = np.asarray(Vs, float)
@@ -522,6 +539,10 @@ def lambert_jonas_fit(Vs, Vr, V_bl_guess: float | None = None) -> dict | None:
 
     x0 = [1.0, 2.0, V_bl_guess / scale]
     sol = least_squares(resid, x0, bounds=([0.05, 1.0, 0.0], [1.5, 10.0, 1.0]), x_scale=[1.0, 1.0, 0.1])
+    if not sol.success:
+        warnings.warn(f"Lambert-Jonas fit: least_squares did not converge ({sol.message}); no fit reported",
+                      RuntimeWarning, stacklevel=2)
+        return None
     a, p, vb = sol.x
     return {"a": float(a), "p": float(p), "V_bl_m_s": float(vb * scale),
             "rms_m_s": float(np.sqrt(np.mean((sol.fun * scale) ** 2)))}
