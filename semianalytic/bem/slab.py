@@ -49,7 +49,6 @@ import math
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.linalg
 from scipy.special import digamma, zeta
 
 from semianalytic.bem.kernels import single_double
@@ -69,11 +68,10 @@ from semianalytic.bem.solve import (
     SurfaceSolution,
     _flat_nodes,
     _layers,
-    _single_threaded_blas,
     assemble,
     near_pairs,
     near_quadrature,
-    raise_non_finite,
+    solve_assembled,
 )
 from semianalytic.geometry import Line, Nose
 
@@ -396,18 +394,5 @@ def solve_slab(layout: SlabLayout, *, neumann=None, plan: SlabPlan | None = None
     same topology (the stencil of a difference in P)."""
     ps = layout.panels()
     S, D = assemble_slab(ps, layout.thickness, plan, layout.cap_radius(), cap_levels(layout))
-    # as semianalytic.bem.solve.solve_panels after its assembly (kept apart: that module is being
-    # reworked on another branch)
-    n = ps.n_primary
-    geo = ps.nodes
-    if neumann is None:
-        g = -geo.tr[:n].ravel()
-    else:
-        x = geo.x[:n].ravel() + ps.offset
-        g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    with _single_threaded_blas():
-        phi = scipy.linalg.solve(0.5 * np.eye(S.shape[0]) - D, -S @ g, overwrite_a=True, check_finite=False)
-    if not np.all(np.isfinite(phi)):
-        raise_non_finite(ps, layout.depth)
-    shape = (ps.n_primary, ps.order)
-    return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), "slab", depth=layout.depth)
+    phi, g = solve_assembled(ps, S, D, neumann, layout.depth)  # the half-space's solve step
+    return SurfaceSolution(ps, phi, g, "slab", depth=layout.depth)

@@ -732,7 +732,15 @@ def solve_panels(
     of a panel set of the same topology.
     """
     S, D = assemble(ps, plan, cache)
-    N = S.shape[0]
+    phi, g = solve_assembled(ps, S, D, neumann, depth)
+    return SurfaceSolution(ps, phi, g, kind, depth=depth, volume=volume)
+
+
+def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, depth: float | None = None):
+    """The boundary-integral equation (1/2 - D) phi = -S g of Part I, eq. (21) on assembled
+    single- and double-layer matrices (the half-space's and the plate's, bem/slab.py): the Neumann
+    data g at the primary nodes (default g = -n_x, unit motion in +x, Part I eq. (7)) and the
+    solution, both shaped (n_primary, order).  A non-finite solution raises ModelError."""
     geo = ps.nodes
     n = ps.n_primary
     if neumann is None:
@@ -740,13 +748,12 @@ def solve_panels(
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    A = 0.5 * np.eye(N) - D
     with _single_threaded_blas():
-        phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
+        phi = scipy.linalg.solve(0.5 * np.eye(S.shape[0]) - D, -S @ g, overwrite_a=True, check_finite=False)
     if not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
-    return SurfaceSolution(ps, phi.reshape(shape), g.reshape(shape), kind, depth=depth, volume=volume)
+    return phi.reshape(shape), g.reshape(shape)
 
 
 def raise_non_finite(ps: PanelSet, depth: float | None, what: str = "potential"):
