@@ -83,7 +83,9 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         warnings.showwarning = collect
         for category in (DeprecationWarning, PendingDeprecationWarning, FutureWarning, ResourceWarning):
             warnings.simplefilter("ignore", category)  # the libraries' business, not the user's
-        restore = _terminate_as_interrupt()
+        from semianalytic.io import interrupt_on_termination
+
+        restore = interrupt_on_termination()
         try:
             rc = _run_command(prog, name, module_name, help_, rest)
         finally:
@@ -100,30 +102,6 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
             if n > MAX_WARNINGS_PER_KIND:
                 print(f"warning: {kind}: {n - MAX_WARNINGS_PER_KIND} more warnings like the above", file=sys.stderr)
     return rc
-
-
-def _terminate_as_interrupt():
-    """SIGTERM and SIGHUP raise KeyboardInterrupt during a command (as Ctrl-C does), so that every
-    staging folder and temporary file is removed on the way out (issue 27).  Returns the undo."""
-    import signal
-    import threading
-
-    if threading.current_thread() is not threading.main_thread():
-        return lambda: None
-
-    def interrupt(signum, frame):
-        raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
-
-    old = {}
-    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
-        if sig is not None and signal.getsignal(sig) in (signal.SIG_DFL, None):
-            old[sig] = signal.signal(sig, interrupt)
-
-    def restore():
-        for sig, handler in old.items():
-            signal.signal(sig, handler)
-
-    return restore
 
 
 def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:

@@ -63,6 +63,40 @@ def contained_path(root: str | os.PathLike, relative: str, field: str) -> Path:
     return candidate
 
 
+def interrupt_on_termination():
+    """SIGTERM and SIGHUP raise KeyboardInterrupt (as Ctrl-C does) until the returned undo is
+    called, so that staging folders and temporary files are removed on the way out (issue 27).
+    Only in the main thread, and only where the signal has its default handler."""
+    import signal
+    import threading
+
+    if threading.current_thread() is not threading.main_thread():
+        return lambda: None
+
+    def interrupt(signum, frame):
+        raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
+
+    old = {}
+    for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
+        if sig is None:
+            continue
+        try:
+            if signal.getsignal(sig) in (signal.SIG_DFL, None):
+                old[sig] = signal.signal(sig, interrupt)
+        except (ValueError, OSError):
+            pass
+
+    def restore():
+        for sig, handler in old.items():
+            try:
+                signal.signal(sig, handler)
+            except (ValueError, OSError):
+                pass
+        old.clear()
+
+    return restore
+
+
 def check_report_target(path: str | os.PathLike, force: bool) -> Path:
     """A report path that may be written: refuse to overwrite an existing one without force, and
     (issue 27) a report into ``/``, the home folder (or above it) or a folder above the working

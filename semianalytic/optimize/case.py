@@ -260,8 +260,9 @@ def build_problem(
 def check_plate_objective(case: Case, objective: str, striking_velocity: str | None) -> tuple[float, ...]:
     """A plate objective needs a plate ([target] thickness or [[target.layers]]) and the perforation
     model (:mod:`semianalytic.perforation`); residual_velocity also striking velocities.  Returns them."""
-    target = case.target
-    if target is None or (getattr(target, "thickness", None) is None and not getattr(target, "layers", None)):
+    from semianalytic.sweep.perforation import has_plate
+
+    if not has_plate(case):
         raise InputError("--objective", f"{objective} needs a plate case: [target] thickness = '20 mm' (or "
                                         "[[target.layers]]); this case is a half-space")
     try:

@@ -122,11 +122,11 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
 
 def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
     """``ballistic_limit``: V_bl by bisection on Part I, eq. (11) through the plate
-    (:func:`semianalytic.perforation.ballistic_limit`; the upper bracket doubled from the largest
-    striking velocity, or 500 m/s, until it perforates, at most 20 km/s), minimised;
+    (:func:`semianalytic.sweep.perforation.plate_ballistic_limit`, the sweep's: the upper bracket
+    doubled from the largest striking velocity, or 500 m/s, until it perforates, at most 20 km/s), minimised;
     ``residual_velocity``: minus the mean V_r over the striking velocities
     (:func:`semianalytic.perforation.residual_velocity`)."""
-    from semianalytic.perforation import ballistic_limit, residual_velocity
+    from semianalytic.perforation import residual_velocity
     from semianalytic.perforation.evaluate import perforation_setup
 
     setup = perforation_setup(case, cache_dir)
@@ -136,16 +136,12 @@ def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
         out["residual_velocities_m_s"] = vr.tolist()
         out["objective"] = -float(np.mean(vr))
         return out
-    upper = max(list(problem.velocities) + [500.0])
-    while True:
-        try:
-            bl = ballistic_limit(setup.coefficients, setup.mass, upper)
-            break
-        except ValueError:  # the upper bracket does not perforate
-            if upper >= 20e3:
-                raise InputError("--objective", "ballistic_limit: the plate is not perforated below 20 km/s") from None
-            upper = min(2.0 * upper, 20e3)
-    out.update(objective=float(bl.value), ballistic_limit_m_s=float(bl.value), ballistic_limit_error_m_s=float(bl.error))
+    from semianalytic.sweep.perforation import MAX_UPPER, plate_ballistic_limit
+
+    value, error = plate_ballistic_limit(setup, max(list(problem.velocities) + [500.0]))
+    if not np.isfinite(value):
+        raise InputError("--objective", f"ballistic_limit: the plate is not perforated below {MAX_UPPER / 1e3:g} km/s")
+    out.update(objective=value, ballistic_limit_m_s=value, ballistic_limit_error_m_s=error)
     return out
 
 

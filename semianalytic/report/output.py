@@ -21,7 +21,8 @@ from pathlib import Path
 from typing import Any, Iterable
 
 from semianalytic.errors import InputError
-from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path
+from semianalytic.io import (atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path,
+                             interrupt_on_termination)
 
 MANIFEST = ".semianalytic-manifest.json"
 
@@ -233,7 +234,7 @@ class StagedDir:
         self.field = field
         self.root: Path | None = None
         self.files: list[str] = []
-        self._signals: dict = {}
+        self._restore_signals = lambda: None
 
     # -- context -------------------------------------------------------------------------
     def __enter__(self) -> "StagedDir":
@@ -252,7 +253,7 @@ class StagedDir:
         from semianalytic.io import _umask
 
         os.chmod(self.root, 0o777 & ~_umask())  # mkdtemp makes 0700; the report folder is for reading
-        self._trap_signals()
+        self._restore_signals = interrupt_on_termination()  # SIGTERM/SIGHUP remove the staging folder as Ctrl-C does
         return self
 
     def __exit__(self, exc_type, exc, tb) -> bool:
@@ -264,37 +265,6 @@ class StagedDir:
             return False
         finally:
             self._restore_signals()
-
-    def _trap_signals(self) -> None:
-        """SIGTERM (and SIGHUP) raise KeyboardInterrupt while the folder is staged, so that the
-        staging folder is removed as on Ctrl-C (only in the main thread, where Python can)."""
-        import signal
-        import threading
-
-        if threading.current_thread() is not threading.main_thread():
-            return
-
-        def interrupt(signum, frame):
-            raise KeyboardInterrupt(f"signal {signal.Signals(signum).name}")
-
-        for sig in (signal.SIGTERM, getattr(signal, "SIGHUP", None)):
-            if sig is None:
-                continue
-            try:
-                if signal.getsignal(sig) in (signal.SIG_DFL, None):
-                    self._signals[sig] = signal.signal(sig, interrupt)
-            except (ValueError, OSError):
-                pass
-
-    def _restore_signals(self) -> None:
-        import signal
-
-        for sig, old in self._signals.items():
-            try:
-                signal.signal(sig, old)
-            except (ValueError, OSError):
-                pass
-        self._signals = {}
 
     def _commit(self) -> None:
         write_manifest(self.root)

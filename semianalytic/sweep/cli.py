@@ -75,13 +75,14 @@ def run(args: argparse.Namespace) -> int:
     case = load_case(args.case)
     check_axes(case, spec)
     from semianalytic.guards import check_case, check_sweep_size
+    from semianalytic.sweep.kernels import changes_table
 
     check_case(case)  # refuse before any worker starts what would not fit in memory
     geometries = 1
     for axis in spec.axes:
-        if axis.key.startswith(GEOMETRY_PREFIXES):
+        if changes_table(axis.key):
             geometries *= len(axis.values)
-    geometries *= args.samples if any(s.key.startswith(GEOMETRY_PREFIXES) for s in spec.samplers) else 1
+    geometries *= args.samples if any(changes_table(s.key) for s in spec.samplers) else 1
     check_sweep_size(spec.n_cases, geometries, "--samples" if spec.samplers else "--vary")
     kernel = sweep_kernel(case, args.analysis, args.cache_dir, args.full)
     summary = run_sweep(
@@ -125,15 +126,12 @@ def sweep_kernel(case, analysis, cache_dir, full):
     return select_kernel(case, analysis, cache_dir=cache_dir, full=full)
 
 
-GEOMETRY_PREFIXES = ("projectile.crh", "projectile.half_angle", "projectile.diameter", "projectile.meplat",
-                     "projectile.tip_radius", "projectile.nose", "projectile.exponent", "projectile.points", "bem.", "coefficients.")
-
-
 def check_axes(case, spec) -> None:
     """Refuse (exit status 2) an axis whose every value the case rejects for that key, e.g.
     ``impact.striking_velocity=400:500:10 kg`` (a mass where a velocity belongs): checked at
     the first and the last value of each axis, before any worker starts."""
     from semianalytic.case import parse_case
+    from semianalytic.sweep.kernels import changes_table
     from semianalytic.sweep.spec import VELOCITY_KEY, apply_overrides, raw_value
 
     for axis in spec.axes:
@@ -143,7 +141,7 @@ def check_axes(case, spec) -> None:
             try:
                 varied = parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}),
                                     case.path)
-                if axis.key.startswith(GEOMETRY_PREFIXES):  # the BEM table of the first and last geometry fits
+                if changes_table(axis.key):  # the BEM table of the first and last geometry fits
                     from semianalytic.guards import check_case
 
                     try:

@@ -40,6 +40,13 @@ _NOT_GEOMETRY = frozenset({
 _ARRAY_PREFIXES = ("target.resistance.", "target.density", "projectile.density", "projectile.mass")
 
 
+def changes_table(key: str) -> bool:
+    """Whether a case key changes the coefficient table (the one list: :data:`_NOT_GEOMETRY`)."""
+    if key.startswith(("bem.", "coefficients.")):
+        return True
+    return key.startswith("projectile.") and key not in _NOT_GEOMETRY
+
+
 def geometry_key(case: Case) -> str:
     """The content key of everything the coefficient table depends on: the cache's own key
     (:func:`semianalytic.cache.case_table_key`, every nose parameter) with the B reading."""
@@ -210,11 +217,7 @@ class PenetrationKernel:
         }
 
     def affects_resource(self, key: str) -> bool:
-        if self.coefficients is not None:
-            return False
-        if key.startswith(("bem.", "coefficients.")):
-            return True
-        return key.startswith("projectile.") and key not in _NOT_GEOMETRY
+        return self.coefficients is None and changes_table(key)
 
     def resource_key(self, case: Case):
         return "fixed" if self.coefficients is not None else geometry_key(case)
