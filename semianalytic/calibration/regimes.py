@@ -370,6 +370,14 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
             "walkers": walkers, "steps": steps, "burn": burn}
 
 
+def _tate1986_resistance(case) -> float:
+    """R_t of Tate (1986) (:func:`.regime.tate_resistance`) from ``[target.resistance]``'s yield
+    stress and Young's modulus; NaN where the resistance model has neither."""
+    res = case.target.resistance
+    return (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
+            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+
+
 def regime_shots(case, coefficients) -> RegimeShots:
     """The shots of a case's ``[data]`` (every recorded response) as :class:`RegimeShots`: each
     shot's mass and hardness (``[data] hardness_column``, else ``[projectile] hardness``), its
@@ -393,9 +401,7 @@ def regime_shots(case, coefficients) -> RegimeShots:
         raise InputError("data.file", "no shots selected")
     base = PenetrationSetup.from_case(case, coefficients)
     ei = eroding_inputs(case, base)
-    res = case.target.resistance
-    tate = (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
-            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+    tate = _tate1986_resistance(case)
     U, m, P, rec, H, p1, crits = [], [], [], [], [], [], []
     col = data.response_column
     for s in shots:
@@ -604,9 +610,7 @@ def shots_at(case, coefficients, U) -> RegimeShots:
     p1 = np.asarray(penetration_curve(setup, U)["depth_elastic_exact_rod_m"], float)
     ci, phi = setup.critical_inputs(), setup.phi
     vcrit = np.vectorize(lambda Y: crit.critical_velocity(float(Y), ci, phi), otypes=[float])
-    res = case.target.resistance
-    tate = (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
-            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+    tate = _tate1986_resistance(case)
     n = len(U)
     return RegimeShots(
         group="prediction", ids=tuple(str(k) for k in range(n)), velocity=U, mass=np.full(n, setup.mass),
