@@ -5,13 +5,16 @@ constant, the dynamic factor f, and the discrepancy sigma):
 
 * projectile dynamic yield stress Y_p,i = f sigma_y(H_i) (ASTM E140 + Pavlina & Van Tyne 2008,
   :mod:`semianalytic.penetration.hardness`);
-* rigid -> deforming at U_y,i = U_sC(Y_p,i) of Part I, eqs. (33)/(36) (shot's mass);
+* rigid -> deforming at U_y,i by the criterion ``onset`` (:data:`.regime.ONSET_CRITERIA`: Tate's
+  (1967) tip pressure against Tabor's (1951) constrained yield stress 3 Y_p,i, the default, or
+  U_sC(Y_p,i) of Part I, eqs. (33)/(36), shot's mass);
 * deforming -> eroding at U_e,i by the criterion ``erosion`` (:data:`.regime.EROSION_CRITERIA`:
-  Tate's, published, or this project's nose-length rule);
+  the same tip pressure against 3 f sigma_u(H_i), the default, Tate's flat-rod criterion, or
+  this project's nose-length rule);
 * depth: Part I (elastic projectile, exact-rod W2) when rigid; the Alekseevskii-Tate rod with
   R_t from ``resistance`` (:data:`.regime.RESISTANCE_RELATIONS`: Part I eq. (16) or Tate 1986) and
-  Y_p,i when eroding; in the deforming band the model ``deforming``
-  (:data:`.regime.DEFORMING_MODELS`);
+  the rod strength ``rod_strength`` (Y_p,i or, the default, f sigma_u(H_i)) when eroding; in the
+  deforming band the model ``deforming`` (:data:`.regime.DEFORMING_MODELS`; default: the eroding rod);
 * ln P_i = ln D_i(f) + eps_i, eps_i ~ N(0, sigma^2); and the recorded response of each shot
   matches the predicted regime with probability 1 - epsilon (:data:`LABEL_ERROR`).
 
