@@ -5,13 +5,16 @@ constant, the dynamic factor f, and the discrepancy sigma):
 
 * projectile dynamic yield stress Y_p,i = f sigma_y(H_i) (ASTM E140 + Pavlina & Van Tyne 2008,
   :mod:`semianalytic.penetration.hardness`);
-* rigid -> deforming at U_y,i = U_sC(Y_p,i) of Part I, eqs. (33)/(36) (shot's mass);
+* rigid -> deforming at U_y,i by the criterion ``onset`` (:data:`.regime.ONSET_CRITERIA`: Tate's
+  (1967) tip pressure against Tabor's (1951) constrained yield stress 3 Y_p,i, the default, or
+  U_sC(Y_p,i) of Part I, eqs. (33)/(36), shot's mass);
 * deforming -> eroding at U_e,i by the criterion ``erosion`` (:data:`.regime.EROSION_CRITERIA`:
-  Tate's, published, or this project's nose-length rule);
+  the same tip pressure against 3 f sigma_u(H_i), the default, Tate's flat-rod criterion, or
+  this project's nose-length rule);
 * depth: Part I (elastic projectile, exact-rod W2) when rigid; the Alekseevskii-Tate rod with
   R_t from ``resistance`` (:data:`.regime.RESISTANCE_RELATIONS`: Part I eq. (16) or Tate 1986) and
-  Y_p,i when eroding; in the deforming band the model ``deforming``
-  (:data:`.regime.DEFORMING_MODELS`);
+  the rod strength ``rod_strength`` (Y_p,i or, the default, f sigma_u(H_i)) when eroding; in the
+  deforming band the model ``deforming`` (:data:`.regime.DEFORMING_MODELS`; default: the eroding rod);
 * ln P_i = ln D_i(f) + eps_i, eps_i ~ N(0, sigma^2); and the recorded response of each shot
   matches the predicted regime with probability 1 - epsilon (:data:`LABEL_ERROR`).
 
@@ -370,6 +373,14 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
             "walkers": walkers, "steps": steps, "burn": burn}
 
 
+def _tate1986_resistance(case) -> float:
+    """R_t of Tate (1986) (:func:`.regime.tate_resistance`) from ``[target.resistance]``'s yield
+    stress and Young's modulus; NaN where the resistance model has neither."""
+    res = case.target.resistance
+    return (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
+            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+
+
 def regime_shots(case, coefficients) -> RegimeShots:
     """The shots of a case's ``[data]`` (every recorded response) as :class:`RegimeShots`: each
     shot's mass and hardness (``[data] hardness_column``, else ``[projectile] hardness``), its
@@ -393,9 +404,7 @@ def regime_shots(case, coefficients) -> RegimeShots:
         raise InputError("data.file", "no shots selected")
     base = PenetrationSetup.from_case(case, coefficients)
     ei = eroding_inputs(case, base)
-    res = case.target.resistance
-    tate = (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
-            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+    tate = _tate1986_resistance(case)
     U, m, P, rec, H, p1, crits = [], [], [], [], [], [], []
     col = data.response_column
     for s in shots:
@@ -604,9 +613,7 @@ def shots_at(case, coefficients, U) -> RegimeShots:
     p1 = np.asarray(penetration_curve(setup, U)["depth_elastic_exact_rod_m"], float)
     ci, phi = setup.critical_inputs(), setup.phi
     vcrit = np.vectorize(lambda Y: crit.critical_velocity(float(Y), ci, phi), otypes=[float])
-    res = case.target.resistance
-    tate = (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
-            if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
+    tate = _tate1986_resistance(case)
     n = len(U)
     return RegimeShots(
         group="prediction", ids=tuple(str(k) for k in range(n)), velocity=U, mass=np.full(n, setup.mass),

@@ -30,7 +30,7 @@ import numpy as np
 from semianalytic.errors import InputError
 
 __all__ = ["E140_HRC_HV", "HRC_RANGE", "DEFAULT_DYNAMIC_FACTOR", "vickers_from_rockwell_c", "yield_stress_from_vickers",
-           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "dynamic_yield_stress", "parse_hardness"]
+           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "dynamic_yield_stress", "parse_hardness"]
 
 # ASTM E140, Table 1: HRC -> HV (non-austenitic steels), HRC 20..68
 E140_HRC_HV = (
@@ -65,6 +65,12 @@ def yield_stress_from_vickers(hv):
     """Static yield stress [Pa] from HV: Pavlina & Van Tyne (2008), J. Mater. Eng. Perform.
     17:888, eq. (4), sigma_y = -90.7 + 2.876 HV [MPa]."""
     return (-90.7 + 2.876 * np.asarray(hv, float))[()] * 1e6
+
+
+def vickers_from_yield_stress(sigma_y):
+    """HV from the static yield stress [Pa]: Pavlina & Van Tyne (2008), eq. (4) inverted,
+    HV = (sigma_y [MPa] + 90.7) / 2.876 (the inverse of :func:`yield_stress_from_vickers`)."""
+    return ((np.asarray(sigma_y, float) / 1e6 + 90.7) / 2.876)[()]
 
 
 def ultimate_strength_from_vickers(hv):

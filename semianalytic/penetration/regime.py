@@ -100,10 +100,8 @@ def eroding_rod_length(length: float, nose_length: float, diameter: float, densi
 
 
 def _erosion_end(rho_p: float, Y_p: float, rho_t: float, R_t: float) -> float:
-    """v_e: u = v (Y_p > R_t) or u = 0 (Y_p < R_t) (module docstring)."""
-    if Y_p > R_t:
-        return math.sqrt(2.0 * (Y_p - R_t) / rho_t)
-    return math.sqrt(2.0 * (R_t - Y_p) / rho_p)
+    """v_e: u = v (Y_p > R_t) or u = 0 (Y_p < R_t) (module docstring; scalar :func:`_erosion_end_array`)."""
+    return float(_erosion_end_array(rho_p, Y_p, rho_t, R_t))
 
 
 def _check_strengths(target_resistance: float, rod_strength: float, target_density: float, density: float):
@@ -137,7 +135,8 @@ def tate_integral(v, v_e, rho_p, Y_p, rho_t, R_t):
 
 
 def _erosion_end_array(rho_p, Y_p, rho_t, R_t):
-    """v_e of :func:`_erosion_end` for arrays of Y_p and R_t."""
+    """v_e for arrays of Y_p and R_t: sqrt(2 (Y_p - R_t)/rho_t) if Y_p > R_t (u = v), else
+    sqrt(2 (R_t - Y_p)/rho_p) (u = 0) (module docstring; Tate 1967)."""
     return np.where(Y_p > R_t, np.sqrt(2.0 * np.abs(Y_p - R_t) / rho_t), np.sqrt(2.0 * np.abs(R_t - Y_p) / rho_p))
 
 

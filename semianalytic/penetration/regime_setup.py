@@ -139,7 +139,8 @@ def rod_strengths(case, setup) -> tuple[float, float, float]:
     ``yield_stress`` only, it is read as f sigma_y of a steel (f = ``dynamic_factor`` default) and
     sigma_u follows through the Vickers hardness eq. (4) implies (eq. (4) inverted, then eq. (5))."""
     from semianalytic.penetration.hardness import (DEFAULT_DYNAMIC_FACTOR, parse_hardness,
-                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c)
+                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
+                                                   vickers_from_yield_stress)
 
     psec = case.projectile
     f = float(getattr(psec, "dynamic_factor", None) or DEFAULT_DYNAMIC_FACTOR)
@@ -150,7 +151,7 @@ def rod_strengths(case, setup) -> tuple[float, float, float]:
     if getattr(psec, "hardness", None) is not None:
         HV = float(vickers_from_rockwell_c(parse_hardness(psec.hardness)))
     else:
-        HV = (Y / f / 1e6 + 90.7) / 2.876  # Pavlina & Van Tyne (2008), eq. (4) inverted
+        HV = float(vickers_from_yield_stress(Y / f))
     return float(Y), float(f * ultimate_strength_from_vickers(HV)), f
 
 
