@@ -497,15 +497,26 @@ def ballistic_limit(coefficients: LayeredCoefficients, mass: float, upper: float
     if not top.perforated[0]:
         raise ValueError(f"the upper bracket {upper:g} m/s does not perforate")
     V, half, n = _bisect(coefficients, mass, float(lower), float(upper), tolerance, prof=top.profile)
-    hi = min(upper, V + 50 * tolerance + 5.0)
-    lo = max(lower, V - 50 * tolerance - 5.0)
-    V2, _, _ = _bisect(coefficients, mass, lo, hi, tolerance, panel_scale=0.5)
+    V2 = _bisect_near(coefficients, mass, V, 50 * tolerance + 5.0, lower, upper, tolerance, panel_scale=0.5)
     integ = abs(V2 - V)
     cpart = 0.0
     for sc in shifted or ():
-        Vs, _, _ = _bisect(sc, mass, max(lower, V - 20.0), min(upper * 2, V + 20.0), tolerance)
-        cpart += abs(Vs - V)
+        cpart += abs(_bisect_near(sc, mass, V, 20.0, lower, 2 * upper, tolerance) - V)
     return BallisticLimit(V, half + integ + cpart, half, integ, cpart, float(tolerance), n)
+
+
+def _bisect_near(coef, mass, V, width, lower, upper, tol, panel_scale=1.0) -> float:
+    """V_bl of a perturbed problem (finer integration, shifted coefficients) by bisection in a
+    bracket about the unperturbed ``V`` that doubles until it holds the limit (the perturbation may
+    move it by more than ``width``), at most to [lower, upper]; RuntimeError if even that does not."""
+    while True:
+        lo, hi = max(lower, V - width), min(upper, V + width)
+        try:
+            return _bisect(coef, mass, lo, hi, tol, panel_scale=panel_scale)[0]
+        except RuntimeError:
+            if lo <= lower and hi >= upper:
+                raise
+            width *= 2.0
 
 
 def lambert_jonas(Vs, a: float, p: float, V_bl: float):
