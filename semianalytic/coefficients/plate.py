@@ -413,19 +413,6 @@ class PlateCoefficientTable(CoefficientAccessors):
     def max_abs(self) -> dict:
         return {k: float(np.max(np.abs(self.values[k]))) if len(self.depth) else 0.0 for k in INTERPOLATED}
 
-    @property
-    def area(self) -> float:
-        return math.pi * self.diameter**2 / 4
-
-    def A_bar(self, P):
-        return self.A(P) / self.area
-
-    def B_bar(self, P, reading: str | None = None):
-        return self.B(P, reading) / self.area
-
-    def C_bar(self, P):
-        return self.C(P) / self.area
-
     # --- persistence ------------------------------------------------------------------
 
     def to_npz_bytes(self) -> bytes:

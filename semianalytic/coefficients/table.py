@@ -426,6 +426,25 @@ class CoefficientAccessors:
         """phi at the nose tip [m] (Fig. 6; 0 once a plate's back face is passed)."""
         return self._eval("phi_tip", P)
 
+    # --- normalised (Part I, after eq. (34); errata item 2) --------------------------
+
+    @property
+    def area(self) -> float:
+        """pi d^2 / 4 [m^2], the shank's cross-section (``self.diameter``)."""
+        return math.pi * self.diameter**2 / 4
+
+    def A_bar(self, P):
+        """Abar = 4A/(pi d^2), a length [m]."""
+        return self.A(P) / self.area
+
+    def B_bar(self, P, reading: str | None = None):
+        """Bbar = 4B/(pi d^2) (dimensionless)."""
+        return self.B(P, reading) / self.area
+
+    def C_bar(self, P):
+        """Cbar = 4C/(pi d^2) (dimensionless)."""
+        return self.C(P) / self.area
+
 
 @dataclass(frozen=True, eq=False)
 class CoefficientTable(CoefficientAccessors):
@@ -550,24 +569,6 @@ class CoefficientTable(CoefficientAccessors):
     def max_abs(self) -> dict:
         """Largest magnitude of each coefficient over the table (the tolerance's reference)."""
         return {k: float(max(np.max(np.abs(self.values[k])), abs(self.limits.get(k, 0.0)))) for k in INTERPOLATED}
-
-    # --- normalised (Part I, after eq. (34); errata item 2) --------------------------
-
-    @property
-    def area(self) -> float:
-        return math.pi * self.diameter**2 / 4
-
-    def A_bar(self, P):
-        """Abar = 4A/(pi d^2), a length [m]."""
-        return self.A(P) / self.area
-
-    def B_bar(self, P, reading: str | None = None):
-        """Bbar = 4B/(pi d^2) (dimensionless)."""
-        return self.B(P, reading) / self.area
-
-    def C_bar(self, P):
-        """Cbar = 4C/(pi d^2) (dimensionless)."""
-        return self.C(P) / self.area
 
     # --- contact pressure and region (Part I, eqs. (9), (13), (15)) ------------------
 
