@@ -287,29 +287,50 @@ def test_cli_regimes_report(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("nose, keys", [("ogive", "crh = 3.0"), ("sphere", "")])
-def test_default_regime_rule_is_tate_tabor(tmp_path, capsys, nose, keys):
+def test_default_regime_rule_is_meyer(tmp_path, capsys, nose, keys):
     """The default labels (chosen by transfer, reports/validation_regimes.md): rigid below
-    U_y = sqrt(2 (3 Y_p - R_t) / rho_t) (Tate 1967's tip pressure against Tabor's constrained yield
-    stress), eroding from U_e with the ultimate strength of Pavlina & Van Tyne (2008) in place of
-    Y_p, the Alekseevskii-Tate depth beyond U_y.  U_y and U_e are recomputed here by hand from the
-    printed R_t, Y_p and the case's density (independent of the code's path)."""
+    U_y = sqrt(2 (H_M - R_t) / rho_t) (Tate 1967's tip pressure against the rod's static Meyer
+    hardness H_M = HV x 9.80665 MPa / sin 68 deg), the depth Part I's below the breakup
+    U_b = sqrt(2 (1.15 H_M - R_t) / rho_t) and the Alekseevskii-Tate rod's above, eroding from
+    U_e with 3 x the dynamic ultimate strength of Pavlina & Van Tyne (2008).  Every velocity is
+    recomputed here by hand from the printed R_t, Y_p and the case's density (independent of the
+    code's path); HV from Y_p through Pavlina & Van Tyne's eq. (4) inverted."""
     code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper")
     assert code == 0, err
     res = json.loads(out)
     rho_t = 2710.0
     Y, R = res["yield_stress_Pa"], res["resistance_Pa"]
-    U_y = math.sqrt(2.0 * (3.0 * Y - R) / rho_t)
-    assert res["regime_rule"] == "tate_tabor"
-    assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
-    # sigma_u from the same Vickers hardness: HV = (Y/1.5 [MPa] + 90.7)/2.876, sigma_u = 1.5 (3.734 HV - 99.8)
     HV = (Y / 1.5e6 + 90.7) / 2.876
+    H_M = HV * 9.80665e6 / math.sin(math.radians(68.0))
+    U_y = math.sqrt(2.0 * (H_M - R) / rho_t)
+    U_b = math.sqrt(2.0 * (1.15 * H_M - R) / rho_t)
     U_e = math.sqrt(2.0 * (3.0 * 1.5e6 * (3.734 * HV - 99.8) - R) / rho_t)
+    assert res["regime_rule"] == "meyer"
+    assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
+    assert res["breakup_velocity_m_s"] == pytest.approx(min(U_b, U_e), rel=1e-12)
     assert res["erosion_velocity_m_s"] == pytest.approx(U_e, rel=1e-12)
     U = res["striking_velocity_m_s"]
     assert [r == "rigid" for r in res["regime"]] == [u < U_y for u in U]
     assert [r == "eroding" for r in res["regime"]] == [u >= U_e for u in U]
+    for i, u in enumerate(U):
+        expect = res["depth_elastic_exact_rod_m"][i] if u < min(U_b, U_e) else res["depth_eroding_m"][i]
+        assert res["depth_m"][i] == expect
+    assert all(res["valid"]["regime_aware"])
+    assert "Tate 1967" in err and "Meyer hardness" in err
+
+
+@pytest.mark.parametrize("nose, keys", [("ogive", "crh = 3.0")])
+def test_regime_rule_tate_tabor_by_hand(tmp_path, capsys, nose, keys):
+    """--regime-rule tate_tabor (the previous default): rigid below U_y = sqrt(2 (3 Y_p - R_t) /
+    rho_t) (Tabor's constrained dynamic yield stress), the eroding rod's depth beyond U_y."""
+    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper",
+                          "--regime-rule", "tate_tabor")
+    assert code == 0, err
+    res = json.loads(out)
+    Y, R = res["yield_stress_Pa"], res["resistance_Pa"]
+    U_y = math.sqrt(2.0 * (3.0 * Y - R) / 2710.0)
+    assert res["regime_rule"] == "tate_tabor"
+    assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
     for i, r in enumerate(res["regime"]):
         expect = res["depth_elastic_exact_rod_m"][i] if r == "rigid" else res["depth_eroding_m"][i]
         assert res["depth_m"][i] == expect
-    assert all(res["valid"]["regime_aware"])
-    assert "Tate 1967" in err

@@ -223,8 +223,9 @@ def _regimes_posterior(tmp_path, case_path, **over):
     obj = {"format": R.REGIMES_FORMAT, "version": R.REGIMES_VERSION, "model": "regimes",
            "options": R.DEFAULT_OPTIONS.as_dict(), "signature": R.geometry_signature(load_case(case_path)),
            "velocity_range_m_s": [569.0, 2988.0],
-           "samples": {"dynamic_factor": (1.26 + 0.02 * rng.standard_normal(n)).tolist(),
-                       "sigma": np.full(n, 0.12).tolist(), "tau": np.full(n, 0.04).tolist()}}
+           "samples": {"dynamic_factor": (1.48 + 0.02 * rng.standard_normal(n)).tolist(),
+                       "sigma": np.full(n, 0.12).tolist(), "tau": np.full(n, 0.04).tolist(),
+                       "breakup_factor": (1.15 + 0.02 * rng.standard_normal(n)).tolist()}}
     obj.update(over)
     p = tmp_path / "posterior.json"
     p.write_text(json.dumps(obj))

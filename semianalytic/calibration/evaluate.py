@@ -474,7 +474,7 @@ def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | Non
     """The regime-aware predictive quantiles at ``U``: per velocity the quantiles of the model
     that holds in the case's predicted regime (penetration.regime_setup.regime_labels, the same
     labels as ``penetrate``'s ``regime``): a rigid-projectile model while the projectile is rigid,
-    the eroding rod beyond the onset (default rule ``tate_tabor``, as ``depth_m``).  Returns
+    the eroding rod beyond the breakup (default rule ``meyer``, as ``depth_m``).  Returns
     ({quantile: list}, {"regime": [...], "rigid_model": name, "eroding_model": name}, warnings)."""
     from semianalytic.penetration.curve import PenetrationSetup
     from semianalytic.penetration.regime_setup import DEFAULT_PART1_MODEL, DEFAULT_REGIME_RULE, PART1_MODELS, regime_labels
@@ -484,8 +484,9 @@ def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | Non
     if setup.rod is None or setup.yield_stress is None:
         return {}, {}, ["warning: posterior: no regime-aware intervals: the regimes need the projectile's youngs_modulus and "
                         "yield_stress (U_sC of Part I, eqs. (33)/(36))"]
-    regimes, _, _, _ = regime_labels(case, setup, U)  # the labels of penetrate's regime (default rule)
-    eroding_band = [r != "rigid" for r in regimes] if DEFAULT_REGIME_RULE == "tate_tabor" else [r == "eroding" for r in regimes]
+    regimes, _, _, _, U_b = regime_labels(case, setup, U)  # the labels of penetrate's regime (default rule)
+    eroding_band = (list(np.asarray(U, float) >= U_b) if DEFAULT_REGIME_RULE in ("tate_tabor", "meyer")
+                    else [r == "eroding" for r in regimes])
     order = [part1_model or DEFAULT_PART1_MODEL, *PART1_MODELS, *MODELS]
     rigid = next((m for m in order if m in quantiles and m != ERODING), None)
     ero = ERODING if ERODING in quantiles else None

@@ -62,21 +62,27 @@ class Options:
     relation and the Y_p reading of the eroding rod, and the depth model of the deforming band
     (:mod:`semianalytic.penetration.regime`)."""
 
-    onset: str = "tate_tip"
+    onset: str = "meyer_tip"
     erosion: str = "tate_tip_uts"
     resistance: str = "part1"
     rod_strength: str = "ultimate"
-    deforming: str = "eroding"
+    deforming: str = "two_stage"
+    discrepancy: str = "shared"
 
     def label(self) -> str:
         return (f"onset={self.onset}, erosion={self.erosion}, R_t={self.resistance}, Y_p={self.rod_strength}, "
-                f"deforming={self.deforming}")
+                f"deforming={self.deforming}, sigma={self.discrepancy}")
 
     def as_dict(self) -> dict:
         return {"onset": self.onset, "erosion": self.erosion, "resistance": self.resistance,
-                "rod_strength": self.rod_strength, "deforming": self.deforming}
+                "rod_strength": self.rod_strength, "deforming": self.deforming, "discrepancy": self.discrepancy}
 
 
+DISCREPANCIES = ("shared", "per_regime")
+"""The depth discrepancy sigma: one for every state (``shared``), or one for the rigid state and one
+for the deformed states (``per_regime``: the Part I model of a rigid rod is checked to 5-10 % on
+rigid shots, a deforming or eroding rod is not; one sigma for both widens the rigid intervals by
+the misfit of the others)."""
 def _one_at_a_time() -> tuple:
     """The default and every alternative that changes one of its choices (the comparison that
     chose each default; the full product of 72 sets is not run)."""
@@ -86,7 +92,7 @@ def _one_at_a_time() -> tuple:
     out = [base]
     for name, values in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA),
                          ("resistance", rg.RESISTANCE_RELATIONS), ("rod_strength", rg.ROD_STRENGTHS),
-                         ("deforming", rg.DEFORMING_MODELS)):
+                         ("deforming", rg.DEFORMING_MODELS), ("discrepancy", DISCREPANCIES)):
         out += [dataclasses.replace(base, **{name: v}) for v in values if v != getattr(base, name)]
     return tuple(out)
 
@@ -111,6 +117,7 @@ class RegimeShots:
     responses: tuple
     static_yield: np.ndarray
     static_ultimate: np.ndarray
+    meyer_hardness: np.ndarray
     part1_depth: np.ndarray
     critical: object
     rod_length: np.ndarray
@@ -139,19 +146,23 @@ def _erosion_table(shots: RegimeShots, opt: Options):
 _TABLES: dict = {}
 
 
-def model_outcome(f, shots: RegimeShots, opt: Options):
+def model_outcome(f, shots: RegimeShots, opt: Options, b=None):
     """(regime code (n_f, n), depth [m] (n_f, n), U_y (n_f, n), U_e (n_f, n)) for dynamic factors
-    ``f`` (module docstring)."""
+    ``f`` (module docstring) and, with ``deforming = "two_stage"``, breakup factors ``b`` (one per f)."""
     f = np.atleast_1d(np.asarray(f, float))
     Y = f[:, None] * shots.static_yield[None, :]
     Yu = f[:, None] * shots.static_ultimate[None, :]
     R = shots.resistance[opt.resistance]
     R1 = shots.resistance["part1"]  # the onset criteria are about the rigid nose: Part I's R_t
     rho_t = shots.target_density
+    fu, inv = np.unique(f, return_inverse=True)  # what depends on f only is computed once per f (b repeats f)
+    inv = inv.ravel()
     if opt.onset == "part1_usc":
-        Uy = shots.critical(Y)
+        Uy = shots.critical(fu[:, None] * shots.static_yield[None, :])[inv]
     elif opt.onset == "tate_tip":
         Uy = rg.tate_erosion_velocity(Y, R1, rho_t, rg.TABOR_CONSTRAINT)
+    elif opt.onset == "meyer_tip":  # no fitted constant: the static Meyer hardness itself
+        Uy = np.broadcast_to(rg.tate_erosion_velocity(shots.meyer_hardness, R1, rho_t), Y.shape)
     else:
         raise ValueError(f"unknown onset criterion {opt.onset!r}")
     Yrod = Y if opt.rod_strength == "yield" else Yu
@@ -168,16 +179,24 @@ def model_outcome(f, shots: RegimeShots, opt: Options):
         raise ValueError(f"unknown erosion criterion {opt.erosion!r}")
     Ue = np.maximum(Uy, Ue)
     code = rg.regime_codes(shots.velocity[None, :], Uy, Ue)
+    Yrod_u = fu[:, None] * (shots.static_yield if opt.rod_strength == "yield" else shots.static_ultimate)[None, :]
     per_len, _, _ = rg.eroding_depth_per_length(shots.velocity[None, :], density=shots.density,
-                                                 target_density=rho_t, target_resistance=R, rod_strength=Yrod)
-    eroding = per_len * shots.rod_length[None, :]
+                                                 target_density=rho_t, target_resistance=R, rod_strength=Yrod_u)
+    eroding = per_len[inv] * shots.rod_length[None, :]
     part1 = np.broadcast_to(shots.part1_depth[None, :], code.shape)
     if opt.deforming == "part1_upper":
         Ux = Ue
     elif opt.deforming == "eroding":
         Ux = Uy
-    else:  # breakup: Part I below the tip-UTS velocity, eroding above
+    elif opt.deforming == "breakup":  # Part I below the tip-UTS velocity, eroding above
         Ux = np.clip(rg.tate_erosion_velocity(Yu, R1, rho_t, rg.TABOR_CONSTRAINT), Uy, Ue)
+    elif opt.deforming == "two_stage":  # Part I below the breakup pressure b H_M, eroding above
+        if b is None:
+            raise ValueError("deforming = 'two_stage' needs breakup factors b")
+        bb = np.broadcast_to(np.atleast_1d(np.asarray(b, float)), f.shape)
+        Ux = np.clip(rg.tate_erosion_velocity(bb[:, None] * shots.meyer_hardness[None, :], R1, rho_t), Uy, Ue)
+    else:
+        raise ValueError(f"unknown deforming-band model {opt.deforming!r}")
     depth = np.where(shots.velocity[None, :] >= Ux, eroding, part1)
     return Thresholds(code, depth, Uy, Ue, Ux, part1, eroding)
 
@@ -237,14 +256,16 @@ _TAU_GRID = np.exp(np.linspace(np.log(0.003), np.log(0.4), 24))
 def _log_likelihood(shots: RegimeShots, out: Thresholds, sigma, tau):
     """ln p(depths, responses | f, sigma, tau) per row (out rows match sigma and tau rows, or
     broadcast): over the four states of :func:`state_probabilities`, each response and depth
-    jointly (depth log-normal about the state's depth, response right with 1 - epsilon)."""
-    sig = np.asarray(sigma, float).reshape(-1, 1)
+    jointly (depth log-normal about the state's depth, response right with 1 - epsilon).  ``sigma``
+    (rows,) is shared by the states; (rows, 2) is (rigid state, deformed states)."""
+    sp = _sigma_pair(sigma)
     probs = state_probabilities(shots.velocity, out, tau)
     labels = (0, 1, 1, 2)
     has_d = np.isfinite(shots.depth)
     lnP = np.log(np.where(has_d, shots.depth, 1.0))[None, :]
     total = 0.0
-    for p, lab, D in zip(probs, labels, (out.part1, out.part1, out.eroding, out.eroding)):
+    for st, (p, lab, D) in enumerate(zip(probs, labels, (out.part1, out.part1, out.eroding, out.eroding))):
+        sig = sp[:, 0:1] if st == 0 else sp[:, 1:2]
         r = lnP - np.log(D)
         dens = np.where(has_d[None, :], np.exp(-0.5 * (r / sig) ** 2) / sig, 1.0)
         lab_p = np.where(shots.recorded[None, :] < 0, 1.0,
@@ -253,47 +274,121 @@ def _log_likelihood(shots: RegimeShots, out: Thresholds, sigma, tau):
     return np.sum(np.log(np.maximum(total, 1e-300)), axis=1)
 
 
-def grid_posterior(shots: RegimeShots, opt: Options) -> dict:
-    """Exact posterior of (f, sigma, tau) on a grid (priors of the module docstring): the f grid,
-    the joint weights (n_f, n_sigma, n_tau), the f marginal and its quantiles."""
-    out = model_outcome(_F_GRID, shots, opt)
-    sig, tau = _SIGMA_GRID, _TAU_GRID
-    nf, ns, nt = len(_F_GRID), len(sig), len(tau)
-    lp = np.empty((nf, ns, nt))
+BREAKUP_PRIOR = (1.0, 3.0)
+"""Prior of the breakup factor b of ``deforming = "two_stage"``: uniform(1, 3): the breakup pressure
+is not below the onset pressure (the static Meyer hardness, b = 1) and at most the 3 x hardness
+pressure that no steel rod of the data survives (the eroding regime starts below it)."""
+_B_GRID = np.linspace(1.0, 2.0, 51)  # 0.02 apart; the posterior found lies in 1.05-1.35, far from 2
+_F_GRID_2D = np.linspace(F_PRIOR[0], 2.2, 121)  # 0.01 apart on the (f, b) grid; the posteriors found lie in
+# 1.2-1.5, and the mass at the grid's upper end is checked (at_prior_edge)
+
+
+def _uses_breakup(opt: Options) -> bool:
+    return opt.deforming == "two_stage"
+
+
+_SIGMA_GRID_2 = np.exp(np.linspace(np.log(0.02), np.log(1.0), 16))
+
+
+def _sigma_pair(sigma):
+    """sigma as (rows, 2) = (rigid state, deformed states): a (rows,) array is shared by both."""
+    s = np.asarray(sigma, float)
+    return np.column_stack([s, s]) if s.ndim <= 1 else s
+
+
+def _grid_loglik(shots: RegimeShots, out: Thresholds, sig_r, sig_d, tau):
+    """ln p(data | row, sigma_r[i], sigma_d[j], tau_k) for every grid row: (rows, n_r, n_d, n_tau);
+    ``sig_d = None``: one sigma shared by every state (n_d = 1).  The state densities are computed
+    once per sigma and the state probabilities once per tau (:func:`_log_likelihood` is the same sum
+    for one (sigma, tau) per row)."""
+    has_d = np.isfinite(shots.depth)
+    lnP = np.log(np.where(has_d, shots.depth, 1.0))[None, :]
+    labels = (0, 1, 1, 2)
+    lab_p = [np.where(shots.recorded[None, :] < 0, 1.0, np.where(shots.recorded[None, :] == lab, 1.0 - LABEL_ERROR,
+                                                                 0.5 * LABEL_ERROR)) for lab in labels]
+    rp, re = lnP - np.log(out.part1), lnP - np.log(out.eroding)
+
+    def dens(r, sg):
+        return np.where(has_d[None, :], np.exp(-0.5 * (r / sg) ** 2) / sg, 1.0)
+
+    rows = out.Uy.shape[0]
+    shared = sig_d is None
+    nd = 1 if shared else len(sig_d)
+    lp = np.empty((rows, len(sig_r), nd, len(tau)))
     for k, t in enumerate(tau):
-        for j, sg in enumerate(sig):
-            lp[:, j, k] = _log_likelihood(shots, out, np.full(nf, sg), np.full(nf, t))
+        probs = state_probabilities(shots.velocity, out, np.full(rows, t))
+        w = [p * lab for p, lab in zip(probs, lab_p)]
+        for i, sr in enumerate(sig_r):
+            rig = w[0] * dens(rp, sr)
+            for j in range(nd):
+                sd = sr if shared else sig_d[j]
+                total = rig + w[1] * dens(rp, sd) + (w[2] + w[3]) * dens(re, sd)
+                lp[:, i, j, k] = np.sum(np.log(np.maximum(total, 1e-300)), axis=1)
+    return lp
+
+
+def grid_posterior(shots: RegimeShots, opt: Options) -> dict:
+    """Exact posterior of (f, sigma, tau) -- with the breakup factor b for ``deforming = "two_stage"``
+    and two sigmas for ``discrepancy = "per_regime"`` -- on a grid (priors of the module docstring):
+    the grid rows (f, b), the joint weights (rows, n_sigma_r, n_sigma_d, n_tau), the f marginal and
+    its quantiles (and b's)."""
+    if _uses_breakup(opt):
+        fg, bg = (a.ravel() for a in np.meshgrid(_F_GRID_2D, _B_GRID, indexing="ij"))
+    else:
+        fg, bg = _F_GRID, None
+    out = model_outcome(fg, shots, opt, bg)
+    per = opt.discrepancy == "per_regime"
+    sig = _SIGMA_GRID_2 if per else _SIGMA_GRID
+    tau = _TAU_GRID
+    lp = _grid_loglik(shots, out, sig, sig if per else None, tau)
     # half-normal priors; the grids are uniform in ln sigma and ln tau: + ln sigma + ln tau (Jacobian)
-    lp += (np.log(sig) - 0.5 * (sig / SIGMA_PRIOR_SCALE) ** 2)[None, :, None] + (np.log(tau) - 0.5 * (tau / TAU_PRIOR_SCALE) ** 2)[None, None, :]
+    ls = np.log(sig) - 0.5 * (sig / SIGMA_PRIOR_SCALE) ** 2
+    lp += ls[None, :, None, None] + (ls[None, None, :, None] if per else 0.0)
+    lp += (np.log(tau) - 0.5 * (tau / TAU_PRIOR_SCALE) ** 2)[None, None, None, :]
     lp -= lp.max()
     w = np.exp(lp)
     w /= w.sum()
-    wf = w.sum(axis=(1, 2))
+    wrow = w.sum(axis=(1, 2, 3))
+    fgrid = _F_GRID_2D if bg is not None else _F_GRID
+    wf = wrow.reshape(len(fgrid), -1).sum(axis=1)
     cdf = np.cumsum(wf)
-    q = {p: float(np.interp(p, cdf, _F_GRID)) for p in (0.05, 0.5, 0.95)}
-    edge = bool(wf[:8].sum() > 0.05 or wf[-8:].sum() > 0.05)
-    return {"f": _F_GRID, "weights": w, "f_weights": wf, "f_quantiles": q, "at_prior_edge": edge, "sigma": sig, "tau": tau}
+    q = {p: float(np.interp(p, cdf, fgrid)) for p in (0.05, 0.5, 0.95)}
+    edge = bool(wf[: len(fgrid) // 50].sum() > 0.05 or wf[-(len(fgrid) // 50):].sum() > 0.05)
+    res = {"f": fg, "b": bg, "weights": w, "f_weights": wf, "f_quantiles": q, "at_prior_edge": edge,
+           "sigma": sig, "sigma_d": sig if per else None, "tau": tau, "df": float(fgrid[1] - fgrid[0])}
+    if bg is not None:
+        wb = wrow.reshape(len(fgrid), -1).sum(axis=0)
+        cdfb = np.cumsum(wb)
+        res["b_quantiles"] = {p: float(np.interp(p, cdfb, _B_GRID)) for p in (0.05, 0.5, 0.95)}
+        res["b_at_grid_edge"] = bool(wb[-3:].sum() > 0.05)
+    return res
 
 
 def draws_from_grid(post: dict, n: int = 1000, seed: int = 1):
-    """(f, sigma, tau) draws (n,) from the grid posterior (cell jitter in f)."""
+    """(f, sigma (n, 2): rigid and deformed states, tau, b) draws from the grid posterior (cell
+    jitter in f and b; b is None without a breakup factor)."""
     rng = np.random.default_rng(seed)
     w = post["weights"].ravel()
     idx = rng.choice(len(w), size=n, p=w)
-    i, j, k = np.unravel_index(idx, post["weights"].shape)
-    df = post["f"][1] - post["f"][0]
-    f = np.clip(post["f"][i] + df * (rng.random(n) - 0.5), F_PRIOR[0], F_PRIOR[1])
-    return f, post["sigma"][j], post["tau"][k]
+    i, jr, jd, k = np.unravel_index(idx, post["weights"].shape)
+    f = np.clip(post["f"][i] + post["df"] * (rng.random(n) - 0.5), F_PRIOR[0], F_PRIOR[1])
+    b = None
+    if post.get("b") is not None:
+        db = _B_GRID[1] - _B_GRID[0]
+        b = np.clip(post["b"][i] + db * (rng.random(n) - 0.5), BREAKUP_PRIOR[0], BREAKUP_PRIOR[1])
+    sr = post["sigma"][jr]
+    sd = post["sigma_d"][jd] if post.get("sigma_d") is not None else sr
+    return f, np.column_stack([sr, sd]), post["tau"][k], b
 
 
-def predict(shots: RegimeShots, opt: Options, f, sigma, tau, probs=(0.05, 0.5, 0.95), seed: int = 2) -> dict:
+def predict(shots: RegimeShots, opt: Options, f, sigma, tau, probs=(0.05, 0.5, 0.95), seed: int = 2, b=None) -> dict:
     """Posterior predictive at the shots from draws (f, sigma, tau): regime probability (3, n)
     (exact over the transition scatter, averaged over draws), the regime-aware quantiles
     (len(probs), n) of the mixture over draws and states (each draw with one z per shot, a
     log-normal of its state's depth and sigma) and the most probable regime."""
     from semianalytic.calibration.sampler import mixture_quantiles
 
-    out = model_outcome(f, shots, opt)
+    out = model_outcome(f, shots, opt, b)
     p_r, p_d1, p_d2, p_e = state_probabilities(shots.velocity, out, tau)
     prob = np.stack([p_r.mean(axis=0), (p_d1 + p_d2).mean(axis=0), p_e.mean(axis=0)])
     rng = np.random.default_rng(seed)
@@ -301,7 +396,9 @@ def predict(shots: RegimeShots, opt: Options, f, sigma, tau, probs=(0.05, 0.5, 0
     t = np.asarray(tau, float)[:, None]
     Ueff = shots.velocity[None, :] * np.exp(-t * z)
     depth = np.where(Ueff >= out.Ux, out.eroding, out.part1)
-    q = mixture_quantiles(np.log(depth), np.asarray(sigma, float), probs)
+    sp = _sigma_pair(sigma)
+    sig_el = np.where(Ueff >= out.Uy, sp[:, 1:2], sp[:, 0:1])  # the rigid state's sigma or the deformed states'
+    q = mixture_quantiles(np.log(depth), sig_el, probs)
     return {"regime_probability": prob, "quantiles": q, "probs": tuple(probs), "regime": np.argmax(prob, axis=0),
             "U_y": np.median(out.Uy, axis=0), "U_e": np.median(out.Ue, axis=0), "U_x": np.median(out.Ux, axis=0)}
 
@@ -327,50 +424,77 @@ def transfer_scores(shots: RegimeShots, pred: dict) -> dict:
 
 def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers: int = 8, steps: int = 1500,
                    burn: int = 500, seed: int = 1, max_draws: int = 2000, start_f=(1.05, 2.0)) -> dict:
-    """The posterior of (f, sigma) by emcee: ``chains`` independent ensembles of ``walkers``
-    walkers each, started apart over the prior (f uniform over its range); sampled in
-    (f, ln sigma).  Diagnostics: arviz rank-normalised split R-hat and the bulk and tail
-    effective sample sizes per parameter, every walker of every ensemble one chain (as
-    arviz.from_emcee reads an ensemble), after ``burn`` steps.  The parameters are (f, ln sigma, ln tau); the ensembles start
-    apart, f uniform over ``start_f``."""
+    """The posterior by emcee: ``chains`` independent ensembles of ``walkers`` walkers each, started
+    apart over the prior (f uniform over ``start_f``).  Sampled in (f, ln sigma, ln tau), plus the
+    breakup factor b (``deforming = "two_stage"``) and ln sigma of the deformed states
+    (``discrepancy = "per_regime"``).  Diagnostics: arviz rank-normalised split R-hat and the bulk and
+    tail effective sample sizes per parameter, every walker of every ensemble one chain (as
+    arviz.from_emcee reads an ensemble), after ``burn`` steps."""
     import emcee
 
     from semianalytic.calibration.sampler import MOVES, chain_diagnostics
 
     rng = np.random.default_rng(seed)
+    has_b, per = _uses_breakup(opt), opt.discrepancy == "per_regime"
+    names = ["dynamic_factor", "sigma", "tau"] + (["breakup_factor"] if has_b else []) + (["sigma_deformed"] if per else [])
+    ib = 3 if has_b else None
+    isd = len(names) - 1 if per else None
 
     def log_prob(x):
         x = np.atleast_2d(x)
         f, ls, lt = x[:, 0], x[:, 1], x[:, 2]
         sg, t = np.exp(ls), np.exp(lt)
+        b = x[:, ib] if has_b else None
+        lsd = x[:, isd] if per else ls
+        sd = np.exp(lsd)
         out = np.full(len(x), -np.inf)
-        ok = (f >= F_PRIOR[0]) & (f <= F_PRIOR[1]) & (sg < 5.0) & (t < 2.0)
+        ok = (f >= F_PRIOR[0]) & (f <= F_PRIOR[1]) & (sg < 5.0) & (t < 2.0) & (sd < 5.0)
+        if has_b:
+            ok &= (b >= BREAKUP_PRIOR[0]) & (b <= BREAKUP_PRIOR[1])
         if ok.any():
-            th = model_outcome(f[ok], shots, opt)
-            ll = _log_likelihood(shots, th, sg[ok], t[ok])
+            th = model_outcome(f[ok], shots, opt, b[ok] if has_b else None)
+            ll = _log_likelihood(shots, th, np.column_stack([sg[ok], sd[ok]]), t[ok])
             out[ok] = (ll - 0.5 * (sg[ok] / SIGMA_PRIOR_SCALE) ** 2 + ls[ok]
                        - 0.5 * (t[ok] / TAU_PRIOR_SCALE) ** 2 + lt[ok])  # + Jacobians of ln sigma, ln tau
+            if per:
+                out[ok] += -0.5 * (sd[ok] / SIGMA_PRIOR_SCALE) ** 2 + lsd[ok]
         return out
 
     chains_out = []
     for c in range(chains):
-        p0 = np.column_stack([rng.uniform(*start_f, walkers), np.log(rng.uniform(0.05, 0.4, walkers)),
-                              np.log(rng.uniform(0.01, 0.15, walkers))])
+        cols = [rng.uniform(*start_f, walkers), np.log(rng.uniform(0.05, 0.4, walkers)),
+                np.log(rng.uniform(0.01, 0.15, walkers))]
+        if has_b:
+            cols.append(rng.uniform(1.0, 1.5, walkers))
+        if per:
+            cols.append(np.log(rng.uniform(0.05, 0.4, walkers)))
+        p0 = np.column_stack(cols)
         # differential-evolution moves (ter Braak 2006; emcee.moves.DEMove / DESnookerMove): the posterior
         # has steps in f where a transition crosses a shot, which the stretch move crosses slowly
-        sampler = emcee.EnsembleSampler(walkers, 3, log_prob, vectorize=True, moves=MOVES())
+        sampler = emcee.EnsembleSampler(walkers, len(names), log_prob, vectorize=True, moves=MOVES())
         sampler.random_state = np.random.RandomState(seed + 1000 * c).get_state()
         sampler.run_mcmc(p0, steps, progress=False)
-        chains_out.append(sampler.get_chain(discard=burn))  # (steps - burn, walkers, 2)
-    arr = np.concatenate([np.swapaxes(ch, 0, 1) for ch in chains_out])  # (chains x walkers, draws, 3)
-    nat = np.stack([arr[..., 0], np.exp(arr[..., 1]), np.exp(arr[..., 2])], axis=-1)
-    diag = chain_diagnostics(nat, ("dynamic_factor", "sigma", "tau"))
+        chains_out.append(sampler.get_chain(discard=burn))  # (steps - burn, walkers, n_par)
+    arr = np.concatenate([np.swapaxes(ch, 0, 1) for ch in chains_out])  # (chains x walkers, draws, n_par)
+    nat = arr.copy()
+    for k, name in enumerate(names):
+        if name.startswith("sigma") or name == "tau":
+            nat[..., k] = np.exp(arr[..., k])
+    diag = chain_diagnostics(nat, tuple(names))
     diag["ensembles"] = chains
-    flat = nat.reshape(-1, 3)
+    flat = nat.reshape(-1, len(names))
     thin = max(1, int(math.ceil(len(flat) / max_draws)))
     flat = flat[::thin]
-    return {"f": flat[:, 0], "sigma": flat[:, 1], "tau": flat[:, 2], "diagnostics": diag, "chains": chains,
-            "walkers": walkers, "steps": steps, "burn": burn}
+    res = {"f": flat[:, 0], "sigma": flat[:, 1], "tau": flat[:, 2], "diagnostics": diag, "chains": chains,
+           "walkers": walkers, "steps": steps, "burn": burn, "b": flat[:, ib] if has_b else None,
+           "sigma_deformed": flat[:, isd] if per else None, "names": tuple(names)}
+    return res
+
+
+def _sigmas(sample) -> np.ndarray:
+    """(n, 2) sigma of the rigid and the deformed states from a sample (one shared sigma: equal)."""
+    sd = sample.get("sigma_deformed")
+    return np.column_stack([sample["sigma"], sample["sigma"] if sd is None else sd])
 
 
 def _tate1986_resistance(case) -> float:
@@ -388,8 +512,9 @@ def regime_shots(case, coefficients) -> RegimeShots:
     from semianalytic.errors import InputError
     from semianalytic.penetration import critical as crit
     from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
-    from semianalytic.penetration.hardness import (parse_hardness, ultimate_strength_from_vickers,
-                                                   vickers_from_rockwell_c, yield_stress_from_vickers)
+    from semianalytic.penetration.hardness import (meyer_hardness_from_vickers, parse_hardness,
+                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
+                                                   yield_stress_from_vickers)
     from semianalytic.penetration.regime_setup import RESPONSE_REGIME, eroding_inputs
     from semianalytic.penetration.validation import load_shots
 
@@ -434,7 +559,7 @@ def regime_shots(case, coefficients) -> RegimeShots:
         group="+".join(groups) or (data.name or "data"), ids=tuple(s.id for s in shots), velocity=np.array(U),
         mass=np.array(m), depth=np.array(P), recorded=np.array(rec), responses=tuple(s.row.get(col, "") if col else "" for s in shots),
         static_yield=np.asarray(yield_stress_from_vickers(HV), float), static_ultimate=np.asarray(ultimate_strength_from_vickers(HV), float),
-        part1_depth=np.array(p1), critical=critical, rod_length=rod,
+        meyer_hardness=np.asarray(meyer_hardness_from_vickers(HV), float), part1_depth=np.array(p1), critical=critical, rod_length=rod,
         length=ei.length, nose_length=ei.nose_length, diameter=ei.diameter, density=ei.density,
         target_density=ei.target_density, resistance={"part1": base.resistance_pa, "tate1986": tate})
 
@@ -449,9 +574,9 @@ def transfer_study(pairs, options=OPTION_SETS, n_draws: int = 1000) -> dict:
         rec = {"options": opt.as_dict(), "label": opt.label(), "transfer": [], "in_sample": []}
         posts = {s.group: grid_posterior(s, opt) for s in pairs}
         for fit in pairs:
-            f, sig, tau = draws_from_grid(posts[fit.group], n_draws)
+            f, sig, tau, b = draws_from_grid(posts[fit.group], n_draws)
             for tgt in pairs:
-                pred = predict(tgt, opt, f, sig, tau)
+                pred = predict(tgt, opt, f, sig, tau, b=b)
                 sc = transfer_scores(tgt, pred)
                 sc.update({"fit": fit.group, "predict": tgt.group, "f_quantiles": posts[fit.group]["f_quantiles"],
                            "f_at_prior_edge": posts[fit.group]["at_prior_edge"],
@@ -520,23 +645,29 @@ def geometry_signature(case) -> dict:
 def posterior_json(case, shots: RegimeShots, opt: Options, sample: dict, n_store: int = 1000) -> dict:
     """The JSON posterior of ``calibrate --model regimes``: options, signature, draws, diagnostics."""
     idx = np.linspace(0, len(sample["f"]) - 1, min(n_store, len(sample["f"]))).astype(int)
-    summ = {k: dict(zip(("q05", "q50", "q95"), map(float, np.percentile(sample[k], [5, 50, 95]))))
-            for k in ("f", "sigma", "tau")}
+    keys = {"dynamic_factor": "f", "sigma": "sigma", "tau": "tau", "breakup_factor": "b", "sigma_deformed": "sigma_deformed"}
+    present = {name: np.asarray(sample[k]) for name, k in keys.items() if sample.get(k) is not None}
+    summ = {name: dict(zip(("q05", "q50", "q95"), map(float, np.percentile(v, [5, 50, 95])))) for name, v in present.items()}
+    priors = {"dynamic_factor": f"uniform({F_PRIOR[0]:g}, {F_PRIOR[1]:g})",
+              "sigma": f"halfnormal({SIGMA_PRIOR_SCALE:g})", "tau": f"halfnormal({TAU_PRIOR_SCALE:g})",
+              "label_error": LABEL_ERROR}
+    edge = {"dynamic_factor": bool(np.mean(sample["f"] < F_PRIOR[0] + 0.02) > 0.05
+                                   or np.mean(sample["f"] > F_PRIOR[1] - 0.02) > 0.05)}
+    if "breakup_factor" in present:
+        priors["breakup_factor"] = f"uniform({BREAKUP_PRIOR[0]:g}, {BREAKUP_PRIOR[1]:g})"
+        b = present["breakup_factor"]
+        edge["breakup_factor"] = bool(np.mean(b < BREAKUP_PRIOR[0] + 0.01) > 0.05 or np.mean(b > BREAKUP_PRIOR[1] - 0.02) > 0.05)
+    if "sigma_deformed" in present:
+        priors["sigma_deformed"] = f"halfnormal({SIGMA_PRIOR_SCALE:g})"
     return {
         "format": REGIMES_FORMAT, "version": REGIMES_VERSION, "model": "regimes",
         "case": str(case.path) if case.path else case.title, "title": case.title,
         "options": opt.as_dict(), "signature": geometry_signature(case),
         "velocity_range_m_s": [float(np.min(shots.velocity)), float(np.max(shots.velocity))],
         "groups": shots.group, "n_shots": len(shots),
-        "priors": {"dynamic_factor": f"uniform({F_PRIOR[0]:g}, {F_PRIOR[1]:g})",
-                   "sigma": f"halfnormal({SIGMA_PRIOR_SCALE:g})", "tau": f"halfnormal({TAU_PRIOR_SCALE:g})",
-                   "label_error": LABEL_ERROR},
-        "summary": {"dynamic_factor": summ["f"], "sigma": summ["sigma"], "tau": summ["tau"]},
-        "at_prior_edge": {"dynamic_factor": bool(np.mean(sample["f"] < F_PRIOR[0] + 0.02) > 0.05
-                                                 or np.mean(sample["f"] > F_PRIOR[1] - 0.02) > 0.05)},
+        "priors": priors, "summary": summ, "at_prior_edge": edge,
         "diagnostics": sample["diagnostics"],
-        "samples": {"dynamic_factor": sample["f"][idx].tolist(), "sigma": sample["sigma"][idx].tolist(),
-                    "tau": sample["tau"][idx].tolist()},
+        "samples": {name: v[idx].tolist() for name, v in present.items()},
     }
 
 
@@ -565,6 +696,9 @@ def read_regimes_posterior(path, case) -> dict:
         obj = json.loads(Path(path).read_text())
         opt = Options(**obj["options"])
         draws = {k: np.asarray(obj["samples"][k], float) for k in ("dynamic_factor", "sigma", "tau")}
+        for k in ("breakup_factor", "sigma_deformed"):
+            if k in obj["samples"]:
+                draws[k] = np.asarray(obj["samples"][k], float)
         sig = obj["signature"]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError("--posterior", f"{path}: not a readable regimes posterior ({exc})") from None
@@ -583,9 +717,14 @@ def read_regimes_posterior(path, case) -> dict:
         raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another target: "
                                         "refit with calibrate --model regimes)")
     for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
-                    ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS)):
+                    ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
+                    ("discrepancy", DISCREPANCIES)):
         if getattr(opt, k) not in vals:
             raise InputError("--posterior", f"{path}: unknown model set {k} = {getattr(opt, k)!r}")
+    for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
+        if need and (k not in draws or len(draws[k]) != len(draws["sigma"])):
+            raise InputError("--posterior", f"{path}: samples.{k} missing or of another length than samples.sigma "
+                                            f"(the model set {opt.label()} needs it)")
     notes = []
     if other_nose:
         notes.append(f"note: posterior {path}: fitted for {', '.join(other_nose)}; applied to this case's nose as a "
@@ -599,8 +738,9 @@ def shots_at(case, coefficients, U) -> RegimeShots:
     from semianalytic.errors import InputError
     from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
     from semianalytic.penetration import critical as crit
-    from semianalytic.penetration.hardness import (parse_hardness, ultimate_strength_from_vickers,
-                                                   vickers_from_rockwell_c, yield_stress_from_vickers)
+    from semianalytic.penetration.hardness import (meyer_hardness_from_vickers, parse_hardness,
+                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
+                                                   yield_stress_from_vickers)
     from semianalytic.penetration.regime_setup import eroding_inputs
 
     if case.projectile.hardness is None:
@@ -618,7 +758,8 @@ def shots_at(case, coefficients, U) -> RegimeShots:
     return RegimeShots(
         group="prediction", ids=tuple(str(k) for k in range(n)), velocity=U, mass=np.full(n, setup.mass),
         depth=np.full(n, np.nan), recorded=np.full(n, -1), responses=("",) * n, static_yield=np.full(n, float(yield_stress_from_vickers(HV))),
-        static_ultimate=np.full(n, float(ultimate_strength_from_vickers(HV))), part1_depth=p1, critical=vcrit,
+        static_ultimate=np.full(n, float(ultimate_strength_from_vickers(HV))),
+        meyer_hardness=np.full(n, float(meyer_hardness_from_vickers(HV))), part1_depth=p1, critical=vcrit,
         rod_length=np.full(n, rg.eroding_rod_length(ei.length, ei.nose_length, ei.diameter, ei.density, setup.mass)),
         length=ei.length, nose_length=ei.nose_length, diameter=ei.diameter, density=ei.density,
         target_density=ei.target_density, resistance={"part1": setup.resistance_pa, "tate1986": tate})
@@ -633,7 +774,10 @@ def predict_case(case, coefficients, path, U, probs=(0.05, 0.25, 0.5, 0.75, 0.95
     shots = shots_at(case, coefficients, U)
     d = post["draws"]
     idx = np.linspace(0, len(d["sigma"]) - 1, min(PREDICTION_DRAWS, len(d["sigma"]))).astype(int)
-    pred = predict(shots, post["options"], d["dynamic_factor"][idx], d["sigma"][idx], d["tau"][idx], probs)
+    sd = d.get("sigma_deformed")
+    sig = np.column_stack([d["sigma"][idx], (sd if sd is not None else d["sigma"])[idx]])
+    b = d["breakup_factor"][idx] if "breakup_factor" in d else None
+    pred = predict(shots, post["options"], d["dynamic_factor"][idx], sig, d["tau"][idx], probs, b=b)
     lo, hi = post["raw"]["velocity_range_m_s"]
     holds = (shots.velocity >= 0.9 * lo) & (shots.velocity <= 1.1 * hi)
     q = np.where(holds[None, :], pred["quantiles"], np.nan)

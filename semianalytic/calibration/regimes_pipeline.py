@@ -59,9 +59,9 @@ def run_regimes(args, command: str) -> dict:
         posts = {g.group: R.grid_posterior(g, R.DEFAULT_OPTIONS) for g in groups}
         for c, k, g in zip(cases, coefs, groups):
             fit = next(h for h in groups if h is not g)
-            f, s, t = R.draws_from_grid(posts[fit.group], 1000)
+            f, s, t, b = R.draws_from_grid(posts[fit.group], 1000)
             pts = R.shots_at(c, k, CURVE_VELOCITIES)
-            pred = R.predict(pts, R.DEFAULT_OPTIONS, f, s, t)
+            pred = R.predict(pts, R.DEFAULT_OPTIONS, f, s, t, b=b)
             result["curves"][g.group] = {"fit": fit.group, "velocity_m_s": CURVE_VELOCITIES.tolist(),
                                          "q05_m": pred["quantiles"][0].tolist(), "q50_m": pred["quantiles"][1].tolist(),
                                          "q95_m": pred["quantiles"][2].tolist(),

@@ -272,7 +272,8 @@ def chain_diagnostics(chains, names) -> dict:
 
 def mixture_quantiles(mu: np.ndarray, sigma: np.ndarray, probs, max_draws: int = 2000) -> np.ndarray:
     """Quantiles of the mixture (1/n) sum_s LogNormal(mu_s, sigma_s^2) for each column of
-    mu (n_s, n_x); returns (len(probs), n_x) in the units of exp(mu).  Solved for ln q by
+    mu (n_s, n_x) (sigma (n_s,) or, one per element, (n_s, n_x)); returns (len(probs), n_x) in the
+    units of exp(mu).  Solved for ln q by
     bisection on the mixture CDF (monotone) over [min mu - 10 sigma, max mu + 10 sigma], 48
     halvings (ln q to about 1e-13).  More than ``max_draws`` draws are thinned evenly (the
     Monte-Carlo error of a quantile from 2000 draws is well below the interval widths)."""
@@ -281,7 +282,7 @@ def mixture_quantiles(mu: np.ndarray, sigma: np.ndarray, probs, max_draws: int =
     if len(s) > max_draws:
         idx = np.linspace(0, len(s) - 1, max_draws).astype(int)
         mu, s = mu[idx], s[idx]
-    s = s[:, None, None]
+    s = np.broadcast_to(s[:, None] if s.ndim == 1 else s, mu.shape)[:, None, :]
     p = np.asarray(probs, float)[:, None]
     lo = np.broadcast_to(np.min(mu - 10 * s[:, :, 0], axis=0), (len(p), mu.shape[1])).copy()
     hi = np.broadcast_to(np.max(mu + 10 * s[:, :, 0], axis=0), (len(p), mu.shape[1])).copy()

@@ -70,10 +70,12 @@ def add_arguments(parser) -> None:
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
                              "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding); a "
                              "posterior of calibrate --model regimes adds regime_probability and the regime mixture")
-    parser.add_argument("--regime-rule", choices=("tate_tabor", "nose_length"), default="tate_tabor",
-                        help="regime labels without a posterior: tate_tabor (default, chosen by transfer: Tate's tip "
-                             "pressure against 3 x the rod's dynamic yield and ultimate strengths) or nose_length (the "
-                             "earlier rule: U_sC of eqs. (33)/(36), then the shank eroded to the nose length)")
+    parser.add_argument("--regime-rule", choices=("meyer", "tate_tabor", "nose_length"), default="meyer",
+                        help="regime labels without a posterior: meyer (default, chosen by transfer: Tate's tip "
+                             "pressure against the rod's static Meyer hardness for the onset, 1.15 x it for the breakup "
+                             "where the depth drops to the eroding rod's, 3 x the dynamic ultimate strength for erosion), "
+                             "tate_tabor (the previous default: 3 x the dynamic yield stress for the onset) or nose_length "
+                             "(the earlier rule: U_sC of eqs. (33)/(36), then the shank eroded to the nose length)")
     parser.add_argument("--csv", metavar="FILE", default=None,
                         help="also write FILE (CSV): one row per case, striking velocity and model (units in the header)")
 
@@ -120,6 +122,13 @@ def _print_text(result: dict, desc: str, file=None) -> None:
           f"eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s (Alekseevskii-Tate, Y_p = "
           f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa), "
           f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
+    elif result.get("regime_rule") == "meyer":
+        p(f"  regimes (Tate 1967 tip pressure against the rod's Meyer hardness H_M and 3 x its dynamic ultimate strength, "
+          f"Tabor 1951): rigid below U_y = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, the rod breaks up "
+          f"(tip pressure 1.15 H_M, this project's own) from U_b = {_fmt(result['breakup_velocity_m_s'], 1, 0)} m/s, eroding "
+          f"from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s; depth = {result['part1_model']} below U_b, "
+          f"Alekseevskii-Tate rod above (Y_p = {result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = "
+          f"{result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")
     else:
         p(f"  regimes (Tate 1967 tip pressure against 3 x the rod's strength, Tabor 1951): rigid below U_y = "
           f"{_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s, "

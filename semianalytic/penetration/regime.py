@@ -273,7 +273,7 @@ TABOR_CONSTRAINT = 3.0
 """Constraint factor C of a plastically indented solid: mean contact pressure = C x flow stress,
 C ~ 3 for metals (Tabor 1951, The Hardness of Metals, Oxford, ch. 4-5)."""
 
-ONSET_CRITERIA = ("part1_usc", "tate_tip")
+ONSET_CRITERIA = ("part1_usc", "tate_tip", "meyer_tip")
 """Rigid -> deforming.  ``part1_usc``: Part I, eqs. (33)/(36) (the mean axial stress of the
 shank reaches Y_p).  ``tate_tip``: Tate's criterion (Tate 1967, J. Mech. Phys. Solids 15:387:
 a rod deforms and erodes once the interface pressure (1/2) rho_t U^2 + R_t exceeds its strength)
@@ -300,7 +300,7 @@ ROD_STRENGTHS = ("yield", "ultimate")
 """Y_p of the Alekseevskii-Tate rod: the dynamic factor times the static yield stress or times
 the ultimate strength (a flow stress at the large strains of an eroding nose) from the hardness."""
 
-DEFORMING_MODELS = ("part1_upper", "eroding", "breakup")
+DEFORMING_MODELS = ("part1_upper", "eroding", "breakup", "two_stage")
 """Depth in the deforming band: ``part1_upper`` (this project's own reading: the Part I depth of a
 nose that keeps its shape, an upper bound); ``eroding`` (the Alekseevskii-Tate rod with its
 rigid-rod phase, Tate 1967 / Part IV eqs. (2)-(3), which covers a rod that erodes while it
@@ -308,6 +308,13 @@ decelerates and penetrates rigidly below v_e); ``breakup`` (this project's own c
 the two: the Part I depth while the tip's pressure stays below its constrained ultimate strength,
 the tip-UTS velocity of :data:`EROSION_CRITERIA` ``tate_tip_uts``, the eroding rod's above it: a
 nose that has yielded keeps penetrating as a slightly bent rigid body until it breaks up)."""
+
+
+DEFAULT_BREAKUP_FACTOR = 1.15
+"""b of the breakup (``deforming = "two_stage"``): the depth drops from Part I's to the eroding rod's
+once the tip pressure reaches b x the rod's static Meyer hardness (this project's own criterion;
+the onset is b = 1).  1.15: between the posterior medians fitted on each steel of Piekutowski et
+al. (1999), each transferring to the other (reports/validation_regimes.md)."""
 
 
 def tate_erosion_velocity(rod_strength, target_resistance, target_density: float, constraint: float = 1.0):

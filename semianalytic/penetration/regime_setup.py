@@ -118,29 +118,37 @@ def _velocities(U, mask) -> str:
     return ", ".join(f"{u:.0f}" for u in np.asarray(U)[mask])
 
 
-REGIME_RULES = ("tate_tabor", "nose_length")
-"""How ``penetrate`` labels the regimes without a posterior.  ``tate_tabor`` (default, chosen by
-the leave-one-material-out transfer of reports/validation_regimes.md, the ``Options()`` default of
+REGIME_RULES = ("meyer", "tate_tabor", "nose_length")
+"""How ``penetrate`` labels the regimes without a posterior.  ``meyer`` (default, chosen by the
+leave-one-material-out transfer of reports/validation_regimes.md, the ``Options()`` default of
 semianalytic/calibration/regimes.py): rigid while Tate's (1967) tip pressure (1/2) rho_t U^2 + R_t
+stays below the rod's static Meyer hardness H_M (the mean pressure of plastic indentation, Tabor
+1951; from the hardness, or from the yield stress through Pavlina & Van Tyne's eq. (4) inverted):
+no fitted constant; the depth is Part I's (a bent rod with its nose) until the tip pressure
+reaches b H_M (b = :data:`.regime.DEFAULT_BREAKUP_FACTOR`, the breakup: the rod turns round or
+breaks; this project's own criterion with a fitted factor), the Alekseevskii-Tate rod's (Y_p = f
+sigma_u, R_t of Part I) beyond; eroding once the pressure reaches 3 f sigma_u (Tabor's constraint
+on the dynamic ultimate strength).  ``tate_tabor`` (the previous default): rigid while Tate's (1967) tip pressure (1/2) rho_t U^2 + R_t
 stays below the constrained dynamic yield stress C Y_p (C = 3, Tabor 1951), eroding once it reaches
 C f sigma_u (the dynamic ultimate strength), the Alekseevskii-Tate rod (Y_p = f sigma_u, R_t of
 Part I) giving the depth beyond the onset; the combination of Tate's criterion with Tabor's factor
 is this project's reading of the two published relations.  ``nose_length``: the earlier rule (U_sC
 of Part I, eqs. (33)/(36), then the shank eroded down to the nose length; this project's own),
 kept as a named option; it lost on transfer."""
-DEFAULT_REGIME_RULE = "tate_tabor"
+DEFAULT_REGIME_RULE = "meyer"
 
 
-def rod_strengths(case, setup) -> tuple[float, float, float]:
-    """(dynamic yield stress, dynamic ultimate strength [Pa], dynamic factor f) of the projectile.
+def rod_strengths(case, setup, meyer: bool = False):
+    """(dynamic yield stress, dynamic ultimate strength [Pa], dynamic factor f) of the projectile,
+    and its static Meyer hardness [Pa] as a fourth element with ``meyer=True``.
 
     With ``[projectile] hardness`` the yield stress is already f sigma_y(HV) (case layer) and the
     ultimate strength is f sigma_u(HV) (ASTM E140, Pavlina & Van Tyne 2008, eqs. (4)-(5)).  With a
     ``yield_stress`` only, it is read as f sigma_y of a steel (f = ``dynamic_factor`` default) and
     sigma_u follows through the Vickers hardness eq. (4) implies (eq. (4) inverted, then eq. (5))."""
-    from semianalytic.penetration.hardness import (DEFAULT_DYNAMIC_FACTOR, parse_hardness,
-                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
-                                                   vickers_from_yield_stress)
+    from semianalytic.penetration.hardness import (DEFAULT_DYNAMIC_FACTOR, meyer_hardness_from_vickers,
+                                                   parse_hardness, ultimate_strength_from_vickers,
+                                                   vickers_from_rockwell_c, vickers_from_yield_stress)
 
     psec = case.projectile
     f = float(getattr(psec, "dynamic_factor", None) or DEFAULT_DYNAMIC_FACTOR)
@@ -152,22 +160,30 @@ def rod_strengths(case, setup) -> tuple[float, float, float]:
         HV = float(vickers_from_rockwell_c(parse_hardness(psec.hardness)))
     else:
         HV = float(vickers_from_yield_stress(Y / f))
-    return float(Y), float(f * ultimate_strength_from_vickers(HV)), f
+    out = (float(Y), float(f * ultimate_strength_from_vickers(HV)), f)
+    return (*out, float(meyer_hardness_from_vickers(HV))) if meyer else out
 
 
 def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
-    """(regimes per velocity, U_y, U_e [m/s], the eroding rod's inputs) by the rule ``rule``
-    (:data:`REGIME_RULES`); the one place both ``penetrate`` and ``penetrate --posterior`` label."""
+    """(regimes per velocity, U_y, U_e [m/s], the eroding rod's inputs, U_b [m/s]: where the depth
+    becomes the eroding rod's) by the rule ``rule`` (:data:`REGIME_RULES`); the one place both
+    ``penetrate`` and ``penetrate --posterior`` label."""
     if rule not in REGIME_RULES:
         raise InputError("--regime-rule", f"must be one of {', '.join(REGIME_RULES)}; got {rule!r}")
     U = np.atleast_1d(np.asarray(U, float))
     ei = eroding_inputs(case, setup)
-    if rule == "tate_tabor":
-        Y_dyn, Yu_dyn, f = rod_strengths(case, setup)
+    U_b = None
+    if rule in ("tate_tabor", "meyer"):
+        Y_dyn, Yu_dyn, f, H_M = rod_strengths(case, setup, meyer=True)
         R1 = setup.resistance_pa  # the onset criteria are about the rigid nose: Part I's R_t
         rho_t = ei.target_density
-        U_y = float(rg.tate_erosion_velocity(Y_dyn, R1, rho_t, rg.TABOR_CONSTRAINT))
+        if rule == "meyer":
+            U_y = float(rg.tate_erosion_velocity(H_M, R1, rho_t))
+        else:
+            U_y = float(rg.tate_erosion_velocity(Y_dyn, R1, rho_t, rg.TABOR_CONSTRAINT))
         U_e = max(U_y, float(rg.tate_erosion_velocity(Yu_dyn, R1, rho_t, rg.TABOR_CONSTRAINT)))
+        U_b = (min(max(float(rg.tate_erosion_velocity(rg.DEFAULT_BREAKUP_FACTOR * H_M, R1, rho_t)), U_y), U_e)
+               if rule == "meyer" else U_y)
         if case.projectile.dynamic_yield_stress is None:  # the eroding rod flows at its ultimate strength
             ei = ErodingInputs(**{**ei.__dict__, "rod_strength": Yu_dyn,
                                   "defaults": tuple(d for d in ei.defaults if "dynamic_yield_stress" not in d)
@@ -176,7 +192,7 @@ def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
     else:
         U_y = float(setup.critical_velocity())
         U_e = rg.erosion_onset_velocity(U_y, **ei.kwargs(mass=setup.mass))
-    return rg.classify_regimes(U, U_y, U_e), U_y, U_e, ei
+    return rg.classify_regimes(U, U_y, U_e), U_y, U_e, ei, U_b
 
 
 def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
@@ -190,19 +206,19 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         raise InputError("--part1-model", f"must be one of {', '.join(PART1_MODELS)}; got {part1_model!r}")
     U = np.atleast_1d(np.asarray(U, float))
     part1 = np.asarray(curve[f"depth_{part1_model}_m"], float)
-    regimes, U_y, U_e, ei = regime_labels(case, setup, U, rule)
+    regimes, U_y, U_e, ei, U_b = regime_labels(case, setup, U, rule)
     er = rg.eroding_depth(U, **ei.kwargs(mass=setup.mass))
     reg = np.asarray(regimes)
-    if rule == "tate_tabor":
-        depth = np.where(reg == "rigid", part1, er.depth)  # the deforming band: the eroding rod (chosen by transfer)
+    if rule in ("tate_tabor", "meyer"):  # Part I below U_b, the eroding rod beyond (tate_tabor: U_b = U_y)
+        depth = np.where(U < U_b, part1, er.depth)
     else:
         depth = rg.regime_depth(regimes, part1, er.depth)
     rigid_ok = reg == "rigid"
     valid = {k: rigid_ok.tolist() for k in PART1_MODELS}
     if peers is not None:
         valid.update({k: rigid_ok.tolist() for k in ("forrestal", "chen_li")})
-    if rule == "tate_tabor":
-        valid["eroding"] = (reg != "rigid").tolist()
+    if rule in ("tate_tabor", "meyer"):
+        valid["eroding"] = (U >= U_b).tolist()
         valid["regime_aware"] = [True] * len(reg)
     else:
         valid["eroding"] = (reg == "eroding").tolist()
@@ -219,14 +235,17 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
                                                   "; the regimes (Tate's criterion) do not use U_sC"))
     if np.any(~rigid_ok):
         why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))" if rule == "nose_length" else
+               f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches the rod's Meyer hardness "
+               "(Tate 1967, Tabor 1951): the nose yields" if rule == "meyer" else
                f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches 3 Y_p (Tate 1967, Tabor 1951): "
                "the nose yields")
         for k in valid:
             if k not in ("eroding", "regime_aware"):
                 warnings.append(f"{_LABEL[k]}: depth outside the model's validity at U_s = {_velocities(U, ~rigid_ok)} m/s; {why}")
-    bad_eroding = (reg == "rigid") if rule == "tate_tabor" else (reg != "eroding")
+    bad_eroding = (U < U_b) if rule in ("tate_tabor", "meyer") else (reg != "eroding")
     if np.any(bad_eroding):
         why = ((f"U_s < U_y = {U_y:.0f} m/s: the projectile stays rigid" if rule == "tate_tabor" else
+                f"U_s < U_b = {U_b:.0f} m/s: the rod keeps its nose (rigid, or bent but not broken)" if rule == "meyer" else
                 f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
                 "rigid or deforming, not eroding") if math.isfinite(U_e) else "no erosion predicted")
         warnings.append(f"{_LABEL['eroding']}: depth outside the model's validity at U_s = "
@@ -243,6 +262,7 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         "residual_length_eroding_m": er.residual_length.tolist(),
         "transition_velocity_m_s": U_y,
         "erosion_velocity_m_s": U_e,
+        "breakup_velocity_m_s": U_b,
         "part1_model": part1_model,
         "regime_rule": rule,
         "eroding_inputs": {"rod_strength_Pa": ei.rod_strength, "target_resistance_Pa": ei.target_resistance,
