@@ -122,6 +122,32 @@ def test_tip_criterion_places_both_onsets_between_the_recorded_shots():
     assert rg.tate_erosion_velocity(1.0e9, R_t, 2710.0) == 0.0  # Y_p < R_t: erodes at any velocity
 
 
+def test_meyer_onset_without_a_fitted_constant_against_the_recorded_transitions():
+    """The default onset: Tate's tip pressure (1/2) rho_t U^2 + R_t against the rod's static Meyer
+    hardness, no fitted constant.  The Meyer hardness by hand from the Vickers pyramid's geometry
+    (136 deg between faces: contact area d^2 / (2 sin 68 deg), projected area d^2 / 2), and the onset
+    of each steel from its shots' mean hardness within 1 % of the interval between its last rigid
+    and its first deformed shot (VAR 4340: 1237 / 1365 m/s; AerMet 100: 1786 / 1816 m/s; the
+    measured onset: 1362 and 1825 m/s, 0.5 % above AerMet 100's first deformed shot)."""
+    from semianalytic.penetration import hardness as H
+    from semianalytic.penetration import regime as rg
+
+    d = 1e-4  # any indent diagonal: H_M / HV = contact area / projected area
+    contact, projected = d**2 / (2 * math.sin(math.radians(68.0))), d**2 / 2
+    # H_M = F / projected area, HV = F / contact area (in kgf/mm^2): H_M = HV x contact / projected
+    assert H.meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 * 9.80665e6 * contact / projected, rel=1e-12)
+    assert H.meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 * 9.80665e6 * 1.07853, rel=1e-5)
+    rows = _rows()
+    R_t = 1453.55e6  # Part I, eq. (16), Y = 400 MPa, E = 68.9 GPa, nu = 0.33 (the cases' target)
+    for mat in ("VAR4340", "AerMet100"):
+        mine = sorted((float(r["Vs_m_s"]), r["regime"]) for r in rows if r["material"] == mat)
+        last_rigid = max(v for v, g in mine if g == "rigid")
+        first_def = min(v for v, g in mine if g != "rigid")
+        hrc = np.mean([float(r["hardness_Rc"]) for r in rows if r["material"] == mat])
+        U = rg.tate_erosion_velocity(H.meyer_hardness_from_vickers(H.vickers_from_rockwell_c(hrc)), R_t, 2710.0)
+        assert 0.99 * last_rigid < U < 1.01 * first_def, (mat, U)
+
+
 def test_tate_1986_resistance_by_hand():
     """Tate (1986): R_t = Y (2/3 + ln(0.57 E / Y)); Y = 276 MPa, E = 68.9 GPa: 0.57 x 68900 / 276
     = 142.29, ln = 4.9579, R_t = 276 x 5.6246 = 1552.4 MPa."""
@@ -182,28 +208,34 @@ def _recorded(mat):
 def test_transfer_between_materials_against_the_data_file(study):
     """Leave one material out with the default model set: each steel predicted from the fit on the
     other; the figures are recomputed here from the predicted labels and quantiles against the
-    data file's recorded responses and depths.  Measured (reports/validation_regimes.md): labels
-    right 29 of 34 (85 %: shots at the transitions, e.g. AerMet 100's last rigid shot at 1786 m/s
-    and first deformed ones at 1816-2042 m/s); eroding mean |error| 8 %, rigid 8 %.  Asserted: at
-    least 28 of 34 labels (the issue's 90 % is 31: missed, see test_issue22_targets; one label of
-    slack for the 600-draw Monte Carlo at shots whose probabilities are near 1/2), eroding and
-    rigid mean |error| <= 15 % (the issue's target, met), every eroded shot labelled eroding."""
+    data file's recorded responses and depths.  Measured (reports/validation_regimes.md, 1000
+    draws): labels right 31 of 34 (the issue's 90 %: the misses are shots at the transitions,
+    VAR 4340's first curved shot at 1365 m/s and AerMet 100's first deformed ones at 1816-1817 m/s,
+    within 1 % of the predicted onset); eroding mean |error| 8 %, rigid 8 %.  Asserted: at least
+    31 of 34 labels (the 600 draws here are seeded: the figure is deterministic, and it is the
+    target), eroding and rigid mean |error| <= 15 % and 90 % coverage of the deforming and eroding
+    shots in 80-95 % (the issue's targets, met), every eroded shot labelled eroding."""
     shots = [s for t in study["options"][0]["transfer"] for s in t["shots"]]
     rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
     assert sorted(s["shot"] for s in shots) == sorted(rec)
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
-    assert right >= 28
+    assert right >= 31
     for reg in ("rigid", "eroding"):
         e = [abs(s["q50_m"] / rec[s["shot"]][1] - 1) for s in shots if rec[s["shot"]][0] == reg and math.isfinite(rec[s["shot"]][1])]
         assert np.mean(e) <= 0.15, (reg, np.mean(e))
+    for reg in ("deforming", "eroding"):
+        cov = [s["q05_m"] <= rec[s["shot"]][1] <= s["q95_m"] for s in shots
+               if rec[s["shot"]][0] == reg and math.isfinite(rec[s["shot"]][1])]
+        assert 0.80 <= np.mean(cov) <= 0.95, (reg, np.mean(cov))
     assert all(s["predicted"] == "eroding" for s in shots if rec[s["shot"]][0] == "eroding")
     for s in shots:  # probabilities sum to 1
         assert sum(s["regime_probability"].values()) == pytest.approx(1.0, abs=1e-12)
 
 
-@pytest.mark.xfail(strict=True, reason="issue 22 targets missed by transfer: 29/34 labels (85 % < 90 %), deforming-band "
-                                       "median error 26 %, 90 % coverage 100 % (> 95 %) in the rigid and deforming "
-                                       "regimes (reports/validation_regimes.md)")
+@pytest.mark.xfail(strict=True, reason="issue 22 targets missed by transfer: deforming-band median error 24 % (> 15 %: the Part I depth 18 % above "
+                                       "the curved shots, the eroding rod 19-26 % above the turned-around ones, "
+                                       "two shots at the breakup), rigid 90 % coverage 100 % (> 95 %) "
+                                       "(reports/validation_regimes.md)")
 def test_issue22_targets(study):
     sm = study["options"][0]["summary"]
     assert sm["label_right"] >= 0.9 * sm["labelled"]
@@ -304,7 +336,8 @@ def test_emcee_against_the_grid_posterior_and_diagnostics(groups):
     s = R.sample_regimes(groups[0], R.DEFAULT_OPTIONS, steps=2000, burn=700)
     g = R.grid_posterior(groups[0], R.DEFAULT_OPTIONS)
     assert abs(np.median(s["f"]) - g["f_quantiles"][0.5]) < 0.03
-    assert set(s["diagnostics"]["parameters"]) == {"dynamic_factor", "sigma", "tau"}
+    assert set(s["diagnostics"]["parameters"]) == {"dynamic_factor", "sigma", "tau", "breakup_factor"}
+    assert abs(np.median(s["b"]) - g["b_quantiles"][0.5]) < 0.03
 
 
 @pytest.mark.slow
@@ -321,7 +354,7 @@ def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     rec = {**_recorded("VAR4340"), **_recorded("AerMet100")}
     shots = [s for t in tr["options"][0]["transfer"] for s in t["shots"]]
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
-    assert f"regime label right {right}/34" in stdout and right >= 28
+    assert f"regime label right {right}/34" in stdout and right >= 31
     assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
     assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 68  # 2 header lines + 66 velocities
 
@@ -332,8 +365,11 @@ def test_shipped_regimes_posterior_is_healthy():
     sampler warning, and its dynamic factor is inside its prior (1, 3), away from the edges."""
     post = json.loads((ROOT / "reports" / "calibration_piekutowski1999_regimes" / "posterior.json").read_text())
     d = post["diagnostics"]
-    assert d["ensembles"] == 4 and set(d["parameters"]) == {"dynamic_factor", "sigma", "tau"} and not d["warnings"]
+    assert d["ensembles"] == 4 and set(d["parameters"]) == {"dynamic_factor", "sigma", "tau", "breakup_factor"}
+    assert not d["warnings"]
     for p in d["parameters"].values():
         assert p["r_hat"] <= 1.01 and min(p["ess_bulk"], p["ess_tail"]) >= 400
     f = post["summary"]["dynamic_factor"]
     assert 1.05 < f["q05"] < f["q95"] < 2.95 and not post["at_prior_edge"]["dynamic_factor"]
+    b = post["summary"]["breakup_factor"]  # prior uniform(1, 3): away from both ends
+    assert 1.02 < b["q05"] < b["q95"] < 2.9 and not post["at_prior_edge"]["breakup_factor"]

@@ -600,6 +600,36 @@ def transfer_study(pairs, options=OPTION_SETS, n_draws: int = 1000) -> dict:
     return out
 
 
+def point_scores(shots: RegimeShots, opt: Options, f: float, b: float | None) -> dict:
+    """Labels right and mean |error| per recorded regime of the point prediction at one (f, b)
+    (what ``penetrate`` prints without a posterior: the nominal transitions, no scatter)."""
+    out = model_outcome([f], shots, opt, None if b is None else [b])
+    code, depth = out.code[0], out.depth[0]
+    rec = shots.recorded
+    res = {"f": float(f), "b": None if b is None else float(b), "label_right": int(np.sum(code[rec >= 0] == rec[rec >= 0])),
+           "labelled": int(np.sum(rec >= 0))}
+    for k, name in enumerate(rg.REGIMES):
+        sel = (rec == k) & np.isfinite(shots.depth)
+        e = np.abs(depth[sel] / shots.depth[sel] - 1.0)
+        res[name] = {"n": int(sel.sum()), "mean_abs_error": float(np.mean(e)) if sel.any() else math.nan}
+    return res
+
+
+def default_constants_study(pairs, opt: Options, posts: dict, f0: float, b0: float | None) -> dict:
+    """The stated defaults of ``penetrate`` (``f0`` = hardness.DEFAULT_DYNAMIC_FACTOR, ``b0`` =
+    regime.DEFAULT_BREAKUP_FACTOR) scored on every group (in-sample: they round the medians fitted on
+    all groups) beside each group predicted at the other group's posterior medians (transfer)."""
+    rows = []
+    for g in pairs:
+        other = next(h for h in pairs if h is not g)
+        po = posts[other.group]
+        bo = po.get("b_quantiles", {}).get(0.5) if b0 is not None else None
+        rows.append({"group": g.group, "fit": other.group,
+                     "defaults": point_scores(g, opt, f0, b0),
+                     "transfer": point_scores(g, opt, po["f_quantiles"][0.5], bo)})
+    return {"f": f0, "b": b0, "rows": rows}
+
+
 def _pool(scores) -> dict:
     """Transfer scores pooled over the held-out groups."""
     tot = {"label_right": sum(s["label_right"] for s in scores), "labelled": sum(s["labelled"] for s in scores)}

@@ -57,6 +57,11 @@ def run_regimes(args, command: str) -> dict:
         result["transfer"] = R.transfer_study(groups, R.OPTION_SETS if not args.quick else (R.DEFAULT_OPTIONS,))
         # curves: each material predicted from the fit on the other(s) (the transfer the figures show)
         posts = {g.group: R.grid_posterior(g, R.DEFAULT_OPTIONS) for g in groups}
+        from semianalytic.penetration.hardness import DEFAULT_DYNAMIC_FACTOR
+        from semianalytic.penetration.regime import DEFAULT_BREAKUP_FACTOR
+
+        result["defaults"] = R.default_constants_study(groups, R.DEFAULT_OPTIONS, posts, DEFAULT_DYNAMIC_FACTOR,
+                                                       DEFAULT_BREAKUP_FACTOR if R.DEFAULT_OPTIONS.deforming == "two_stage" else None)
         for c, k, g in zip(cases, coefs, groups):
             fit = next(h for h in groups if h is not g)
             f, s, t, b = R.draws_from_grid(posts[fit.group], 1000)

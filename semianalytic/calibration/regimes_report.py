@@ -88,22 +88,31 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
         "Projectile strength from its hardness: each shot's Rockwell C hardness (the data's hardness_Rc column) -> "
         "Vickers by ASTM E140 Table 1 -> static yield stress sigma_y = -90.7 + 2.876 HV MPa and ultimate strength "
         "sigma_u = -99.8 + 3.734 HV MPa (Pavlina & Van Tyne 2008, J. Mater. Eng. Perform. 17:888, eqs. (4), (5)); the "
-        "dynamic values are f sigma_y and f sigma_u with one dynamic factor f, the only fitted constant of the model. "
-        "R_t from the target's properties (Part I, eq. (16), or Tate 1986), never fitted.")
+        "dynamic values are f sigma_y and f sigma_u with one dynamic factor f. The static Meyer hardness H_M = HV x "
+        "9.80665 MPa / sin 68 deg (the mean pressure of plastic indentation on the projected area, Tabor 1951) is the "
+        "tip's resistance in the meyer_tip onset: no fitted constant. The deforming band holds two states (two_stage): "
+        "a bent rod that keeps its nose (curved, exited shots: Part I depth) and, once the tip pressure reaches b H_M, a "
+        "rod that turns round or breaks (the eroding rod's depth); the breakup factor b is fitted and the criterion is "
+        "this project's own. Fitted: f, and b with two_stage. R_t from the target's properties (Part I, eq. (16), or "
+        "Tate 1986), never fitted.")
     doc.table(["choice", "default (chosen by transfer)", "what it is", "source"], [
-        ["rigid -> deforming", o["onset"], "tate_tip: (1/2) rho_t U^2 + R_t reaches the tip's constrained strength "
-         "C f sigma_y, C = 3; part1_usc: Part I eqs. (33)/(36) with Y_p = f sigma_y",
-         "Tate 1967 (J. Mech. Phys. Solids 15:387) criterion + Tabor 1951 constraint factor: their combination is this "
-         "project's reading; Part I"],
+        ["rigid -> deforming", o["onset"], "meyer_tip: (1/2) rho_t U^2 + R_t reaches the rod's static Meyer hardness "
+         "H_M (no fitted constant); tate_tip: the same pressure reaches the tip's constrained strength C f sigma_y, "
+         "C = 3; part1_usc: Part I eqs. (33)/(36) with Y_p = f sigma_y",
+         "Tate 1967 (J. Mech. Phys. Solids 15:387) tip pressure against Tabor 1951's indentation pressure (meyer_tip) "
+         "or constraint factor (tate_tip): both combinations are this project's reading; Part I"],
         ["deforming -> eroding", o["erosion"], "tate_tip_uts: the same pressure reaches C f sigma_u; tate: Tate's "
          "flat-rod criterion (1/2) rho_t U^2 + R_t > Y_p; nose_length: the Alekseevskii-Tate rod consumed to its nose",
          "tate: Tate 1967; tate_tip_uts: this project's reading of Tate + Tabor; nose_length: this project's own"],
         ["R_t of the eroding rod", o["resistance"], "part1: Part I eq. (16); tate1986: Y_t (2/3 + ln(0.57 E_t/Y_t))",
          "Part I; Tate 1986 (Int. J. Mech. Sci. 28:599)"],
         ["Y_p of the eroding rod", o["rod_strength"], "f sigma_u (ultimate) or f sigma_y (yield)", "Pavlina & Van Tyne 2008"],
-        ["depth in the deforming band", o["deforming"], "breakup: Part I below the tip-UTS velocity, eroding rod above; "
-         "part1_upper: Part I; eroding: the Alekseevskii-Tate rod", "breakup and part1_upper: this project's own; eroding: "
-         "Alekseevskii 1966, Tate 1967"],
+        ["depth in the deforming band", o["deforming"], "two_stage: Part I below the breakup (tip pressure b H_M, b "
+         "fitted), the eroding rod above; breakup: Part I below the tip-UTS velocity, eroding rod above; "
+         "part1_upper: Part I; eroding: the Alekseevskii-Tate rod", "two_stage, breakup and part1_upper: this project's "
+         "own; eroding: Alekseevskii 1966, Tate 1967"],
+        ["depth discrepancy", o.get("discrepancy", "shared"), "shared: one sigma for every state; per_regime: one for "
+         "the rigid state, one for the deformed states", "statistics (this project's choice, compared by transfer)"],
     ], caption="The model set: each choice is a named option; the defaults are the ones the leave-one-material-out "
                "transfer below chooses.")
     doc.para(
@@ -121,6 +130,10 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
         ["sigma (depth scatter, ln)", post["priors"]["sigma"], "30 % at one standard deviation"],
         ["tau (transition scatter, ln)", post["priors"]["tau"], "10 % at one standard deviation (hardness +-1 HRC is "
          "+-3 % in strength; pitch and yaw up to 7 deg)"],
+        *([["breakup factor b", post["priors"]["breakup_factor"], "the breakup pressure is not below the onset's (b = 1: "
+            "the static Meyer hardness) and below 3 x it, which no steel rod of the data survives (they erode below it)"]]
+          if "breakup_factor" in post["priors"] else []),
+        *([["sigma_deformed", post["priors"]["sigma_deformed"], "as sigma"]] if "sigma_deformed" in post["priors"] else []),
     ], caption="Priors (physical ranges).")
     doc.heading("Shipped posterior and sampler diagnostics")
     d = post["diagnostics"]
@@ -134,8 +147,9 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
               caption=f"Posterior of {post['groups']} ({post['n_shots']} shots): emcee, {d.get('ensembles', 4)} independent "
                       f"ensembles ({d['chains']} walkers in all, each an arviz chain of {d['draws_per_chain']} draws after "
                       "burn-in); arviz rank-normalised split R-hat and bulk/tail ESS (Vehtari et al. 2021).")
-    if post["at_prior_edge"]["dynamic_factor"]:
-        doc.note("The dynamic factor's posterior runs to the edge of its prior.", kind="warning")
+    for k, edge in post["at_prior_edge"].items():
+        if edge:
+            doc.note(f"The posterior of {k} runs to the edge of its prior.", kind="warning")
     for w in d["warnings"]:
         doc.note(f"Sampler: {w}", kind="warning")
     tr = result["transfer"]
@@ -164,6 +178,19 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
                 met.append(f"{k}: mean |error| {_p(e)} ({'met' if e <= 0.15 else 'NOT met'}), 90 % coverage {_p(c)} "
                            f"({'met' if 0.8 <= c <= 0.95 else 'NOT met'})")
         doc.para("Targets by transfer: " + "; ".join(met) + ".")
+        dc = result.get("defaults")
+        if dc:
+            rows = []
+            for r in dc["rows"]:
+                for label, sc in (("stated defaults (in-sample: they round both materials' medians)", r["defaults"]),
+                                  (f"transfer: the medians fitted on {r['fit']}", r["transfer"])):
+                    rows.append([r["group"], label, f"{sc['f']:.3f}", "-" if sc["b"] is None else f"{sc['b']:.3f}",
+                                 f"{sc['label_right']}/{sc['labelled']}",
+                                 *[_p(sc[k]["mean_abs_error"]) + f" (n {sc[k]['n']})" for k in REGIMES]])
+            doc.table(["material", "constants", "f", "b", "labels right", *[f"{k}: mean abs error" for k in REGIMES]], rows,
+                      caption=f"The stated defaults of penetrate without a posterior (dynamic_factor f = {dc['f']:g}, "
+                              f"breakup factor b = {dc['b'] if dc['b'] is not None else '-'}): point predictions at the "
+                              "nominal transitions, beside each material at the other's posterior medians.")
         doc.heading("Model comparison (transfer chooses every default)")
         doc.para(f"Rule: {tr['rule']}. Each row changes one choice of the default; the first row is the default.")
         rows = []
