@@ -27,6 +27,9 @@ if settings is not None:
 # runs, FEM studies, subprocess sweeps); `make test` (and so CI) runs everything that is not
 # `slow`.  A node id here is a file, or a test function of a file (all its parameters).
 LONG = {
+    "tests/test_regimes_transfer.py::test_calibrate_regimes_transfer_through_the_cli",
+    "tests/test_regimes_transfer.py::test_transfer_between_materials_against_the_data_file",
+    "tests/test_regimes_transfer.py::test_issue22_targets",
     "tests/test_benchmarks_small.py",
     "tests/test_bad_input.py::test_bad_case_exit_status_in_a_subprocess",
     "tests/test_browser_report.py",

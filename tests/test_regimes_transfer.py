@@ -340,7 +340,6 @@ def test_emcee_against_the_grid_posterior_and_diagnostics(groups):
     assert abs(np.median(s["b"]) - g["b_quantiles"][0.5]) < 0.03
 
 
-@pytest.mark.slow
 def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     """calibrate --model regimes --cross-validate --transfer (the other material) --quick: the
     transfer table printed and written, recomputed here from transfer.json's shots against the
@@ -355,6 +354,9 @@ def test_calibrate_regimes_transfer_through_the_cli(tmp_path, capsys):
     shots = [s for t in tr["options"][0]["transfer"] for s in t["shots"]]
     right = sum(s["predicted"] == rec[s["shot"]][0] for s in shots)
     assert f"regime label right {right}/34" in stdout and right >= 31
+    for reg in ("rigid", "eroding"):  # the issue's 15 % target, met by transfer (the deforming band's is not)
+        e = [abs(s["q50_m"] / rec[s["shot"]][1] - 1) for s in shots if rec[s["shot"]][0] == reg and math.isfinite(rec[s["shot"]][1])]
+        assert np.mean(e) <= 0.15, (reg, np.mean(e))
     assert (out / "depth_velocity_VAR4340.png").stat().st_size > 10000
     assert (out / "depth_velocity_AerMet100.csv").read_text().count("\n") == 68  # 2 header lines + 66 velocities
 
