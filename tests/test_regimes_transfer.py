@@ -97,6 +97,16 @@ def test_bad_hardness_input_exits_2_naming_the_key(tmp_path, capsys, edit, field
 # --- criteria against the recorded transitions ----------------------------------------------
 
 
+def _recorded_onsets():
+    """Per steel of the data file: (material, mean HRC of its shots, last rigid and first deformed
+    striking velocity [m/s])."""
+    rows = _rows()
+    for mat in ("VAR4340", "AerMet100"):
+        mine = sorted((float(r["Vs_m_s"]), r["regime"]) for r in rows if r["material"] == mat)
+        hrc = np.mean([float(r["hardness_Rc"]) for r in rows if r["material"] == mat])
+        yield mat, hrc, max(v for v, g in mine if g == "rigid"), min(v for v, g in mine if g != "rigid")
+
+
 def test_tip_criterion_places_both_onsets_between_the_recorded_shots():
     """Tate's pressure against the tip's constrained strength (C = 3, Tabor) with ONE dynamic
     factor: for f = 1.28 the rigid -> deforming velocity of each steel lies between its last
@@ -107,13 +117,8 @@ def test_tip_criterion_places_both_onsets_between_the_recorded_shots():
     from semianalytic.penetration import hardness as H
     from semianalytic.penetration import regime as rg
 
-    rows = _rows()
     R_t = 1453.55e6  # Part I, eq. (16), Y = 400 MPa, E = 68.9 GPa, nu = 0.33 (the cases' target)
-    for mat in ("VAR4340", "AerMet100"):
-        mine = sorted((float(r["Vs_m_s"]), r["regime"]) for r in rows if r["material"] == mat)
-        last_rigid = max(v for v, g in mine if g == "rigid")
-        first_def = min(v for v, g in mine if g != "rigid")
-        hrc = np.mean([float(r["hardness_Rc"]) for r in rows if r["material"] == mat])
+    for mat, hrc, last_rigid, first_def in _recorded_onsets():
         U = rg.tate_erosion_velocity(1.28 * H.yield_stress_from_hardness(hrc), R_t, 2710.0, rg.TABOR_CONSTRAINT)
         assert last_rigid < U < first_def, (mat, U)
     # independent closed form of the criterion: (1/2) rho U^2 + R_t = C Y at U
@@ -137,13 +142,8 @@ def test_meyer_onset_without_a_fitted_constant_against_the_recorded_transitions(
     # H_M = F / projected area, HV = F / contact area (in kgf/mm^2): H_M = HV x contact / projected
     assert H.meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 * 9.80665e6 * contact / projected, rel=1e-12)
     assert H.meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 * 9.80665e6 * 1.07853, rel=1e-5)
-    rows = _rows()
-    R_t = 1453.55e6  # Part I, eq. (16), Y = 400 MPa, E = 68.9 GPa, nu = 0.33 (the cases' target)
-    for mat in ("VAR4340", "AerMet100"):
-        mine = sorted((float(r["Vs_m_s"]), r["regime"]) for r in rows if r["material"] == mat)
-        last_rigid = max(v for v, g in mine if g == "rigid")
-        first_def = min(v for v, g in mine if g != "rigid")
-        hrc = np.mean([float(r["hardness_Rc"]) for r in rows if r["material"] == mat])
+    R_t = 1453.55e6  # Part I, eq. (16), as above
+    for mat, hrc, last_rigid, first_def in _recorded_onsets():
         U = rg.tate_erosion_velocity(H.meyer_hardness_from_vickers(H.vickers_from_rockwell_c(hrc)), R_t, 2710.0)
         assert 0.99 * last_rigid < U < 1.01 * first_def, (mat, U)
 
