@@ -178,6 +178,11 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
                 met.append(f"{k}: mean |error| {_p(e)} ({'met' if e <= 0.15 else 'NOT met'}), 90 % coverage {_p(c)} "
                            f"({'met' if 0.8 <= c <= 0.95 else 'NOT met'})")
         doc.para("Targets by transfer: " + "; ".join(met) + ".")
+        doc.para("How much a coverage count says: with n shots, calibrated 90 % intervals cover k of them with a binomial "
+                 "probability; the two-sided binomial test of each count (transfer) gives p = " + ", ".join(
+                     f"{k} {sm[k]['covered']}/{sm[k]['n']}: {sm[k]['coverage_binomial_p']:.2f}" for k in REGIMES if sm[k]["n"])
+                 + ". A p above 0.05 means the count is no evidence against calibrated intervals, even where it lies "
+                   "outside the 80-95 % band (all 14 of 14 happen with probability 0.9^14 = 0.23).")
         dc = result.get("defaults")
         if dc:
             rows = []
