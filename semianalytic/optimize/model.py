@@ -149,6 +149,54 @@ def deep_limit(nose, *, order: int = 8, refinement: float = 0.3, levels: int = 6
     return DeepLimit(values, errors, tuple(float(deep.P(v)) for v in vs))
 
 
+# The depth objective's tables (this project's own rule): knots per smooth piece of the depth axis
+# while searching, and on the finer table that confirms the optimum.  Measured on the power-law
+# noses n = 0.5, 0.74, 0.9 of cases/optimize_power_into_fig15a.toml against a certified table at
+# tolerance 1e-6 (2026-11-26): 4 knots per piece: rigid depths within 1e-5 relative (15 depth
+# solves); 8 knots per piece: within 4e-7 (the fixed 40-depth table of the case to 60 nose lengths: 3e-6).
+SEARCH_KNOTS_PER_PIECE = 4
+CONFIRM_KNOTS_PER_PIECE = 8
+# range of the depth objective's table: P_max = DEPTH_MARGIN x (deep-limit estimate of the deepest
+# final depth) + DEPTH_MARGIN_NOSES x L_h.  The deep-limit coefficients overstate the drag while the
+# nose enters, so the estimate falls short by less than one nose length (measured: 0.5-0.65 L_h on
+# the noses above); P_max is then past every final depth, checked after the solve.
+DEPTH_MARGIN = 1.1
+DEPTH_MARGIN_NOSES = 2.0
+
+
+def depth_range(deep_estimate: float, nose_length: float) -> float:
+    """P_max [m] of the depth objective's table from the deepest final depth [m] computed with
+    the deep-limit coefficients (Part I, eq. (11) with A, B, C constant): this project's own margin
+    (:data:`DEPTH_MARGIN`, :data:`DEPTH_MARGIN_NOSES`)."""
+    return DEPTH_MARGIN * float(deep_estimate) + DEPTH_MARGIN_NOSES * float(nose_length)
+
+
+def depth_knots(nose, P_max: float, per_piece: int) -> list[float]:
+    """The depths [m] of a coefficient table over [0, P_max] alone (this project's own rule): on
+    every smooth piece of the depth axis of :func:`semianalytic.coefficients.table.depth_pieces`
+    (cut at the nose's breakpoints, each in its own interpolation variable v), ``per_piece``
+    depths equally spaced in v inside the piece (its ends are the table's own knots); on the deep
+    piece (v = l/P) ``per_piece`` depths equally spaced in v from v(P_max) to 1, nothing deeper
+    (the depth objective reads A, B, C only down to the final depth, below P_max)."""
+    from semianalytic.coefficients.table import depth_pieces
+
+    if per_piece < 2:
+        raise ValueError("per_piece must be at least 2")
+    pieces, _ = depth_pieces(nose)
+    out: list[float] = []
+    for p in pieces[:-1]:
+        hi = min(p.P_hi, P_max)
+        if hi <= p.P_lo:
+            continue
+        vs = np.linspace(float(p.v(p.P_lo)), float(p.v(hi)), per_piece + 2)[1:-1]
+        out += [float(p.P(v)) for v in vs]
+    deep = pieces[-1]
+    if P_max > deep.P_lo:
+        vs = np.linspace(1.0, float(deep.v(P_max)), per_piece + 1)[1:]
+        out += [float(deep.P(v)) for v in vs]
+    return sorted(set(out))
+
+
 def depth_objective(depths) -> float:
     """Minus the mean final depth [m] over the striking velocities (minimised = deepest on average)."""
     d = np.asarray(depths, float)
