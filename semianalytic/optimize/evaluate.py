@@ -164,7 +164,7 @@ def depth_record(problem: Problem, case, nose, cache_dir=None, per_piece: int | 
         raise RuntimeError(f"the final depth {deepest:.4g} m stays past the table range {P_max:.4g} m")
     return {"deep_drag_Bbar": deep_drag(B, nose.diameter), "depths_m": [float(v) for v in depths],
             "objective": depth_objective(depths), "table_range_m": P_max, "table_knots": len(knots),
-            "deep_estimate_m": estimate, "bem_depths_solved": lim.solves + len(knots)}
+            "deep_estimate_m": estimate, "bem_depths_solved": lim.solves + len(table.depth)}
 
 
 def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
@@ -317,6 +317,30 @@ def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int)
             "max_polls": max_polls, "polls": polls, "moves": moves, "final_step": h,
             "message": "step below the resolution" if done else
             "stopped at --maxfev polls", "success": bool(done)}
+
+
+def known_result(problem: Problem, best_x) -> dict | None:
+    """The optimum of a power-law or spline nose against the known minimum-drag exponent
+    (:data:`~semianalytic.optimize.model.NEWTONIAN_MIN_DRAG_EXPONENT`): the power law's own
+    exponent, or the exponent of the power law nearest the spline's meridian
+    (:func:`~semianalytic.optimize.model.fitted_exponent`, on 400 points).  None for other noses."""
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.optimize.model import NEWTONIAN_MIN_DRAG_EXPONENT, NEWTONIAN_SOURCE, fitted_exponent
+
+    try:
+        nose = nose_from_section(design_case(problem, problem.overrides(best_x)).require("projectile"))
+    except (InputError, Infeasible):
+        return None
+    if nose.kind == "power":
+        n, how = float(nose.parameters["exponent"]), "the optimum's exponent"
+    elif nose.kind == "spline":
+        x, r = nose.segments[0].point(np.linspace(0.0, 1.0, 401))
+        n, how = fitted_exponent(-np.asarray(x), r, nose.length, nose.radius), \
+            "the exponent of the power law nearest the optimum's meridian (least squares in r)"
+    else:
+        return None
+    return {"exponent": n, "how": how, "reference_exponent": NEWTONIAN_MIN_DRAG_EXPONENT, "source": NEWTONIAN_SOURCE,
+            "relative_difference": (n - NEWTONIAN_MIN_DRAG_EXPONENT) / NEWTONIAN_MIN_DRAG_EXPONENT}
 
 
 def finer_bem(problem: Problem) -> tuple:
@@ -487,6 +511,7 @@ def optimise(
             if reads_depths:
                 own_tables["depth_knots"] = problem.depth_knots
     finer = finer_check(problem, best_x, low, high, cache_dir, max(confirm, 5), confirm_half_width) if finer_bem else None
+    known = known_result(problem, best_x)
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -506,6 +531,7 @@ def optimise(
         "start": start_rec,
         "confirmation": grid,
         "classic": classic,
+        "known_result": known,
         "n_designs_search": n_search,
         "n_designs_total": len(ev.memo),
         "seconds_search": search_seconds,

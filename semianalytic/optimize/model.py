@@ -197,6 +197,30 @@ def depth_knots(nose, P_max: float, per_piece: int) -> list[float]:
     return sorted(set(out))
 
 
+# The known result the power-law and spline designs are compared with: the minimum-drag body of
+# revolution of given length and base diameter under Newtonian impact theory (no friction) is
+# close to the power law r ~ x^(3/4) (Eggers, Resnikoff & Dennis 1957, "Bodies of revolution
+# having minimum drag at high supersonic airspeeds", NACA Report 1306; the exact Newtonian optimum
+# has a small flat tip and lies within a few per cent of the 3/4-power body).
+NEWTONIAN_MIN_DRAG_EXPONENT = 0.75
+NEWTONIAN_SOURCE = ("Eggers, Resnikoff & Dennis (1957), NACA Report 1306: the Newtonian minimum-drag body of given "
+                    "length and base diameter, close to the 3/4-power law")
+
+
+def fitted_exponent(xi, r, nose_length: float, radius: float) -> float:
+    """The exponent n of the power law r = R (xi/L_h)^n nearest a nose meridian in the least-squares
+    sense over the points (xi, r) [m] (this project's own comparison measure: the power law a free-form
+    nose is closest to, compared with the known optimum exponents)."""
+    from scipy.optimize import minimize_scalar
+
+    xi, r = np.asarray(xi, float) / nose_length, np.asarray(r, float) / radius
+    keep = (xi > 0) & (xi <= 1)
+    xi, r = xi[keep], r[keep]
+    res = minimize_scalar(lambda n: float(np.sum((r - xi**n) ** 2)), bounds=(0.05, 1.5), method="bounded",
+                          options={"xatol": 1e-8})
+    return float(res.x)
+
+
 def depth_objective(depths) -> float:
     """Minus the mean final depth [m] over the striking velocities (minimised = deepest on average)."""
     d = np.asarray(depths, float)

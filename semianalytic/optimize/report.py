@@ -165,6 +165,11 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
         for i, u in enumerate(vel):
             table.append([f"{u:.0f}"] + [fmt(r["depths_m"][i] * 1e3, 5) if r.get("depths_m") else "n/a" for r in recs])
         doc.table(hdr, table, caption="Final depth per striking velocity, same constraints for every nose.")
+    kr = result.get("known_result")
+    if kr:
+        doc.para(f"Known result: {kr['source']} (n = {kr['reference_exponent']:g}). Here {kr['how']}: n = "
+                 f"{kr['exponent']:.4g}, {kr['relative_difference'] * 100:+.1f} % from it (the objective here is the "
+                 "depth or drag of this BEM model, not Newtonian impact pressure; see docs/optimize.md).")
     g = result.get("confirmation")
     if g:
         doc.heading("Confirmation on a finer grid")
