@@ -149,7 +149,7 @@ def main(argv=None) -> int:
     doc.para("Reference: on certified tables at tolerance 1e-6 (to the deep limit), the objective at n = 0.720, "
              "0.725, .., 0.760 puts the vertex of its parabola at n = 0.7390 (a cubic: 0.7387; measured 2026-11-26, "
              "`reports/optimize_constrained_power.md`). The lighter tables of the previous report (rigid depths "
-             "1.5e-4 off, the error changing with n) moved the optimum to 0.7403.")
+             f"1.5e-4 off, the error changing with n) move the optimum to {cl['x']:.4f}.")
     doc.para(f"Load average (1, 5, 15 min) at the end: {', '.join(f'{v:.1f}' for v in os.getloadavg())}; the machine "
              "(2 cores) was shared with other jobs, so the CPU and wall times are indicative; the counts of depth "
              "evaluations and solves do not depend on the load.")
