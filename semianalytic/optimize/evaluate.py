@@ -466,6 +466,7 @@ def optimise(
     n_search = len({json.dumps(r["overrides"], sort_keys=True) for r in ev.history})
 
     grid = None
+    confirm_designs = 0  # designs evaluated on the confirmation's finer tables (their own memo)
     if confirm >= 2:
         pts, spacing = confirmation_grid(best_x, low, high, confirm, confirm_half_width)
         ev_confirm, confirm_knots, ref = ev, None, best
@@ -479,6 +480,7 @@ def optimise(
         recs = ev_confirm.map([problem.overrides(p) for p in pts], "confirm", gen["n"], pts)
         if ev_confirm is not ev:
             ev.history += ev_confirm.history
+            confirm_designs = len(ev_confirm.memo)
         f = np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
         k = int(np.argmin(f))
         steps = np.abs(pts[k] - best_x) / np.where(spacing > 0, spacing, 1.0)
@@ -533,7 +535,7 @@ def optimise(
         "classic": classic,
         "known_result": known,
         "n_designs_search": n_search,
-        "n_designs_total": len(ev.memo),
+        "n_designs_total": len(ev.memo) + confirm_designs,
         "seconds_search": search_seconds,
         "seconds_total": time.perf_counter() - t0,
         "history": ev.history,
