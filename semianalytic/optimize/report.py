@@ -118,9 +118,10 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
              f"stopped: {o['message']}.")
     chk = result.get("own_tables_check")
     if chk and chk.get("depth_knots"):
-        doc.para(f"Design tables: every design's coefficient table over the depths the objective reads alone (issue 24: "
-                 f"{chk['depth_knots']} knots per smooth piece of the depth axis from first contact to P_max, a margin past "
-                 "the deepest final depth estimated from the deep limit of four solves). The optimum on the case's own "
+        doc.para(f"Design tables: every design's coefficient table over the depths the objective reads alone (issue 24, "
+                 f"this project's own rule: {chk['depth_knots']} knots per smooth piece of the depth axis from first contact "
+                 "to P_max, a margin past the deepest final depth estimated from the deep limit of four solves; "
+                 "docs/optimize.md). The optimum on the case's own "
                  f"tables (to the deep limit): objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
                  f"on the design tables, relative difference **{chk['relative_difference']:.1e}** (the design tables' "
                  "error in the objective).")
@@ -167,7 +168,8 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
         doc.table(hdr, table, caption="Final depth per striking velocity, same constraints for every nose.")
     kr = result.get("known_result")
     if kr:
-        doc.para(f"Known result: {kr['source']} (n = {kr['reference_exponent']:g}). Here {kr['how']}: n = "
+        own = " (this project's own measure of a free-form nose)" if "nearest" in kr["how"] else ""
+        doc.para(f"Known result: {kr['source']} (n = {kr['reference_exponent']:g}). Here {kr['how']}{own}: n = "
                  f"{kr['exponent']:.4g}, {kr['relative_difference'] * 100:+.1f} % from it (the objective here is the "
                  "depth or drag of this BEM model, not Newtonian impact pressure; see docs/optimize.md).")
     g = result.get("confirmation")
