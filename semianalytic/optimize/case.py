@@ -4,7 +4,7 @@
 like case files (``projectile.half_angle=10 deg:40 deg``; ``crh`` is a bare number).  Allowed
 keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; power
 ``projectile.exponent`` (in (0, 1]) and ``projectile.nose_length``; spline
-``projectile.control_radii.K`` (the K-th control radius, 0-based, a fraction of d/2 in (0, 1))
+``projectile.control_radii.K`` (the K-th control radius, 0-based, a fraction of d/2 in (0, 1])
 and ``projectile.nose_length``; and
 ``projectile.meplat_diameter`` / ``projectile.tip_radius`` (blunted or truncated ogives and
 cones) where the case schema has them.
@@ -120,8 +120,8 @@ def parse_variable(text: str) -> Variable:
         if len(parts) != 2:
             raise InputError(flag, f"bounds are LOW:HIGH; got {rest!r}")
         low, high = (_parse_bound(t, None, flag)[0] for t in parts)
-        if not (0.0 < low < high < 1.0):
-            raise InputError(flag, f"a control radius is a fraction of d/2: need 0 < LOW < HIGH < 1; got {rest!r}")
+        if not (0.0 < low < high <= 1.0):
+            raise InputError(flag, f"a control radius is a fraction of d/2: need 0 < LOW < HIGH <= 1; got {rest!r}")
         return Variable(key, low, high, "")
     if key not in NOSE_KEYS:
         raise InputError("--vary", f"{key!r} is not a nose-shape parameter; one of {', '.join(NOSE_KEYS)}, "
