@@ -64,6 +64,8 @@ class BodySection(Section):
     points_unit: LengthUnit | None = None
     exponent: float | None = Field(default=None, description="power nose: r = (d/2) (x/L_h)^n, n in (0, 1]")
     nose_length: Length | None = Field(default=None, description="power nose: nose length L_h")
+    control_radii: list[float] | None = Field(
+        default=None, description="spline nose: control radii at m equally spaced stations k L_h/(m+1), fractions of d/2 in (0, 1]")
 
     @model_validator(mode="after")
     def _complete(self):
@@ -94,10 +96,14 @@ class ProjectileSection(Section):
     Ogive and cone take an optional ``meplat_diameter`` (flat tip: truncated nose) or
     ``tip_radius`` (spherically blunted tip); a key a nose kind has no use for is an error.
     power: r = (d/2) (x/L_h)^n from the tip, ``exponent`` n in (0, 1] and ``nose_length`` L_h.
+    spline: ``control_radii`` = [c_1, .., c_m] (fractions of d/2, dimensionless, in (0, 1]) of the
+    control points at m equally spaced stations k L_h / (m + 1) along ``nose_length`` L_h, between
+    the tip and the shoulder: a Bezier curve, increasing, with non-increasing increments
+    (monotone and convex; geometry.spline_nose).
     ``shank_length`` is the cylindrical part: total length = shank + nose.
     """
 
-    nose: Literal["ogive", "sphere", "cone", "flat", "table", "power"]
+    nose: Literal["ogive", "sphere", "cone", "flat", "table", "power", "spline"]
     diameter: Length
     shank_length: NonNegativeLength | None = None
     length: Length | None = Field(default=None, description="total length L = shank + nose (instead of shank_length)")
@@ -112,6 +118,8 @@ class ProjectileSection(Section):
     points_unit: LengthUnit | None = None
     exponent: float | None = Field(default=None, description="power nose: r = (d/2) (x/L_h)^n, n in (0, 1]")
     nose_length: Length | None = Field(default=None, description="power nose: nose length L_h")
+    control_radii: list[float] | None = Field(
+        default=None, description="spline nose: control radii at m equally spaced stations k L_h/(m+1), fractions of d/2 in (0, 1]")
     # material (Part I, section 2: elastic projectile and critical velocity)
     youngs_modulus: Pressure | None = None
     poisson_ratio: float | None = None
@@ -184,7 +192,8 @@ class ProjectileSection(Section):
 
         uses = {"crh": ("ogive",), "half_angle": ("cone",), "corner_radius": ("flat",),
                 "meplat_diameter": ("ogive", "cone"), "tip_radius": ("ogive", "cone"),
-                "points": ("table",), "points_unit": ("table",), "exponent": ("power",), "nose_length": ("power",)}
+                "points": ("table",), "points_unit": ("table",), "exponent": ("power",), "nose_length": ("power", "spline"),
+                "control_radii": ("spline",)}
         for key, kinds in uses.items():
             if getattr(self, key) is not None and self.nose not in kinds:
                 raise InputError(f"projectile.{key}", f"has no use for the '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")
@@ -192,6 +201,10 @@ class ProjectileSection(Section):
             for key, example in (("exponent", "0.6"), ("nose_length", "'11.8 mm'")):
                 if getattr(self, key) is None:
                     raise InputError(f"projectile.{key}", f"a power nose r = (d/2) (x/L_h)^n needs it, e.g. {key} = {example}")
+        if self.nose == "spline":
+            for key, example in (("control_radii", "[0.45, 0.75, 0.92] (fractions of d/2)"), ("nose_length", "'11.8 mm'")):
+                if getattr(self, key) is None:
+                    raise InputError(f"projectile.{key}", f"a spline nose needs it, e.g. {key} = {example}")
         nose = nose_from_section(self)
         if self.length is not None:
             shank = self.length - nose.length

@@ -226,7 +226,64 @@ class PowerCurve:
         return (ddx, np.zeros_like(t))
 
 
-Segment = Line | Arc | EllipseArc | SplineCurve | PowerCurve
+@dataclass(frozen=True)
+class BezierCurve:
+    """Nose meridian r(xi) = R sum_k c_k C(N, k) t^k (1 - t)^(N - k), xi = t L back from the tip,
+    t in [0, 1]: the Bezier curve of the control points (k L / N, c_k R), k = 0..N (control
+    abscissae equally spaced, so x is linear in t).  A Bernstein polynomial keeps the shape of
+    its control polygon (variation diminishing: Farin, Curves and Surfaces for CAGD, 5th ed.,
+    2002, sections 5.4 and 6.4; Lorentz, Bernstein Polynomials, 1953, ch. 1.7): a monotone
+    polygon gives a monotone meridian, a concave one a concave r(xi) (a convex nose); control
+    points on a straight line give that line exactly."""
+
+    length: float  # L_h
+    radius: float  # R = d/2
+    weights: tuple[float, ...]  # c_0 = 0 .. c_N = 1 (fractions of R)
+    t0: float = 0.0
+    t1: float = 1.0
+
+    @cached_property
+    def _power(self) -> np.ndarray:
+        """Coefficients a_j of r(t) = sum_j a_j t^j (power basis, [m])."""
+        from math import comb
+
+        N = len(self.weights) - 1
+        a = np.zeros(N + 1)
+        for k, c in enumerate(self.weights):  # C(N,k) t^k (1-t)^(N-k) = sum_i C(N,k) C(N-k,i) (-1)^i t^(k+i)
+            for i in range(N - k + 1):
+                a[k + i] += c * comb(N, k) * comb(N - k, i) * (-1) ** i
+        return self.radius * a
+
+    def _r(self, t, order: int = 0):
+        a = np.polynomial.polynomial.polyder(self._power, order) if order else self._power
+        return np.polynomial.polynomial.polyval(np.asarray(t, dtype=float), a)
+
+    def point(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.length * t, self._r(t))
+
+    def derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (-self.length * np.ones_like(t), self._r(t, 1))
+
+    def displacement(self, t, dt):
+        """point(t + dt) - point(t) without cancellation: r by the divided difference
+        sum_j a_j ((t + dt)^j - t^j) / dt = sum_j a_j h_j, h_j = (t + dt) h_(j-1) + t^(j-1)."""
+        t, dt = np.broadcast_arrays(np.asarray(t, dtype=float), np.asarray(dt, dtype=float))
+        u = t + dt
+        h, tp, acc = np.zeros_like(t), np.ones_like(t), np.zeros_like(t)
+        for a in self._power[1:]:
+            h = u * h + tp  # h_j
+            tp = tp * t
+            acc = acc + a * h
+        return (-self.length * dt, acc * dt)
+
+    def second_derivative(self, t):
+        t = np.asarray(t, dtype=float)
+        return (np.zeros_like(t), self._r(t, 2))
+
+
+Segment = Line | Arc | EllipseArc | SplineCurve | PowerCurve | BezierCurve
 
 
 @functools.cache
@@ -453,6 +510,54 @@ def power_nose(diameter: float, exponent: float, nose_length: float) -> Nose:
     return Nose("power", diameter, nose_length, (curve,), {"exponent": exponent, "nose_length": nose_length})
 
 
+def spline_stations(control_radii, nose_length: float, diameter: float) -> np.ndarray:
+    """The control points (xi, r) of a spline nose: the tip (0, 0), (k L_h / (m + 1), c_k d/2)
+    for k = 1..m, the shoulder (L_h, d/2) (:func:`spline_nose`)."""
+    c = np.asarray(control_radii, dtype=float)
+    xi = np.linspace(0.0, nose_length, len(c) + 2)
+    return np.column_stack([xi, 0.5 * diameter * np.concatenate([[0.0], c, [1.0]])])
+
+
+def spline_nose(diameter: float, control_radii, nose_length: float, field_name: str = "projectile.control_radii") -> Nose:
+    """Free-form nose from a few control points (issue 24; this project's own shape family):
+    the control radii c_1..c_m (fractions of d/2, each in (0, 1]) at the m equally spaced
+    stations xi_k = k L_h / (m + 1) back from the tip, with the tip (0, 0) and the shoulder
+    (L_h, d/2) as end points, define the Bezier curve (one-interval clamped B-spline) of degree
+    m + 1, :class:`BezierCurve`: it starts at the tip and ends at the shoulder, and lies inside
+    its control polygon.
+
+    Monotone and convex at the door (this project's own rule, sufficient by the variation-
+    diminishing property): the control radii increase (0 < c_1 < .. < c_m <= 1; c_m = 1: a shoulder
+    tangent to the shank) and the polygon's
+    increments c_(k+1) - c_k never increase from the tip to the shoulder; else InputError naming
+    ``field_name`` and the control radius at fault (0-based index)."""
+    if not diameter > 0:
+        raise InputError("projectile.diameter", "must be positive")
+    if nose_length is None or not (math.isfinite(nose_length) and nose_length > 0):
+        raise InputError("projectile.nose_length", f"must be a positive length (e.g. '11.8 mm'); got {nose_length!r} m")
+    c = np.asarray(control_radii if control_radii is not None else [], dtype=float)
+    if c.ndim != 1 or not 1 <= len(c) <= 16:
+        raise InputError(field_name, f"give 1 to 16 radii (fractions of d/2 in (0, 1]), e.g. [0.45, 0.75, 0.92]; got {c.size}")
+    for i, ci in enumerate(c):
+        if not (math.isfinite(ci) and 0.0 < ci <= 1.0):
+            raise InputError(field_name, f"index {i}: {float(ci)!r} must lie in (0, 1] (a fraction of the radius d/2; "
+                                         "1 for the last one: a shoulder tangent to the shank)")
+    full = np.concatenate([[0.0], c, [1.0]])
+    for i in range(1, len(c)):
+        if not full[i + 1] > full[i]:
+            raise InputError(field_name, f"index {i}: {full[i + 1]:g} is not above the previous radius {full[i]:g}: "
+                                         "the meridian must widen monotonically from the tip to the shoulder")
+    steps = np.diff(full)
+    for i in range(1, len(steps)):
+        if steps[i] > steps[i - 1] * (1 + 1e-12):
+            raise InputError(field_name, f"index {min(i, len(c)) - 1}: the control polygon is not convex there (the "
+                                         f"radius grows by {steps[i - 1]:.4g} of d/2 before station {i} and by "
+                                         f"{steps[i]:.4g} after it: the increments must not increase towards the shoulder)")
+    curve = BezierCurve(float(nose_length), 0.5 * diameter, tuple(float(v) for v in full))
+    return Nose("spline", diameter, float(nose_length), (curve,),
+                {"control_radii": [float(v) for v in c], "nose_length": float(nose_length)})
+
+
 def _check_tip_options(diameter: float, meplat_diameter: float, tip_radius: float) -> None:
     if meplat_diameter and tip_radius:
         raise InputError("projectile.tip_radius", "give either 'meplat_diameter' (flat tip) or 'tip_radius' (rounded tip), not both")
@@ -667,6 +772,8 @@ def nose_from_section(sec) -> Nose:
         return flat_nose(sec.diameter, sec.corner_radius or 0.0)
     if sec.nose == "power":
         return power_nose(sec.diameter, sec.exponent, sec.nose_length)
+    if sec.nose == "spline":
+        return spline_nose(sec.diameter, sec.control_radii, sec.nose_length)
     return table_nose(sec.points_si(), sec.diameter)
 
 

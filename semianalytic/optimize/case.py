@@ -3,7 +3,9 @@
 ``--vary KEY=LOW:HIGH`` (repeatable) names a nose-shape parameter and its bounds, with units
 like case files (``projectile.half_angle=10 deg:40 deg``; ``crh`` is a bare number).  Allowed
 keys per nose kind: ogive ``projectile.crh`` (>= 0.5); cone ``projectile.half_angle``; power
-``projectile.exponent`` (in (0, 1]) and ``projectile.nose_length``; and
+``projectile.exponent`` (in (0, 1]) and ``projectile.nose_length``; spline
+``projectile.control_radii.K`` (the K-th control radius, 0-based, a fraction of d/2 in (0, 1])
+and ``projectile.nose_length``; and
 ``projectile.meplat_diameter`` / ``projectile.tip_radius`` (blunted or truncated ogives and
 cones) where the case schema has them.
 
@@ -22,8 +24,8 @@ from typing import Any, Mapping
 
 from semianalytic.case import Case, ProjectileSection, parse_case
 from semianalytic.errors import InputError
-from semianalytic.optimize.model import (CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, PLATE_OBJECTIVES, Infeasible,
-                                         shank_for_constraints)
+from semianalytic.optimize.model import (CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, PLATE_OBJECTIVES,
+                                         SEARCH_KNOTS_PER_PIECE, Infeasible, shank_for_constraints)
 from semianalytic.sweep.spec import apply_overrides
 
 # key -> (nose kinds it applies to (None: any with the schema key), SI unit of its values, parse kind)
@@ -33,8 +35,16 @@ NOSE_KEYS: dict[str, tuple[tuple[str, ...] | None, str, str | None]] = {
     "projectile.meplat_diameter": (None, "m", "length"),
     "projectile.tip_radius": (None, "m", "length"),
     "projectile.exponent": (("power",), "", None),
-    "projectile.nose_length": (("power",), "m", "length"),
+    "projectile.nose_length": (("power", "spline"), "m", "length"),
 }
+# a spline nose's control radius K (0-based): --vary projectile.control_radii.K=LOW:HIGH (fractions of d/2)
+CONTROL_RADIUS = "projectile.control_radii"
+
+
+def control_index(key: str) -> int | None:
+    """K of ``projectile.control_radii.K`` (None for any other key)."""
+    head, _, k = key.rpartition(".")
+    return int(k) if head == CONTROL_RADIUS and k.isdigit() else None
 
 
 @dataclass(frozen=True)
@@ -71,6 +81,9 @@ class Problem:
     velocities: tuple[float, ...] = field(default=())
     # [coefficients] settings of every design's table (--table-depths, --table-nose-lengths): key -> value
     table_overrides: tuple[tuple[str, Any], ...] = field(default=())
+    # depth objective: knots per smooth piece of its table over [0, P_max] (only the depths it reads,
+    # optimize.model.depth_knots); 0: the case's own table to the deep limit (before issue 24)
+    depth_knots: int = SEARCH_KNOTS_PER_PIECE
 
     @property
     def low(self) -> list[float]:
@@ -101,8 +114,18 @@ def parse_variable(text: str) -> Variable:
     if "=" not in text:
         raise InputError("--vary", f"expected KEY=LOW:HIGH, e.g. projectile.crh=1:6; got {text!r}")
     key, _, rest = (s.strip() for s in text.partition("="))
+    if control_index(key) is not None:
+        flag = f"--vary {key}"
+        parts = rest.split(":")
+        if len(parts) != 2:
+            raise InputError(flag, f"bounds are LOW:HIGH; got {rest!r}")
+        low, high = (_parse_bound(t, None, flag)[0] for t in parts)
+        if not (0.0 < low < high <= 1.0):
+            raise InputError(flag, f"a control radius is a fraction of d/2: need 0 < LOW < HIGH <= 1; got {rest!r}")
+        return Variable(key, low, high, "")
     if key not in NOSE_KEYS:
-        raise InputError("--vary", f"{key!r} is not a nose-shape parameter; one of {', '.join(NOSE_KEYS)}")
+        raise InputError("--vary", f"{key!r} is not a nose-shape parameter; one of {', '.join(NOSE_KEYS)}, "
+                                   f"{CONTROL_RADIUS}.K (K = 0, 1, ..)")
     kinds, unit, kind = NOSE_KEYS[key]
     flag = f"--vary {key}"
     parts = rest.split(":")
@@ -129,7 +152,18 @@ def parse_variable(text: str) -> Variable:
 
 
 def _design_raw(problem: Problem, overrides: Mapping[str, Any]) -> dict:
-    raw = apply_overrides(json.loads(problem.raw_json), overrides)
+    """The base case with the overrides; ``projectile.control_radii.K`` sets one radius of the list."""
+    radii = {control_index(k): v for k, v in overrides.items() if control_index(k) is not None}
+    raw = apply_overrides(json.loads(problem.raw_json), {k: v for k, v in overrides.items() if control_index(k) is None})
+    if radii:
+        p = raw.setdefault("projectile", {})
+        values = list(p.get("control_radii") or [])
+        for k, v in radii.items():
+            if k >= len(values):
+                raise InputError(f"{CONTROL_RADIUS}.{k}", f"the case's spline nose has {len(values)} control radii "
+                                                          f"(K = 0..{len(values) - 1})")
+            values[k] = v
+        p["control_radii"] = values
     return raw
 
 
@@ -166,12 +200,16 @@ def build_problem(
     table_depths: int | None = None,
     table_nose_lengths: float | None = None,
     striking_velocity: str | None = None,
+    depth_knots: int | None = None,
 ) -> Problem:
     """Parse and check everything the user gave (exit 2 naming the flag on bad input).
 
     ``table_depths`` / ``table_nose_lengths`` set every design's ``[coefficients] depths`` and
     ``max_depth_nose_lengths`` (the design tables; None: the case's own); ``striking_velocity``
-    (``--striking-velocity``, with units): the depth objective at that one velocity."""
+    (``--striking-velocity``, with units): the depth objective at that one velocity;
+    ``depth_knots`` (``--depth-knots``): knots per piece of the depth objective's tables over the
+    depths it reads (default 4; 0: the case's own tables; ignored with ``table_depths`` /
+    ``table_nose_lengths``, which set the case's tables)."""
     from semianalytic.geometry import projectile_from_section
 
     if objective not in OBJECTIVES:
@@ -188,6 +226,14 @@ def build_problem(
     if len(set(keys)) != len(keys):
         raise InputError("--vary", "a key is varied twice")
     for v in variables:
+        k = control_index(v.key)
+        if k is not None:
+            if psec.nose != "spline":
+                raise InputError(v.flag, f"applies to a spline nose; the case's nose is {psec.nose!r}")
+            if k >= len(psec.control_radii or []):
+                raise InputError(v.flag, f"the case's spline nose has {len(psec.control_radii or [])} control radii "
+                                         f"(K = 0..{len(psec.control_radii or []) - 1})")
+            continue
         kinds = NOSE_KEYS[v.key][0]
         name = v.key.split(".", 1)[1]
         if kinds is not None and psec.nose not in kinds:
@@ -249,9 +295,14 @@ def build_problem(
         if not table_nose_lengths > 1.0:
             raise InputError("--table-nose-lengths", f"must be above 1 (nose lengths); got {table_nose_lengths:g}")
         tables.append(("coefficients.max_depth_nose_lengths", float(table_nose_lengths)))
+    if depth_knots is None:
+        depth_knots = SEARCH_KNOTS_PER_PIECE
+    if depth_knots != 0 and not 2 <= depth_knots <= 64:
+        raise InputError("--depth-knots", f"must be 0 (the case's own tables) or lie in [2, 64] (knots per piece); "
+                                          f"got {depth_knots}")
     problem = Problem(
         json.dumps(case.raw), str(case.path) if case.path else None, variables, objective, depth_model, cons,
-        fixed_mass, fixed_length, start.shank_length, velocities, tuple(tables),
+        fixed_mass, fixed_length, start.shank_length, velocities, tuple(tables), int(depth_knots),
     )
     check_bounds(problem)
     return problem
@@ -279,6 +330,10 @@ def check_bounds(problem: Problem) -> None:
     """Every corner of the bounds and their centre must be a valid design meeting the constraints."""
     corners = list(itertools.product(*[(v.low, v.high) for v in problem.variables]))
     corners.append(tuple(0.5 * (v.low + v.high) for v in problem.variables))
+    if sum(control_index(v.key) is not None for v in problem.variables) > 1:
+        # several control radii: corners of the box may be non-monotone or non-convex meridians (invalid designs,
+        # marked so in the search); the box's centre must be a valid design
+        corners = corners[-1:]
     for x in corners:
         try:
             from semianalytic.guards import check_case

@@ -25,7 +25,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--vary", action="append", default=[], metavar="KEY=LOW:HIGH",
                         help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
                              "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
-                             "projectile.nose_length (repeatable)")
+                             "projectile.nose_length, projectile.control_radii.K (a spline nose's K-th control radius, 0-based) (repeatable)")
     parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised), deep_drag (Bbar, "
                         "minimised), ballistic_limit (a plate's V_bl, minimised) or residual_velocity (a plate's mean V_r, "
                         "maximised)")
@@ -45,6 +45,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--table-nose-lengths", type=float, default=None,
                         help="deepest depth of every design's table, in nose lengths ([coefficients] "
                              "max_depth_nose_lengths; default: the case's); the optimum is re-evaluated on the case's own tables")
+    parser.add_argument("--depth-knots", type=int, default=None,
+                        help="depth objective: knots per smooth piece of every design's table over the depths it reads "
+                             "(0 to a little past the deepest final depth; default 4; the optimum is confirmed with 8); "
+                             "0: the case's own tables to the deep limit")
     parser.add_argument("--popsize", type=int, default=5, help="differential evolution: population per variable (default 5)")
     parser.add_argument("--maxiter", type=int, default=12, help="differential evolution: generations (default 12)")
     parser.add_argument("--tol", type=float, default=1e-5,

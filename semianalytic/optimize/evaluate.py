@@ -49,12 +49,12 @@ import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.optimize.case import Problem, design_case
-from semianalytic.optimize.model import (PLATE_OBJECTIVES, Infeasible, confirmation_grid, deep_drag, depth_objective,
-                                         quantise)
+from semianalytic.optimize.model import (CONFIRM_KNOTS_PER_PIECE, PLATE_OBJECTIVES, Infeasible, confirmation_grid,
+                                         deep_drag, depth_objective, quantise)
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
 _SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
-               "projectile.tip_radius", "projectile.exponent", "projectile.nose_length")
+               "projectile.tip_radius", "projectile.exponent", "projectile.nose_length", "projectile.control_radii")
 CLASSIC_NOSES: dict[str, dict[str, Any]] = {
     name: {**dict.fromkeys(_SHAPE_KEYS), **shape}  # None: the case's other shape keys removed (sharp tips)
     for name, shape in {
@@ -92,18 +92,15 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
             rec["bem_depths_solved"] = lim.solves
         elif problem.objective in PLATE_OBJECTIVES:  # the plate's tables only (no half-space table)
             rec.update(plate_objective(problem, case, cache_dir))
+        elif problem.objective == "depth" and problem.depth_knots and not problem.table_overrides:
+            rec.update(depth_record(problem, case, proj.nose, cache_dir))  # only the depths it reads
         else:
             table = coefficients_for_case(case, "bem", cache_dir=cache_dir)[0]
             rec["deep_drag_Bbar"] = deep_drag(table.deep_limit()[1], psec.diameter)
-        if problem.objective in PLATE_OBJECTIVES:
+        if problem.objective in PLATE_OBJECTIVES or "depths_m" in rec:
             pass
         elif problem.objective == "depth":
-            from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
-
-            exact = problem.depth_model == "exact-rod"
-            setup = PenetrationSetup.from_case(case, table, require_material=exact)
-            res = penetration_curve(setup, np.asarray(problem.velocities), elastic=exact)
-            depths = res["depth_elastic_exact_rod_m" if exact else "depth_rigid_m"]
+            depths = _depths(problem, case, table)
             rec["depths_m"] = [float(v) for v in depths]
             rec["objective"] = depth_objective(depths)
         else:
@@ -118,6 +115,56 @@ def evaluate_design(problem: Problem, overrides: Mapping[str, Any], cache_dir: s
         rec.update(status="error", message=f"{type(exc).__name__}: {exc}")
     rec["seconds"] = time.perf_counter() - t0
     return rec
+
+
+def _depths(problem: Problem, case, coefficients) -> np.ndarray:
+    """The final depths at the problem's striking velocities (Part I, eq. (11); rigid, or the
+    elastic projectile with the exact-rod energy, errata item 5)."""
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+
+    exact = problem.depth_model == "exact-rod"
+    setup = PenetrationSetup.from_case(case, coefficients, require_material=exact)
+    res = penetration_curve(setup, np.asarray(problem.velocities), elastic=exact)
+    return np.asarray(res["depth_elastic_exact_rod_m" if exact else "depth_rigid_m"], float)
+
+
+def depth_record(problem: Problem, case, nose, cache_dir=None, per_piece: int | None = None) -> dict:
+    """The ``depth`` objective from the depths it reads alone (issue 24): the deep limit from four
+    solves (:func:`~semianalytic.optimize.model.deep_limit`, 2 to 16 nose lengths), the deepest
+    final depth with those constant A, B, C (Part I, eq. (11)), the table range P_max
+    (:func:`~semianalytic.optimize.model.depth_range`) and a coefficient table over [0, P_max]
+    alone (:func:`~semianalytic.optimize.model.depth_knots`, ``per_piece`` knots per smooth piece;
+    default ``problem.depth_knots``), cached like any table; when a final depth lies past P_max
+    the range is widened to 1.5 times it and the table rebuilt.  Returns the record's fields."""
+    from semianalytic.cache import cached_coefficient_table, case_table_request
+    from semianalytic.coefficients import ConstantCoefficients
+    from semianalytic.optimize.model import deep_limit, depth_knots, depth_range
+
+    cs = case.coefficients
+    _, kw = case_table_request(case)
+    bem = {k: kw[k] for k in ("order", "refinement") if k in kw}
+    lim = deep_limit(nose, max_depth_nose_lengths=16.0, max_solves=4, strict=False, **bem)
+    B = lim.values[f"B_{cs.reading}"]
+    const = ConstantCoefficients(lim.values["A"], B, lim.values["C"], nose.diameter)
+    import dataclasses
+
+    rigid = dataclasses.replace(problem, depth_model="rigid")
+    estimate = float(np.max(_depths(rigid, case, const)))
+    P_max = depth_range(estimate, nose.length)
+    per_piece = per_piece or problem.depth_knots
+    for _ in range(3):
+        knots = depth_knots(nose, P_max, per_piece)
+        table = cached_coefficient_table(nose, cache_dir, depths=knots, bem_error=False, **bem).with_reading(cs.reading)
+        depths = _depths(problem, case, table)
+        deepest = float(np.max(depths)) if np.all(np.isfinite(depths)) else math.inf
+        if deepest <= P_max:
+            break
+        P_max = 1.5 * deepest if math.isfinite(deepest) else 2.0 * P_max
+    else:
+        raise RuntimeError(f"the final depth {deepest:.4g} m stays past the table range {P_max:.4g} m")
+    return {"deep_drag_Bbar": deep_drag(B, nose.diameter), "depths_m": [float(v) for v in depths],
+            "objective": depth_objective(depths), "table_range_m": P_max, "table_knots": len(knots),
+            "deep_estimate_m": estimate, "bem_depths_solved": lim.solves + len(table.depth)}
 
 
 def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
@@ -208,8 +255,11 @@ def _start_x(problem: Problem) -> list[float] | None:
     case = parse_case(raw)
     psec = case.require("projectile")
     x = []
+    from semianalytic.optimize.case import control_index
+
     for v in problem.variables:
-        val = getattr(psec, v.key.split(".", 1)[1], None)
+        k = control_index(v.key)
+        val = psec.control_radii[k] if k is not None else getattr(psec, v.key.split(".", 1)[1], None)
         if val is None:
             val = 0.0 if v.unit == "m" else None
         if val is None:
@@ -267,6 +317,30 @@ def _grid_pattern(batch, k: int, coarse: int, resolution: float, max_polls: int)
             "max_polls": max_polls, "polls": polls, "moves": moves, "final_step": h,
             "message": "step below the resolution" if done else
             "stopped at --maxfev polls", "success": bool(done)}
+
+
+def known_result(problem: Problem, best_x) -> dict | None:
+    """The optimum of a power-law or spline nose against the known minimum-drag exponent
+    (:data:`~semianalytic.optimize.model.NEWTONIAN_MIN_DRAG_EXPONENT`): the power law's own
+    exponent, or the exponent of the power law nearest the spline's meridian
+    (:func:`~semianalytic.optimize.model.fitted_exponent`, on 400 points).  None for other noses."""
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.optimize.model import NEWTONIAN_MIN_DRAG_EXPONENT, NEWTONIAN_SOURCE, fitted_exponent
+
+    try:
+        nose = nose_from_section(design_case(problem, problem.overrides(best_x)).require("projectile"))
+    except (InputError, Infeasible):
+        return None
+    if nose.kind == "power":
+        n, how = float(nose.parameters["exponent"]), "the optimum's exponent"
+    elif nose.kind == "spline":
+        x, r = nose.segments[0].point(np.linspace(0.0, 1.0, 401))
+        n, how = fitted_exponent(-np.asarray(x), r, nose.length, nose.radius), \
+            "the exponent of the power law nearest the optimum's meridian (least squares in r)"
+    else:
+        return None
+    return {"exponent": n, "how": how, "reference_exponent": NEWTONIAN_MIN_DRAG_EXPONENT, "source": NEWTONIAN_SOURCE,
+            "relative_difference": (n - NEWTONIAN_MIN_DRAG_EXPONENT) / NEWTONIAN_MIN_DRAG_EXPONENT}
 
 
 def finer_bem(problem: Problem) -> tuple:
@@ -392,9 +466,21 @@ def optimise(
     n_search = len({json.dumps(r["overrides"], sort_keys=True) for r in ev.history})
 
     grid = None
+    confirm_designs = 0  # designs evaluated on the confirmation's finer tables (their own memo)
     if confirm >= 2:
         pts, spacing = confirmation_grid(best_x, low, high, confirm, confirm_half_width)
-        recs = ev.map([problem.overrides(p) for p in pts], "confirm", gen["n"], pts)
+        ev_confirm, confirm_knots, ref = ev, None, best
+        if problem.objective == "depth" and problem.depth_knots and not problem.table_overrides:
+            # the optimum confirmed on finer tables (twice the knots per piece, at least CONFIRM_KNOTS_PER_PIECE)
+            import dataclasses
+
+            confirm_knots = max(CONFIRM_KNOTS_PER_PIECE, 2 * problem.depth_knots)
+            ev_confirm = Evaluator(dataclasses.replace(problem, depth_knots=confirm_knots), client, cache_dir, on_done)
+            ref = ev_confirm.map([problem.overrides(best_x)], "confirm", gen["n"], [best_x])[0]
+        recs = ev_confirm.map([problem.overrides(p) for p in pts], "confirm", gen["n"], pts)
+        if ev_confirm is not ev:
+            ev.history += ev_confirm.history
+            confirm_designs = len(ev_confirm.memo)
         f = np.array([r["objective"] if r["status"] == "ok" else PENALTY for r in recs])
         k = int(np.argmin(f))
         steps = np.abs(pts[k] - best_x) / np.where(spacing > 0, spacing, 1.0)
@@ -404,24 +490,30 @@ def optimise(
             "spacing": spacing.tolist(),
             "best_x": pts[k].tolist(),
             "best_objective": float(f[k]),
-            "optimum_objective": float(best["objective"]),
+            "optimum_objective": float(ref["objective"]),
             "distance_in_grid_steps": steps.tolist(),
             # confirmed: no grid point beats the optimum by more than the objective's numerical noise
             # (relative 1e-6: the BEM tables are converged to about that, see reports/bem_convergence.md),
             # or the grid's best is within one grid step of the optimum
-            "confirmed": bool(f[k] >= best["objective"] - 1e-6 * abs(best["objective"]) or np.all(steps <= 1.0 + 1e-9)),
+            "confirmed": bool(f[k] >= ref["objective"] - 1e-6 * abs(ref["objective"]) or np.all(steps <= 1.0 + 1e-9)),
+            "depth_knots": confirm_knots,
             "points": [{"x": p.tolist(), "objective": float(fi), "status": r["status"]} for p, fi, r in zip(pts, f, recs)],
         }
     own_tables = None
-    if problem.table_overrides:  # the optimum again on the case's own tables: the design tables' error
+    reads_depths = problem.objective == "depth" and bool(problem.depth_knots) and not problem.table_overrides
+    if problem.table_overrides or reads_depths:  # the optimum again on the case's own tables: the design tables' error
         import dataclasses
 
-        own = evaluate_design(dataclasses.replace(problem, table_overrides=()), problem.overrides(best_x), cache_dir)
+        own = evaluate_design(dataclasses.replace(problem, table_overrides=(), depth_knots=0), problem.overrides(best_x),
+                              cache_dir)
         if own["status"] == "ok":
             own_tables = {"objective": own["objective"], "design_tables_objective": best["objective"],
                           "relative_difference": abs(best["objective"] - own["objective"]) / abs(own["objective"]),
                           "seconds": own["seconds"], "table_overrides": dict(problem.table_overrides)}
+            if reads_depths:
+                own_tables["depth_knots"] = problem.depth_knots
     finer = finer_check(problem, best_x, low, high, cache_dir, max(confirm, 5), confirm_half_width) if finer_bem else None
+    known = known_result(problem, best_x)
     classic = {}
     if classic_noses:
         recs = ev.map(list(CLASSIC_NOSES.values()), "classic", gen["n"])
@@ -441,8 +533,9 @@ def optimise(
         "start": start_rec,
         "confirmation": grid,
         "classic": classic,
+        "known_result": known,
         "n_designs_search": n_search,
-        "n_designs_total": len(ev.memo),
+        "n_designs_total": len(ev.memo) + confirm_designs,
         "seconds_search": search_seconds,
         "seconds_total": time.perf_counter() - t0,
         "history": ev.history,

@@ -149,6 +149,78 @@ def deep_limit(nose, *, order: int = 8, refinement: float = 0.3, levels: int = 6
     return DeepLimit(values, errors, tuple(float(deep.P(v)) for v in vs))
 
 
+# The depth objective's tables (this project's own rule): knots per smooth piece of the depth axis
+# while searching, and on the finer table that confirms the optimum.  Measured on the power-law
+# noses n = 0.5, 0.74, 0.9 of cases/optimize_power_into_fig15a.toml against a certified table at
+# tolerance 1e-6 (2026-11-26): 4 knots per piece: rigid depths within 1e-5 relative (15 depth
+# solves); 8 knots per piece: within 4e-7 (the fixed 40-depth table of the case to 60 nose lengths: 3e-6).
+SEARCH_KNOTS_PER_PIECE = 4
+CONFIRM_KNOTS_PER_PIECE = 8
+# range of the depth objective's table: P_max = DEPTH_MARGIN x (deep-limit estimate of the deepest
+# final depth) + DEPTH_MARGIN_NOSES x L_h.  The deep-limit coefficients overstate the drag while the
+# nose enters, so the estimate falls short by less than one nose length (measured: 0.5-0.65 L_h on
+# the noses above); P_max is then past every final depth, checked after the solve.
+DEPTH_MARGIN = 1.1
+DEPTH_MARGIN_NOSES = 2.0
+
+
+def depth_range(deep_estimate: float, nose_length: float) -> float:
+    """P_max [m] of the depth objective's table from the deepest final depth [m] computed with
+    the deep-limit coefficients (Part I, eq. (11) with A, B, C constant): this project's own margin
+    (:data:`DEPTH_MARGIN`, :data:`DEPTH_MARGIN_NOSES`)."""
+    return DEPTH_MARGIN * float(deep_estimate) + DEPTH_MARGIN_NOSES * float(nose_length)
+
+
+def depth_knots(nose, P_max: float, per_piece: int) -> list[float]:
+    """The depths [m] of a coefficient table over [0, P_max] alone (this project's own rule): on
+    every smooth piece of the depth axis of :func:`semianalytic.coefficients.table.depth_pieces`
+    (cut at the nose's breakpoints, each in its own interpolation variable v), ``per_piece``
+    depths equally spaced in v inside the piece (its ends are the table's own knots); on the deep
+    piece (v = l/P) ``per_piece`` depths equally spaced in v from v(P_max) to 1, nothing deeper
+    (the depth objective reads A, B, C only down to the final depth, below P_max)."""
+    from semianalytic.coefficients.table import depth_pieces
+
+    if per_piece < 2:
+        raise ValueError("per_piece must be at least 2")
+    pieces, _ = depth_pieces(nose)
+    out: list[float] = []
+    for p in pieces[:-1]:
+        hi = min(p.P_hi, P_max)
+        if hi <= p.P_lo:
+            continue
+        vs = np.linspace(float(p.v(p.P_lo)), float(p.v(hi)), per_piece + 2)[1:-1]
+        out += [float(p.P(v)) for v in vs]
+    deep = pieces[-1]
+    if P_max > deep.P_lo:
+        vs = np.linspace(1.0, float(deep.v(P_max)), per_piece + 1)[1:]
+        out += [float(deep.P(v)) for v in vs]
+    return sorted(set(out))
+
+
+# The known result the power-law and spline designs are compared with: the minimum-drag body of
+# revolution of given length and base diameter under Newtonian impact theory (no friction) is
+# close to the power law r ~ x^(3/4) (Eggers, Resnikoff & Dennis 1957, "Bodies of revolution
+# having minimum drag at high supersonic airspeeds", NACA Report 1306; the exact Newtonian optimum
+# has a small flat tip and lies within a few per cent of the 3/4-power body).
+NEWTONIAN_MIN_DRAG_EXPONENT = 0.75
+NEWTONIAN_SOURCE = ("Eggers, Resnikoff & Dennis (1957), NACA Report 1306: the Newtonian minimum-drag body of given "
+                    "length and base diameter, close to the 3/4-power law")
+
+
+def fitted_exponent(xi, r, nose_length: float, radius: float) -> float:
+    """The exponent n of the power law r = R (xi/L_h)^n nearest a nose meridian in the least-squares
+    sense over the points (xi, r) [m] (this project's own comparison measure: the power law a free-form
+    nose is closest to, compared with the known optimum exponents)."""
+    from scipy.optimize import minimize_scalar
+
+    xi, r = np.asarray(xi, float) / nose_length, np.asarray(r, float) / radius
+    keep = (xi > 0) & (xi <= 1)
+    xi, r = xi[keep], r[keep]
+    res = minimize_scalar(lambda n: float(np.sum((r - xi**n) ** 2)), bounds=(0.05, 1.5), method="bounded",
+                          options={"xatol": 1e-8})
+    return float(res.x)
+
+
 def depth_objective(depths) -> float:
     """Minus the mean final depth [m] over the striking velocities (minimised = deepest on average)."""
     d = np.asarray(depths, float)

@@ -35,7 +35,8 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     if args.method not in ("grid-pattern", "grid-nm", "de"):
         raise InputError("--method", f"must be grid-pattern, grid-nm or de; got {args.method!r}")
     problem = build_problem(case, args.vary, args.objective, args.constraint, args.depth_model,
-                            args.table_depths, args.table_nose_lengths, getattr(args, "striking_velocity", None))
+                            args.table_depths, args.table_nose_lengths, getattr(args, "striking_velocity", None),
+                            getattr(args, "depth_knots", None))
     from semianalytic.guards import check_optimiser
 
     check_optimiser(len(problem.variables), method=args.method, coarse=args.coarse, confirm=args.confirm,

@@ -117,7 +117,15 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
              f"{result['seconds_search']:.1f} s ({result['scheduler']}, {result['workers']} worker(s)); "
              f"stopped: {o['message']}.")
     chk = result.get("own_tables_check")
-    if chk:
+    if chk and chk.get("depth_knots"):
+        doc.para(f"Design tables: every design's coefficient table over the depths the objective reads alone (issue 24, "
+                 f"this project's own rule: {chk['depth_knots']} knots per smooth piece of the depth axis from first contact "
+                 "to P_max, a margin past the deepest final depth estimated from the deep limit of four solves; "
+                 "docs/optimize.md). The optimum on the case's own "
+                 f"tables (to the deep limit): objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
+                 f"on the design tables, relative difference **{chk['relative_difference']:.1e}** (the design tables' "
+                 "error in the objective).")
+    elif chk:
         tabs = ", ".join(f"{k.split('.', 1)[1]} = {v:g}" for k, v in chk["table_overrides"].items())
         doc.para(f"Design tables: every design's coefficient table with {tabs} (lighter than the case's). The optimum "
                  f"on the case's own tables: objective {chk['objective']:.8g} against {chk['design_tables_objective']:.8g} "
@@ -158,6 +166,12 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
         for i, u in enumerate(vel):
             table.append([f"{u:.0f}"] + [fmt(r["depths_m"][i] * 1e3, 5) if r.get("depths_m") else "n/a" for r in recs])
         doc.table(hdr, table, caption="Final depth per striking velocity, same constraints for every nose.")
+    kr = result.get("known_result")
+    if kr:
+        own = " (this project's own measure of a free-form nose)" if "nearest" in kr["how"] else ""
+        doc.para(f"Known result: {kr['source']} (n = {kr['reference_exponent']:g}). Here {kr['how']}{own}: n = "
+                 f"{kr['exponent']:.4g}, {kr['relative_difference'] * 100:+.1f} % from it (the objective here is the "
+                 "depth or drag of this BEM model, not Newtonian impact pressure; see docs/optimize.md).")
     g = result.get("confirmation")
     if g:
         doc.heading("Confirmation on a finer grid")
@@ -167,7 +181,9 @@ def markdown(result: dict, command: str, figure_name: str) -> str:
                  + f"): best grid point {best_grid}, objective {g['best_objective']:.8g} against the optimum's "
                  f"{g['optimum_objective']:.8g}; distance in grid steps "
                  + ", ".join(f"{d:.2f}" for d in g["distance_in_grid_steps"])
-                 + f". Confirmed within the grid's resolution: **{'yes' if g['confirmed'] else 'NO'}**.")
+                 + f". Confirmed within the grid's resolution: **{'yes' if g['confirmed'] else 'NO'}**."
+                 + (f" The optimum and the grid on finer tables ({g['depth_knots']} knots per piece of the depth axis)."
+                    if g.get("depth_knots") else ""))
     doc.image(figure_name, "The best nose against the start and the classic noses (hemisphere, crh 3 ogive, "
                            "cone as long as the crh 3 ogive), with the objective of each.")
     return to_markdown(doc)
