@@ -241,7 +241,10 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     if psec.nose == "table":
         _refuse("projectile.points", what, need, limit, f"use fewer points ({len(psec.points)} given: each adds panels; "
                                                          "a few dozen describe a smooth nose) or lower the refinement")
-    _refuse("projectile", what, need, limit, "make the nose less slender or lower the refinement")
+    if psec.nose == "spline":
+        _refuse("projectile.control_radii", what, need, limit, "make the nose less slender (larger control radii near "
+                                                               "the tip) or lower the refinement")
+    _refuse(shape_field(psec.nose), what, need, limit, "make the nose less slender or lower the refinement")
     return need
 
 
@@ -314,8 +317,7 @@ def check_fem(case, h: float, depths_nose_lengths=(), far: float = 20.0) -> floa
         deepest = max(depths_nose_lengths or (1.0,)) * nose.depth_unit  # fem_check's depths are in this unit
         wetted = sum(_arc(seg) for seg in nose.segments) + max(deepest - nose.length, 0.0)
         dofs = fem_unknowns(d, wetted, far * (d + deepest), h)
-        field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
-            case.projectile.nose, "projectile")
+        field = shape_field(case.projectile.nose)
     else:
         return 0.0
     need = BASE_BYTES + FEM_BYTES_PER_DOF * dofs
@@ -357,13 +359,21 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
 TABLE_SECONDS_PER_UNKNOWN2 = 5e-5
 
 
+SHAPE_FIELDS = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points",
+                "spline": "projectile.control_radii", "power": "projectile.exponent"}
+
+
+def shape_field(nose: str) -> str:
+    """The case key that sets how many panels a nose kind needs (named by a refusal)."""
+    return SHAPE_FIELDS.get(nose, "projectile")
+
+
 def check_table_time(case, need_bytes: float) -> float:
     """Refuse a coefficient table whose estimated time exceeds the time budget (issue 27); its
     size is the BEM guard's (bytes = BEM_BYTES_PER_UNKNOWN2 N^2).  Returns ``need_bytes``."""
     seconds = need_bytes / BEM_BYTES_PER_UNKNOWN2 * TABLE_SECONDS_PER_UNKNOWN2
     psec = case.projectile
-    field = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points"}.get(
-        psec.nose, "projectile")
+    field = shape_field(psec.nose)
     check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(need_bytes / BEM_BYTES_PER_UNKNOWN2):.3g}"
                       " unknowns)", seconds=seconds,
                hint="make the nose less slender, give fewer points or a lower refinement (or raise the time budget)")

@@ -201,3 +201,14 @@ def test_field_depths_of_a_flat_nose_are_in_its_depth_unit(tmp_path):
     case.write_text(Path(__file__).resolve().parent.parent.joinpath("cases", "flat_nose.toml").read_text()
                     + '\n[run]\nanalyses = ["coefficients", "velocity_field"]\nfield_depths = ["10 mm"]\n')
     guards.check_case(load_case(case), field=True)  # 10 mm = 2.8 radii: far inside the default budget
+
+
+def test_spline_nose_too_slow_names_its_control_radii(monkeypatch, capsys, tmp_path):
+    """A spline nose whose table does not fit the time budget names the key that shapes it (not
+    just 'projectile'), as the ogive's names crh."""
+    case = Path(__file__).resolve().parents[1] / "cases" / "optimize_spline_into_fig15a.toml"
+    monkeypatch.setenv(guards.TIME_ENV, "0.001")
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path))  # no cached table: the budget is checked
+    assert main(["coefficients", str(case)]) == 2
+    err = capsys.readouterr().err
+    assert err.startswith("error: projectile.control_radii:") and "time budget" in err
