@@ -75,36 +75,54 @@ def _samples(order: int) -> np.ndarray:
     return np.linspace(-1.0, 1.0, 2 * order + 1)
 
 
+def _sample_table(ps: PanelSet):
+    """x, r, x_u, r_u of every panel at the 2p+1 samples of :func:`closest_points`, shape
+    (n_panels, 2p+1): evaluated once per panel set instead of once per (target, panel) pair
+    (the same numbers; kept on the panel set)."""
+    table = ps.__dict__.get("_closest_samples")
+    if table is None:
+        samples = _samples(ps.order)
+        pk = np.repeat(np.arange(ps.n_panels), samples.size).reshape(ps.n_panels, samples.size)
+        table = ps.evaluate(pk, np.broadcast_to(samples, pk.shape))
+        ps.__dict__["_closest_samples"] = table
+    return table
+
+
 def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray):
     """Parameter u* of the point of panel ``pan`` nearest to (xq, rq), and the distance in
     the panel's parameter, du = distance / |dy/du| at u*.
 
     Sampled, then refined by Newton's method (projected onto [-1, 1]): the minimum may lie
-    between an end sample and its neighbour."""
+    between an end sample and its neighbour.  A pair whose nearest sample is an end of the
+    panel where the distance grows inwards ((y - x) . y' >= 0 at u = -1, <= 0 at u = +1) keeps
+    that end: every Newton step from there points out of the panel and is projected back."""
     samples = _samples(ps.order)
-    x, r, xu, ru = ps.evaluate(pan[:, None], samples[None, :])
+    sx, sr, sxu, sru = _sample_table(ps)
+    x, r = sx[pan], sr[pan]
     d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
     j = np.argmin(d2, axis=1)
     rows = np.arange(len(pan))
     u = samples[j]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
-    inner = np.arange(len(pan))
+    x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
+    f = (x - xq) * xu + (r - rq) * ru
+    last = samples.size - 1
+    settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
+    inner = np.nonzero(~settled)[0]
     if inner.size:
         ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
         for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
-            x, r, xu, ru, xuu, ruu = ps.evaluate(pi, ui, second=True)
-            ex, er = x - xi, r - ri
-            f = ex * xu + er * ru
-            fp = xu * xu + ru * ru + ex * xuu + er * ruu
-            step = np.where(fp > 0, f / np.where(fp > 0, fp, 1.0), 0.0)
+            xn, rn, xun, run, xuu, ruu = ps.evaluate(pi, ui, second=True)
+            ex, er = xn - xi, rn - ri
+            fn = ex * xun + er * run
+            fp = xun * xun + run * run + ex * xuu + er * ruu
+            step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
             ui = np.clip(ui - step, -1.0, 1.0)
-        x, r, xu, ru = ps.evaluate(pi, ui)
+        x[inner], r[inner], xu[inner], ru[inner] = ps.evaluate(pi, ui)
         u[inner] = ui
-        dist = np.hypot(x - xi, r - ri)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            du[inner] = dist / np.hypot(xu, ru)
-        du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
+    dist = np.hypot(x - xq, r - rq)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        du = dist / np.hypot(xu, ru)
+    du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
     return u, du
 
 
