@@ -179,6 +179,12 @@ class PairQuadrature:
     ``(a[k] K + b[k] Q) |dy/du| lag[k, j]`` to the integral of the kernel K against the
     Lagrange basis function l_j; Q is the coefficient of the logarithm (self rules only,
     b = 0 elsewhere).
+
+    The pairs come in ``blocks`` (first pair, number of pairs, points per pair, Lagrange
+    matrix): pairs of a block with a shared (Q, p) matrix (the end rules of neighbouring
+    panels) or with one (Q, p) matrix each (the self rules) are summed by one matrix
+    product; a block with matrix None (rules of varying length) by the flat ``lag`` rows of
+    its points.
     """
 
     target: np.ndarray
@@ -188,8 +194,9 @@ class PairQuadrature:
     u: np.ndarray
     a: np.ndarray
     b: np.ndarray
-    lag: np.ndarray
+    lag: np.ndarray  # (points of the blocks without a matrix, p)
     target_u: np.ndarray | None = None  # self rules: the target's own panel coordinate
+    blocks: tuple = ()
 
     @staticmethod
     def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
@@ -206,16 +213,25 @@ class PairQuadrature:
         starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         pair = np.repeat(np.arange(len(order_idx)), counts)
         u, a, b = (np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3))
-        lags = []
+        lags, blocks = [], []
+        first = 0
         for part in parts:
-            uu, lag = part[1], part[4]
-            if lag is None:
-                lag = lagrange_matrix(nodes, uu)
-            lags.append(lag if lag.ndim == 2 and lag.shape[0] == uu.size else
-                        np.broadcast_to(lag, (*uu.shape, order)).reshape(-1, order))
+            n, uu, lag = len(part[0]), part[1], part[4]
+            if len(part) > 5:  # flat points of varying counts
+                if lag is None:
+                    lag = lagrange_matrix(nodes, uu)
+                lags.append(lag)
+                blocks.append((first, n, 0, None))
+            else:
+                if lag is None:
+                    lag = lagrange_matrix(nodes, uu)
+                Q = uu.shape[1]
+                blocks.append((first, n, Q, lag))
+            first += n
+        flat = np.concatenate(lags) if lags else np.empty((0, order))
         return PairQuadrature(
-            target[order_idx], panel[order_idx], pair, starts, u, a, b, np.concatenate(lags),
-            None if target_u is None else target_u[order_idx],
+            target[order_idx], panel[order_idx], pair, starts, u, a, b, flat,
+            None if target_u is None else target_u[order_idx], tuple(blocks),
         )
 
     def subset(self, keep: np.ndarray) -> "PairQuadrature":
@@ -226,10 +242,47 @@ class PairQuadrature:
         renumber = np.cumsum(keep) - 1
         pair = renumber[self.pair[points]]
         counts = np.bincount(pair, minlength=int(keep.sum()))
+        blocks, flat_rows = [], []
+        first = 0
+        flat_at = 0
+        for f, n, Q, lag in self.blocks:
+            k = keep[f:f + n]
+            m = int(k.sum())
+            if lag is None:
+                s0, s1 = self._points_of(f, n)
+                flat_rows.append(self.lag[flat_at:flat_at + (s1 - s0)][points[s0:s1]])
+                flat_at += s1 - s0
+                if m:
+                    blocks.append((first, m, 0, None))
+            elif m:
+                blocks.append((first, m, Q, lag if lag.ndim == 2 else lag[k]))
+            first += m
+        flat = np.concatenate(flat_rows) if flat_rows else np.empty((0, self.lag.shape[1]))
         return PairQuadrature(
             self.target[keep], self.panel[keep], pair, np.cumsum(counts) - counts, self.u[points], self.a[points],
-            self.b[points], self.lag[points], None if self.target_u is None else self.target_u[keep],
+            self.b[points], flat, None if self.target_u is None else self.target_u[keep], tuple(blocks),
         )
+
+    def _points_of(self, f: int, n: int) -> tuple[int, int]:
+        """First and past-the-last point of the pairs f .. f + n - 1."""
+        return int(self.starts[f]), int(self.starts[f + n]) if f + n < len(self.starts) else self.u.size
+
+    def _reduce(self, wk: np.ndarray) -> np.ndarray:
+        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
+        out = np.empty((len(self.target), self.lag.shape[1]))
+        flat_at = 0
+        for f, n, Q, lag in self.blocks:
+            s0 = self.starts[f]
+            if lag is None:
+                s1 = self._points_of(f, n)[1]
+                rows = self.lag[flat_at:flat_at + (s1 - s0)]
+                flat_at += s1 - s0
+                out[f:f + n] = np.add.reduceat(wk[s0:s1, None] * rows, self.starts[f:f + n] - s0, axis=0)
+            elif lag.ndim == 2:
+                out[f:f + n] = wk[s0:s0 + n * Q].reshape(n, Q) @ lag
+            else:
+                out[f:f + n] = np.matmul(wk[s0:s0 + n * Q].reshape(n, 1, Q), lag)[:, 0, :]
+        return out
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
@@ -261,7 +314,7 @@ class PairQuadrature:
                 wk = (self.a * K + self.b * Q) * J
             else:
                 wk = self.a * ker * J
-            out.append(np.add.reduceat(wk[:, None] * self.lag, self.starts, axis=0))
+            out.append(self._reduce(wk))
         return out
 
 
