@@ -610,26 +610,20 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
     g, gw = gauss_legendre(n)
     g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
     t01, tw01 = gauss_log(n)
-    out = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
-    for uq in uq_all:
-        su, sw, swl, lu, lw, fu, fw = ([] for _ in range(7))
-        for h, sign, lev in ((1.0 - uq, 1.0, lev_right), (1.0 + uq, -1.0, lev_left)):
-            inner = h * 2.0**-lev
-            su.append(uq + sign * inner * g01)
-            sw.append(inner * gw01)
-            swl.append(-math.log(inner) * inner * gw01)
-            lu.append(uq + sign * inner * t01)
-            lw.append(inner * tw01)
-            for k in range(lev, 0, -1):
-                a = h * 2.0**-k
-                fu.append(uq + sign * (a + a * g01))
-                fw.append(a * gw01)
-        for key, parts in zip(out, (su, sw, swl, lu, lw, fu, fw)):
-            out[key].append(np.concatenate(parts) if parts else np.empty(0))
-    table = {k: np.array(v) for k, v in out.items()}
-    if table["fu"].ndim == 1:  # no outer pieces
-        table["fu"] = np.empty((p, 0))
-        table["fw"] = np.empty((p, 0))
+    uq = uq_all[:, None]
+    parts = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
+    for h, sign, lev in ((1.0 - uq_all, 1.0, lev_right), (1.0 + uq_all, -1.0, lev_left)):  # all nodes at once
+        inner = (h * 2.0**-lev)[:, None]
+        neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
+        parts["su"].append(uq + sign * inner * g01)
+        parts["sw"].append(inner * gw01)
+        parts["swl"].append(neglog * inner * gw01)
+        parts["lu"].append(uq + sign * inner * t01)
+        parts["lw"].append(inner * tw01)
+        a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
+        parts["fu"].append((uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1))
+        parts["fw"].append((a * gw01).reshape(p, -1))
+    table = {k: np.concatenate(v, axis=1) for k, v in parts.items()}
     table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
     return table
 
