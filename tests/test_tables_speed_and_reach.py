@@ -21,7 +21,7 @@ import pytest
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
 from semianalytic.bem.solve import AssemblyCache, assemble, plan_assembly
 from semianalytic.coefficients import table as table_mod
-from semianalytic.coefficients.study import study_nose, table_error_study
+from semianalytic.coefficients.study import reach_study, study_nose, table_error_study
 from semianalytic.coefficients.table import CONTROLLED, coefficient_table, direct_coefficients
 from semianalytic.geometry import cone_nose, flat_nose, ogive_nose
 
@@ -145,12 +145,6 @@ def test_tolerance_1e8_with_the_defaults_bounds_1000_random_depths(kind):
     """Issue 24's target: --tolerance 1e-8 with the default options, and every estimate at
     least the off-knot error at 1000 random depths (log-uniform from 1e-6 to 300 nose lengths,
     a third in 0.9-1.3 L_h) against direct solves."""
-    nose = study_nose(kind)
-    table = coefficient_table(nose, tolerance=1e-8)
-    rng = np.random.default_rng(1000)
-    L = nose.depth_unit
-    depths = np.sort(np.concatenate([rng.uniform(0.9, 1.3, 333) * L,
-                                     np.exp(rng.uniform(math.log(1e-6), math.log(300.0), 667)) * L]))
-    study = table_error_study(nose, table, depths)
+    r = reach_study(kind, tolerance=1e-8, n=1000, seed=1000)
     for q in CONTROLLED:
-        assert study[q]["bounded"] == study[q]["n"], (q, study[q])
+        assert r["study"][q]["bounded"] == r["study"][q]["n"], (q, r["study"][q])
