@@ -367,12 +367,13 @@ def write_reach_report(out_dir: Path, force: bool, quick: bool = False) -> list[
         f"{n} seeded random depths (a third in 0.9-1.3 L_h, the rest log-uniform from 1e-6 to 300 nose lengths: "
         "below the first knot and in the extrapolated deep piece too). 'bounded' counts the depths where the "
         "table's error estimate is at least the actual error; 'estimate/error' is the smallest ratio over the depths "
-        "(>= 1: every estimate bounds its error); 'error' the largest actual error over the coefficient's largest "
-        f"magnitude. CPU times on a shared 2-core machine, load average (1, 5, 15 min) {load0[0]:.1f}, {load0[1]:.1f}, "
+        "(>= 1: every estimate bounds its error); errors are relative to the coefficient's largest magnitude (a "
+        f"nose whose errors exceed the tolerance has noise-limited intervals, whose estimates are their discrepancies). CPU times on a shared 2-core machine, load average (1, 5, 15 min) {load0[0]:.1f}, {load0[1]:.1f}, "
         f"{load0[2]:.1f} before and {load1[0]:.1f}, {load1[1]:.1f}, {load1[2]:.1f} after. The same check is the slow "
         "test `tests/test_tables_speed_and_reach.py::test_tolerance_1e8_with_the_defaults_bounds_1000_random_depths`.")
     doc.table(("nose", "knots", "deepest solve [nose lengths]", "noise-limited intervals", "table CPU [s]",
-               "check CPU [s]", "worst coefficient", "bounded", "estimate/error (smallest)", "error (largest)"),
+               "check CPU [s]", "coefficient with the smallest estimate/error", "bounded", "estimate/error (smallest)",
+               "largest error of any coefficient"),
               [(r["nose"], r["knots"], f"{r['max_depth_nose_lengths']:.4g}", r["noise_limited"], f"{r['cpu_table_s']:.1f}",
                 f"{r['cpu_check_s']:.1f}", w, f"{r['study'][w]['bounded']}/{r['study'][w]['n']}",
                 f"{r['study'][w]['min_estimate_ratio']:.3g}", f"{max(r['study'][q]['max_rel_error'] for q in CONTROLLED):.1e}")
