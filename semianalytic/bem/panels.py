@@ -73,6 +73,16 @@ class PanelSet:
             return np.empty(0, dtype=int)
         return np.nonzero(self.cluster != 0)[0]
 
+    @cached_property
+    def _half(self) -> np.ndarray:
+        """Half the parameter span of each panel (d dt/du of a plain panel)."""
+        return 0.5 * (self.db - self.da)
+
+    @cached_property
+    def _clustered(self) -> np.ndarray:
+        """Panels with a corner substitution (a mask)."""
+        return np.zeros(self.n_panels, bool) if self.cluster is None else self.cluster != 0
+
     def _param(self, pk, u, second: bool = False):
         """Offset of the segment parameter from the anchor, dt(u), and its derivatives.
 
@@ -80,22 +90,22 @@ class PanelSet:
         at corners): dt = da + (db - da) w(u), w = ((1 + u)/2)^q, or dt = db - (db - da)
         ((1 - u)/2)^q at the other end; the corner end is the anchor, so tiny offsets keep
         their relative precision."""
-        da, db = self.da[pk], self.db[pk]
-        span = db - da
-        half = 0.5 * span
+        da = self.da[pk]
+        half = self._half[pk]
         dt = da + half * (u + 1.0)
         d2 = np.zeros_like(dt) if second else None
         if self.cluster is None:
             return dt, half, d2
-        on = np.nonzero(self.cluster[pk])  # the few nodes on corner panels
+        on = np.nonzero(self._clustered[pk])  # the few nodes on corner panels
         if on[0].size == 0:
             return dt, half, d2
         dtdu = np.array(np.broadcast_to(half, dt.shape), dtype=float)
-        pko, uo, so = pk[on], u[on], span[on]
+        pko, uo = pk[on], u[on]
+        so = self.db[pko] - self.da[pko]
         c, q = self.cluster[pko], self.power[pko]
         lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
         w = lo**q
-        dt[on] = np.where(c > 0, db[on] - so * w, da[on] + so * w)
+        dt[on] = np.where(c > 0, self.db[pko] - so * w, da[on] + so * w)
         dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
         if second:
             d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)

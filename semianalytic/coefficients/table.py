@@ -1024,7 +1024,13 @@ def coefficient_table(
         from tqdm import tqdm
 
         bar = tqdm(desc="BEM depths", unit="depth", leave=False)
+    import contextlib
+
+    from semianalytic.bem.solve import _single_threaded_blas
+
+    blas = contextlib.ExitStack()
     try:
+        blas.enter_context(_single_threaded_blas())  # once for all the table's solves
         b = _Builder(nose, opts, tol, P_max, bar)
         options = {"order": order, "refinement": refinement, "levels": levels}
         if depths is None and n_depths is not None:
@@ -1048,6 +1054,7 @@ def coefficient_table(
         bem_err = b.bem_errors() if bem_error else {}
         return b.table(options, bem_err)
     finally:
+        blas.close()
         if bar is not None:
             bar.close()
 
