@@ -291,7 +291,8 @@ class PairQuadrature:
         """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
         out = np.empty((len(self.target), self.lag.shape[1]))
         flat_at = 0
-        for f, n, Q, lag in self.blocks:
+        blocks = self.blocks or (((0, len(self.target), 0, None),) if len(self.target) else ())  # all rows flat
+        for f, n, Q, lag in blocks:
             s0 = self.starts[f]
             if lag is None:
                 s1 = self._points_of(f, n)[1]
