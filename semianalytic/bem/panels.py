@@ -73,6 +73,16 @@ class PanelSet:
             return np.empty(0, dtype=int)
         return np.nonzero(self.cluster != 0)[0]
 
+    @cached_property
+    def _half(self) -> np.ndarray:
+        """Half the parameter span of each panel (d dt/du of a plain panel)."""
+        return 0.5 * (self.db - self.da)
+
+    @cached_property
+    def _clustered(self) -> np.ndarray:
+        """Panels with a corner substitution (a mask)."""
+        return np.zeros(self.n_panels, bool) if self.cluster is None else self.cluster != 0
+
     def _param(self, pk, u, second: bool = False):
         """Offset of the segment parameter from the anchor, dt(u), and its derivatives.
 
@@ -80,22 +90,22 @@ class PanelSet:
         at corners): dt = da + (db - da) w(u), w = ((1 + u)/2)^q, or dt = db - (db - da)
         ((1 - u)/2)^q at the other end; the corner end is the anchor, so tiny offsets keep
         their relative precision."""
-        da, db = self.da[pk], self.db[pk]
-        span = db - da
-        half = 0.5 * span
+        da = self.da[pk]
+        half = self._half[pk]
         dt = da + half * (u + 1.0)
         d2 = np.zeros_like(dt) if second else None
         if self.cluster is None:
             return dt, half, d2
-        on = np.nonzero(self.cluster[pk])  # the few nodes on corner panels
+        on = np.nonzero(self._clustered[pk])  # the few nodes on corner panels
         if on[0].size == 0:
             return dt, half, d2
         dtdu = np.array(np.broadcast_to(half, dt.shape), dtype=float)
-        pko, uo, so = pk[on], u[on], span[on]
+        pko, uo = pk[on], u[on]
+        so = self.db[pko] - self.da[pko]
         c, q = self.cluster[pko], self.power[pko]
         lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
         w = lo**q
-        dt[on] = np.where(c > 0, db[on] - so * w, da[on] + so * w)
+        dt[on] = np.where(c > 0, self.db[pko] - so * w, da[on] + so * w)
         dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
         if second:
             d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)
@@ -112,15 +122,12 @@ class PanelSet:
         u = np.asarray(u, dtype=float)
         if panel.shape != u.shape:
             panel, u = np.broadcast_arrays(panel, u)
-        if len(self.segments) == 1:
-            return self._evaluate_segment(self.segments[0], panel, u, second)
+        curves, group = self._curves
+        if len(curves) == 1:
+            return self._evaluate_segment(curves[0], panel, u, second)
         out = [np.empty(u.shape) for _ in range(6 if second else 4)]
-        seg_of = self.segment_index[panel]
-        for s, seg in enumerate(self.segments):
-            mask = seg_of == s
-            if not mask.any():
-                continue
-            for o, v in zip(out, self._evaluate_segment(seg, panel[mask], u[mask], second)):
+        for seg, mask, pk in self._by_segment(panel):
+            for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second)):
                 o[mask] = v
         return tuple(out)
 
@@ -136,10 +143,34 @@ class PanelSet:
             out += [sg * (ddx * half * half + dx * d2t), ddr * half * half + dr * d2t]
         return tuple(out)
 
+    @cached_property
+    def _curves(self) -> tuple[tuple[Segment, ...], np.ndarray]:
+        """Segments that evaluate alike, merged (this project's own shortcut): the pieces of one
+        table spline between its knots share its fitted splines, and their points, derivatives
+        and displacements depend on the parameter only, so one call evaluates all of them (the
+        same numbers, a fifth of the spline calls on a table nose).  Returns the distinct
+        curves and the curve of each panel."""
+        curves: list = []
+        of_segment = []
+        for seg in self.segments:
+            for k, c in enumerate(curves):
+                if c is seg or (isinstance(seg, SplineCurve) and isinstance(c, SplineCurve) and seg.lo is not None
+                                and c.lo is not None and c._splines is seg._splines):
+                    of_segment.append(k)
+                    break
+            else:
+                of_segment.append(len(curves))
+                curves.append(seg)
+        return tuple(curves), np.asarray(of_segment, dtype=int)[self.segment_index]
+
     def _by_segment(self, panel: np.ndarray):
-        """(segment, mask into ``panel``, the panels of that segment) for each segment used."""
-        seg_of = self.segment_index[panel]
-        for s, seg in enumerate(self.segments):
+        """(curve, mask into ``panel``, the panels on that curve) for each curve used."""
+        curves, group = self._curves
+        if len(curves) == 1:
+            yield curves[0], np.ones(panel.shape, bool), panel
+            return
+        seg_of = group[panel]
+        for s, seg in enumerate(curves):
             mask = seg_of == s
             if mask.any():
                 yield seg, mask, panel[mask]
@@ -208,14 +239,11 @@ class PanelSet:
         pk, uk, dk = panel[on], u[on], dist[on]
         c, q = self.cluster[pk], self.power[pk]
         span = np.abs(self.db[pk] - self.da[pk])
-        seg_of = self.segment_index[pk]
         speed = np.empty(on.size)
         dt = self._param(pk, uk)[0]
-        for s_idx, seg in enumerate(self.segments):
-            m = seg_of == s_idx
-            if m.any():
-                dx, dr = seg.derivative(self.base[pk[m]] + dt[m])
-                speed[m] = np.hypot(dx, dr)
+        for seg, m, pkm in self._by_segment(pk):
+            dx, dr = seg.derivative(self.base[pkm] + dt[m])
+            speed[m] = np.hypot(dx, dr)
         lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
         w = lo**q  # fraction of the panel's parameter span from the corner
         dw = dk / np.maximum(speed * span, 1e-300)

@@ -27,8 +27,10 @@ pairs with dyadically graded rules; assembly vectorised over all pairs.
 
 from __future__ import annotations
 
+import contextlib
 import functools
 import math
+import threading
 from dataclasses import dataclass
 from functools import cached_property
 
@@ -51,6 +53,11 @@ N_NEAR = 8  # Gauss points per dyadic piece in the near rules
 NEAR_FACTOR = 1.3  # a panel is "near" a target closer than this many panel lengths to its centre
 MAX_LEVELS = 48
 IMAGE_MARGIN = 4.0  # innermost self piece <= (distance to the axis image)/IMAGE_MARGIN
+# kernel entries per block of rows of the dense assembly, so that the kernels' temporaries stay
+# near glibc's mmap threshold (128 KiB) instead of being mapped and unmapped at every call (this
+# project's own; measured in one process, alternately 8 times: the certified table nose 2.40 s
+# against 2.66 s of CPU, the Fig. 5 ogive unchanged; the same numbers bitwise)
+DENSE_CHUNK = 12288
 
 
 @functools.cache
@@ -60,10 +67,23 @@ def _threadpools():
     return ThreadpoolController()
 
 
+_BLAS_LIMIT = threading.local()
+
+
+@contextlib.contextmanager
 def _single_threaded_blas():
     """Small dense solves run far faster on one BLAS thread on a loaded 2-core machine
-    (numerical notes); the limit is lifted again on exit."""
-    return _threadpools().limit(limits=1, user_api="blas")
+    (numerical notes); the limit is lifted again on exit.  Nested uses inside one thread cost
+    nothing (a table sets it once for its 150 solves: each setting is ~0.1 ms of library calls)."""
+    if getattr(_BLAS_LIMIT, "on", False):
+        yield
+        return
+    with _threadpools().limit(limits=1, user_api="blas"):
+        _BLAS_LIMIT.on = True
+        try:
+            yield
+        finally:
+            _BLAS_LIMIT.on = False
 
 
 # ------------------------------------------------------------------------------------
@@ -75,36 +95,54 @@ def _samples(order: int) -> np.ndarray:
     return np.linspace(-1.0, 1.0, 2 * order + 1)
 
 
+def _sample_table(ps: PanelSet):
+    """x, r, x_u, r_u of every panel at the 2p+1 samples of :func:`closest_points`, shape
+    (n_panels, 2p+1): evaluated once per panel set instead of once per (target, panel) pair
+    (the same numbers; kept on the panel set)."""
+    table = ps.__dict__.get("_closest_samples")
+    if table is None:
+        samples = _samples(ps.order)
+        pk = np.repeat(np.arange(ps.n_panels), samples.size).reshape(ps.n_panels, samples.size)
+        table = ps.evaluate(pk, np.broadcast_to(samples, pk.shape))
+        ps.__dict__["_closest_samples"] = table
+    return table
+
+
 def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray):
     """Parameter u* of the point of panel ``pan`` nearest to (xq, rq), and the distance in
     the panel's parameter, du = distance / |dy/du| at u*.
 
     Sampled, then refined by Newton's method (projected onto [-1, 1]): the minimum may lie
-    between an end sample and its neighbour."""
+    between an end sample and its neighbour.  A pair whose nearest sample is an end of the
+    panel where the distance grows inwards ((y - x) . y' >= 0 at u = -1, <= 0 at u = +1) keeps
+    that end: every Newton step from there points out of the panel and is projected back."""
     samples = _samples(ps.order)
-    x, r, xu, ru = ps.evaluate(pan[:, None], samples[None, :])
+    sx, sr, sxu, sru = _sample_table(ps)
+    x, r = sx[pan], sr[pan]
     d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
     j = np.argmin(d2, axis=1)
     rows = np.arange(len(pan))
     u = samples[j]
-    with np.errstate(divide="ignore", invalid="ignore"):
-        du = np.sqrt(d2[rows, j]) / np.hypot(xu[rows, j], ru[rows, j])
-    inner = np.arange(len(pan))
+    x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
+    f = (x - xq) * xu + (r - rq) * ru
+    last = samples.size - 1
+    settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
+    inner = np.nonzero(~settled)[0]
     if inner.size:
         ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
         for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
-            x, r, xu, ru, xuu, ruu = ps.evaluate(pi, ui, second=True)
-            ex, er = x - xi, r - ri
-            f = ex * xu + er * ru
-            fp = xu * xu + ru * ru + ex * xuu + er * ruu
-            step = np.where(fp > 0, f / np.where(fp > 0, fp, 1.0), 0.0)
+            xn, rn, xun, run, xuu, ruu = ps.evaluate(pi, ui, second=True)
+            ex, er = xn - xi, rn - ri
+            fn = ex * xun + er * run
+            fp = xun * xun + run * run + ex * xuu + er * ruu
+            step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
             ui = np.clip(ui - step, -1.0, 1.0)
-        x, r, xu, ru = ps.evaluate(pi, ui)
+        x[inner], r[inner], xu[inner], ru[inner] = ps.evaluate(pi, ui)
         u[inner] = ui
-        dist = np.hypot(x - xi, r - ri)
-        with np.errstate(divide="ignore", invalid="ignore"):
-            du[inner] = dist / np.hypot(xu, ru)
-        du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
+    dist = np.hypot(x - xq, r - rq)
+    with np.errstate(divide="ignore", invalid="ignore"):
+        du = dist / np.hypot(xu, ru)
+    du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
     return u, du
 
 
@@ -161,6 +199,12 @@ class PairQuadrature:
     ``(a[k] K + b[k] Q) |dy/du| lag[k, j]`` to the integral of the kernel K against the
     Lagrange basis function l_j; Q is the coefficient of the logarithm (self rules only,
     b = 0 elsewhere).
+
+    The pairs come in ``blocks`` (first pair, number of pairs, points per pair, Lagrange
+    matrix): pairs of a block with a shared (Q, p) matrix (the end rules of neighbouring
+    panels) or with one (Q, p) matrix each (the self rules) are summed by one matrix
+    product; a block with matrix None (rules of varying length) by the flat ``lag`` rows of
+    its points.
     """
 
     target: np.ndarray
@@ -170,8 +214,9 @@ class PairQuadrature:
     u: np.ndarray
     a: np.ndarray
     b: np.ndarray
-    lag: np.ndarray
+    lag: np.ndarray  # (points of the blocks without a matrix, p)
     target_u: np.ndarray | None = None  # self rules: the target's own panel coordinate
+    blocks: tuple = ()
 
     @staticmethod
     def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
@@ -188,16 +233,25 @@ class PairQuadrature:
         starts = np.concatenate([[0], np.cumsum(counts)[:-1]])
         pair = np.repeat(np.arange(len(order_idx)), counts)
         u, a, b = (np.concatenate([part[k].ravel() for part in parts]) for k in (1, 2, 3))
-        lags = []
+        lags, blocks = [], []
+        first = 0
         for part in parts:
-            uu, lag = part[1], part[4]
-            if lag is None:
-                lag = lagrange_matrix(nodes, uu)
-            lags.append(lag if lag.ndim == 2 and lag.shape[0] == uu.size else
-                        np.broadcast_to(lag, (*uu.shape, order)).reshape(-1, order))
+            n, uu, lag = len(part[0]), part[1], part[4]
+            if len(part) > 5:  # flat points of varying counts
+                if lag is None:
+                    lag = lagrange_matrix(nodes, uu)
+                lags.append(lag)
+                blocks.append((first, n, 0, None))
+            else:
+                if lag is None:
+                    lag = lagrange_matrix(nodes, uu)
+                Q = uu.shape[1]
+                blocks.append((first, n, Q, lag))
+            first += n
+        flat = np.concatenate(lags) if lags else np.empty((0, order))
         return PairQuadrature(
-            target[order_idx], panel[order_idx], pair, starts, u, a, b, np.concatenate(lags),
-            None if target_u is None else target_u[order_idx],
+            target[order_idx], panel[order_idx], pair, starts, u, a, b, flat,
+            None if target_u is None else target_u[order_idx], tuple(blocks),
         )
 
     def subset(self, keep: np.ndarray) -> "PairQuadrature":
@@ -208,10 +262,48 @@ class PairQuadrature:
         renumber = np.cumsum(keep) - 1
         pair = renumber[self.pair[points]]
         counts = np.bincount(pair, minlength=int(keep.sum()))
+        blocks, flat_rows = [], []
+        first = 0
+        flat_at = 0
+        for f, n, Q, lag in self.blocks:
+            k = keep[f:f + n]
+            m = int(k.sum())
+            if lag is None:
+                s0, s1 = self._points_of(f, n)
+                flat_rows.append(self.lag[flat_at:flat_at + (s1 - s0)][points[s0:s1]])
+                flat_at += s1 - s0
+                if m:
+                    blocks.append((first, m, 0, None))
+            elif m:
+                blocks.append((first, m, Q, lag if lag.ndim == 2 else lag[k]))
+            first += m
+        flat = np.concatenate(flat_rows) if flat_rows else np.empty((0, self.lag.shape[1]))
         return PairQuadrature(
             self.target[keep], self.panel[keep], pair, np.cumsum(counts) - counts, self.u[points], self.a[points],
-            self.b[points], self.lag[points], None if self.target_u is None else self.target_u[keep],
+            self.b[points], flat, None if self.target_u is None else self.target_u[keep], tuple(blocks),
         )
+
+    def _points_of(self, f: int, n: int) -> tuple[int, int]:
+        """First and past-the-last point of the pairs f .. f + n - 1."""
+        return int(self.starts[f]), int(self.starts[f + n]) if f + n < len(self.starts) else self.u.size
+
+    def _reduce(self, wk: np.ndarray) -> np.ndarray:
+        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
+        out = np.empty((len(self.target), self.lag.shape[1]))
+        flat_at = 0
+        blocks = self.blocks or (((0, len(self.target), 0, None),) if len(self.target) else ())  # all rows flat
+        for f, n, Q, lag in blocks:
+            s0 = self.starts[f]
+            if lag is None:
+                s1 = self._points_of(f, n)[1]
+                rows = self.lag[flat_at:flat_at + (s1 - s0)]
+                flat_at += s1 - s0
+                out[f:f + n] = np.add.reduceat(wk[s0:s1, None] * rows, self.starts[f:f + n] - s0, axis=0)
+            elif lag.ndim == 2:
+                out[f:f + n] = wk[s0:s0 + n * Q].reshape(n, Q) @ lag
+            else:
+                out[f:f + n] = np.matmul(wk[s0:s0 + n * Q].reshape(n, 1, Q), lag)[:, 0, :]
+        return out
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
@@ -243,7 +335,7 @@ class PairQuadrature:
                 wk = (self.a * K + self.b * Q) * J
             else:
                 wk = self.a * ker * J
-            out.append(np.add.reduceat(wk[:, None] * self.lag, self.starts, axis=0))
+            out.append(self._reduce(wk))
         return out
 
 
@@ -483,10 +575,15 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     xt, rt = X[:N], R[:N]
 
     def dense(rows, cols):
-        with np.errstate(divide="ignore", invalid="ignore"):
-            S, D = single_double(xt[rows, None], rt[rows, None], X[None, cols], R[None, cols], NX[None, cols], NR[None, cols])
-        S *= W[None, cols]
-        D *= W[None, cols]
+        xr, rr = xt[rows], rt[rows]
+        xc, rc, nxc, nrc, wc = X[cols], R[cols], NX[cols], NR[cols], W[cols]
+        S, D = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
+        step = max(1, DENSE_CHUNK // max(xc.size, 1))
+        for a in range(0, xr.size, step):  # row blocks: temporaries stay small (see DENSE_CHUNK)
+            with np.errstate(divide="ignore", invalid="ignore"):
+                S[a:a + step], D[a:a + step] = single_double(xr[a:a + step, None], rr[a:a + step, None], xc, rc, nxc, nrc)
+        S *= wc
+        D *= wc
         return S, D
 
     if plan.fixed is None:
@@ -539,26 +636,20 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
     g, gw = gauss_legendre(n)
     g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
     t01, tw01 = gauss_log(n)
-    out = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
-    for uq in uq_all:
-        su, sw, swl, lu, lw, fu, fw = ([] for _ in range(7))
-        for h, sign, lev in ((1.0 - uq, 1.0, lev_right), (1.0 + uq, -1.0, lev_left)):
-            inner = h * 2.0**-lev
-            su.append(uq + sign * inner * g01)
-            sw.append(inner * gw01)
-            swl.append(-math.log(inner) * inner * gw01)
-            lu.append(uq + sign * inner * t01)
-            lw.append(inner * tw01)
-            for k in range(lev, 0, -1):
-                a = h * 2.0**-k
-                fu.append(uq + sign * (a + a * g01))
-                fw.append(a * gw01)
-        for key, parts in zip(out, (su, sw, swl, lu, lw, fu, fw)):
-            out[key].append(np.concatenate(parts) if parts else np.empty(0))
-    table = {k: np.array(v) for k, v in out.items()}
-    if table["fu"].ndim == 1:  # no outer pieces
-        table["fu"] = np.empty((p, 0))
-        table["fw"] = np.empty((p, 0))
+    uq = uq_all[:, None]
+    parts = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
+    for h, sign, lev in ((1.0 - uq_all, 1.0, lev_right), (1.0 + uq_all, -1.0, lev_left)):  # all nodes at once
+        inner = (h * 2.0**-lev)[:, None]
+        neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
+        parts["su"].append(uq + sign * inner * g01)
+        parts["sw"].append(inner * gw01)
+        parts["swl"].append(neglog * inner * gw01)
+        parts["lu"].append(uq + sign * inner * t01)
+        parts["lw"].append(inner * tw01)
+        a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
+        parts["fu"].append((uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1))
+        parts["fw"].append((a * gw01).reshape(p, -1))
+    table = {k: np.concatenate(v, axis=1) for k, v in parts.items()}
     table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
     return table
 

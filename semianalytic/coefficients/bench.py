@@ -39,7 +39,14 @@ def add_arguments(parser) -> None:
     parser.add_argument("--corners", action="store_true", help="only the cornered-nose study: bem_corners.md/.png (issue 10)")
     parser.add_argument("--baseline-python", default=None, metavar="PYTHON",
                         help="interpreter of another checkout (e.g. main's .venv/bin/python): its certified Fig. 5 "
-                             "ogive table is timed interleaved with this one's, and the ratio reported")
+                             "ogive table (and the cone's and the table nose's) is timed interleaved with this one's, "
+                             "and the ratio reported")
+    parser.add_argument("--reach", action="store_true",
+                        help="only the study of --tolerance 1e-8 tables (issue 24): the five study noses, each checked "
+                             "at 1000 random depths against direct solves; writes bench_tables_1e8.md (minutes)")
+    parser.add_argument("--baseline-only", action="store_true",
+                        help="with --baseline-python: only that comparison, rewritten in place as its section of "
+                             "an existing bench_bem.md in --out (the other sections are kept)")
 
 
 def _best_time(fn, repeats: int) -> float:
@@ -235,14 +242,17 @@ def _table_studies(quick: bool):
 
 
 _TIMING_SNIPPET = """
-import time, scipy.interpolate, scipy.linalg, scipy.special
-from semianalytic.geometry import ogive_nose
+import sys, time, scipy.interpolate, scipy.linalg, scipy.special
+from semianalytic.coefficients.study import study_nose
 from semianalytic.coefficients.table import coefficient_table
-nose = ogive_nose(7.11e-3, 3.0)
+nose = study_nose(sys.argv[1])
 t, c = time.perf_counter(), time.process_time()
 tab = coefficient_table(nose, tolerance=1e-5)
 print(time.perf_counter() - t, time.process_time() - c, len(tab.depth))
 """
+
+INTERLEAVED_NOSES = ("ogive", "cone", "table")  # issue 24: the ogive 4x faster; cone and table at most 2x the ogive
+INTERLEAVED_TITLE = "## Certified Fig. 5 ogive table against the code before it (issue 24)"
 
 
 def _revision(python: str) -> str:
@@ -260,51 +270,121 @@ def _revision(python: str) -> str:
     return (rev or "unknown") + ("+dirty" if dirty else "")
 
 
-def interleaved_ratio(baseline_python: str, repeats: int = 5) -> dict:
-    """The certified Fig. 5 ogive table (tolerance 1e-5) built by this checkout and by a baseline
-    interpreter alternately, each in a fresh process with one BLAS thread: best wall and CPU times,
-    knots, and the load average before and after (the machine is shared: only the ratio compares)."""
+def interleaved_ratio(baseline_python: str, repeats: int = 5, noses=INTERLEAVED_NOSES) -> dict:
+    """The certified tables (tolerance 1e-5) of the study noses (the Fig. 5 ogive first) built by
+    this checkout and by a baseline interpreter alternately, each in a fresh process with one
+    BLAS thread: best wall and CPU times and knots per nose and side, and the load average
+    before and after (the machine is shared: only ratios compare)."""
     import os
     import subprocess
     import sys
 
     env = dict(os.environ, OPENBLAS_NUM_THREADS="1", OMP_NUM_THREADS="1", MKL_NUM_THREADS="1")
-    best = {"this": [math.inf, math.inf, 0], "baseline": [math.inf, math.inf, 0]}
+    best = {(name, kind): [math.inf, math.inf, 0] for name in ("this", "baseline") for kind in noses}
     import tempfile
 
     load0 = os.getloadavg()
     for _ in range(repeats):
-        for name, py in (("baseline", baseline_python), ("this", sys.executable)):
-            with tempfile.TemporaryDirectory() as neutral:  # `python -c` imports from its working folder first
-                out = subprocess.run([py, "-c", _TIMING_SNIPPET], capture_output=True, text=True, env=env, timeout=900,
-                                     cwd=neutral)
-            if out.returncode:
-                raise InputError("--baseline-python", f"the baseline run failed: {out.stderr.strip().splitlines()[-1:]}")
-            wall, cpu, knots = out.stdout.split()
-            b = best[name]
-            b[0], b[1], b[2] = min(b[0], float(wall)), min(b[1], float(cpu)), int(knots)
-    return {"best": best, "load": (load0, os.getloadavg()), "repeats": repeats,
+        for kind in noses:
+            for name, py in (("baseline", baseline_python), ("this", sys.executable)):
+                with tempfile.TemporaryDirectory() as neutral:  # `python -c` imports from its working folder first
+                    out = subprocess.run([py, "-c", _TIMING_SNIPPET, kind], capture_output=True, text=True, env=env,
+                                         timeout=900, cwd=neutral)
+                if out.returncode:
+                    raise InputError("--baseline-python", f"the baseline run failed: {out.stderr.strip().splitlines()[-1:]}")
+                wall, cpu, knots = out.stdout.split()
+                b = best[(name, kind)]
+                b[0], b[1], b[2] = min(b[0], float(wall)), min(b[1], float(cpu)), int(knots)
+    return {"best": best, "noses": tuple(noses), "load": (load0, os.getloadavg()), "repeats": repeats,
             "revisions": {"this": _revision(sys.executable), "baseline": _revision(baseline_python)}}
 
 
-def _append_interleaved(path: Path, r: dict) -> list[Path]:
-    """A section of bench_bem.md: this checkout's certified ogive table against a baseline's."""
+def interleaved_section(r: dict, only: bool = True) -> list[str]:
+    """Lines of the section of bench_bem.md: this checkout's certified tables against a baseline's."""
+    (l0, l1) = r["load"]
+    best, rev = r["best"], r["revisions"]
+    lines = ["", INTERLEAVED_TITLE, "",
+             "Generated by `python -m semianalytic bench-bem --out reports --force --baseline-python "
+             "BASELINE/.venv/bin/python" + (" --baseline-only" if only else "") + "` (BASELINE: a checkout of the code before, revision "
+             f"{rev['baseline']}). Each side built each certified table (tolerance 1e-5, default options) in a fresh "
+             f"process, one BLAS thread, alternately, {r['repeats']} times; best of each. Load average (1, 5, 15 min) "
+             f"{l0[0]:.1f}, {l0[1]:.1f}, {l0[2]:.1f} before and {l1[0]:.1f}, {l1[1]:.1f}, {l1[2]:.1f} after, on a "
+             "2-core machine shared with other jobs: the absolute times are inflated by the load, the ratios are the "
+             "comparable numbers.", "",
+             "| nose | knots before | knots after | before wall [s] | after wall [s] | before CPU [s] | after CPU [s] "
+             "| ratio wall | ratio CPU | after / ogive after (CPU) |",
+             "|---|---|---|---|---|---|---|---|---|---|"]
+    ogive = best[("this", r["noses"][0])]
+    for kind in r["noses"]:
+        b, t = best[("baseline", kind)], best[("this", kind)]
+        lines.append(f"| {kind} | {b[2]} | {t[2]} | {b[0]:.2f} | {t[0]:.2f} | {b[1]:.2f} | {t[1]:.2f} | "
+                     f"{b[0] / t[0]:.2f} | {b[1] / t[1]:.2f} | {t[1] / ogive[1]:.2f} |")
+    b, t = best[("baseline", "ogive")], best[("this", "ogive")]
+    lines += ["", f"Revisions: before {rev['baseline']}, after {rev['this']}. Fig. 5 ogive: before/after "
+              f"{b[0] / t[0]:.2f} in wall time, {b[1] / t[1]:.2f} in CPU time (issue 24's target: at least 4, same "
+              "knots); cone and table nose against the ogive, after: issue 24's target at most 2."]
+    return lines
+
+
+def _append_interleaved(path: Path, r: dict, only: bool = True) -> list[Path]:
+    """The section of bench_bem.md with this checkout's certified tables against a baseline's,
+    appended, or replacing the section of an earlier run."""
     from semianalytic.io import atomic_write_text
 
-    b, t = r["best"]["baseline"], r["best"]["this"]
-    (l0, l1) = r["load"]
-    lines = ["", "## Certified Fig. 5 ogive table against the code before it (issue 24)", "",
-             f"Each side built the certified table (tolerance 1e-5) in a fresh process, one BLAS thread, alternately, "
-             f"{r['repeats']} times; best of each. Load average (1, 5, 15 min) {l0[0]:.1f}, {l0[1]:.1f}, {l0[2]:.1f} "
-             f"before and {l1[0]:.1f}, {l1[1]:.1f}, {l1[2]:.1f} after, on a 2-core machine shared with other jobs: "
-             "the absolute times are inflated by the load, the ratio is the comparable number.", "",
-             "| code | revision | knots | wall [s] | CPU [s] |", "|---|---|---|---|---|",
-             f"| before (baseline) | {r['revisions']['baseline']} | {b[2]} | {b[0]:.2f} | {b[1]:.2f} |",
-             f"| after (this) | {r['revisions']['this']} | {t[2]} | {t[0]:.2f} | {t[1]:.2f} |", "",
-             f"Ratio before/after: {b[0] / t[0]:.2f} in wall time, {b[1] / t[1]:.2f} in CPU time "
-             "(issue 24's target: at least 4, same knots)."]
-    text = path.read_text() + "\n".join(lines) + "\n"
+    text = path.read_text()
+    at = text.find("\n" + INTERLEAVED_TITLE)
+    if at >= 0:
+        nxt = text.find("\n## ", at + 1)
+        text = text[:at] + (text[nxt:] if nxt >= 0 else "\n")
+    text = text.rstrip("\n") + "\n" + "\n".join(interleaved_section(r, only)) + "\n"
     return [atomic_write_text(path, text, overwrite=True)]
+
+
+def write_reach_report(out_dir: Path, force: bool, quick: bool = False) -> list[Path]:
+    """``bench_tables_1e8.md``: issue 24's tight tables (tolerance 1e-8, default options) of the
+    five study noses, each checked at 1000 random depths against direct solves."""
+    import os
+    import sys
+
+    from semianalytic.coefficients.study import STUDY_NOSES, reach_study
+    from semianalytic.coefficients.table import CONTROLLED
+    from semianalytic.io import atomic_write_text
+    from semianalytic.report.document import Document, to_markdown
+
+    path = out_dir / "bench_tables_1e8.md"
+    if path.exists() and not force:
+        raise InputError("--out", f"{path.name} exists in {str(out_dir)!r}; pass --force to overwrite the reports")
+    n = 30 if quick else 1000
+    revision = _revision(sys.executable)  # before the run (edits while it runs are not its code)
+    load0 = os.getloadavg()
+    rows = [reach_study(kind, 1e-8, n) for kind in (("sphere",) if quick else STUDY_NOSES)]
+    load1 = os.getloadavg()
+    doc = Document("Certified tables at tolerance 1e-8 (issue 24)")
+    doc.para(
+        f"Generated by `python -m semianalytic bench-bem --out reports --force --reach{' --quick' if quick else ''}` "
+        f"(revision {revision}). Each nose's table is built with `--tolerance 1e-8` and the default options "
+        "(the depth range extends itself as far as the deep limit needs) and checked against direct BEM solves at "
+        f"{n} seeded random depths (a third in 0.9-1.3 L_h, the rest log-uniform from 1e-6 to 300 nose lengths: "
+        "below the first knot and in the extrapolated deep piece too). 'bounded' counts the depths where the "
+        "table's error estimate is at least the actual error; 'estimate/error' is the smallest ratio over the depths "
+        "(>= 1: every estimate bounds its error); errors are relative to the coefficient's largest magnitude (a "
+        f"nose whose errors exceed the tolerance has noise-limited intervals, whose estimates are their discrepancies). CPU times on a shared 2-core machine, load average (1, 5, 15 min) {load0[0]:.1f}, {load0[1]:.1f}, "
+        f"{load0[2]:.1f} before and {load1[0]:.1f}, {load1[1]:.1f}, {load1[2]:.1f} after. The same check is the slow "
+        "test `tests/test_tables_speed_and_reach.py::test_tolerance_1e8_with_the_defaults_bounds_1000_random_depths`.")
+    doc.table(("nose", "knots", "deepest solve [nose lengths]", "noise-limited intervals", "table CPU [s]",
+               "check CPU [s]", "coefficient with the smallest estimate/error", "bounded", "estimate/error (smallest)",
+               "largest error of any coefficient"),
+              [(r["nose"], r["knots"], f"{r['max_depth_nose_lengths']:.4g}", r["noise_limited"], f"{r['cpu_table_s']:.1f}",
+                f"{r['cpu_check_s']:.1f}", w, f"{r['study'][w]['bounded']}/{r['study'][w]['n']}",
+                f"{r['study'][w]['min_estimate_ratio']:.3g}", f"{max(r['study'][q]['max_rel_error'] for q in CONTROLLED):.1e}")
+               for r in rows for w in [min(CONTROLLED, key=lambda q: r["study"][q]["min_estimate_ratio"])]])
+    doc.heading("Per coefficient")
+    doc.table(("nose", "coefficient", "bounded", "estimate/error (smallest)", "error (largest, relative)"),
+              [(r["nose"], q, f"{r['study'][q]['bounded']}/{r['study'][q]['n']}", f"{r['study'][q]['min_estimate_ratio']:.3g}",
+                f"{r['study'][q]['max_rel_error']:.1e}") for r in rows for q in CONTROLLED])
+    ok = all(r["study"][q]["bounded"] == r["study"][q]["n"] for r in rows for q in CONTROLLED)
+    doc.para("**Every estimate bounds its off-knot error:** " + ("yes." if ok else "no (see the rows with bounded < n)."))
+    return [atomic_write_text(path, to_markdown(doc), overwrite=True)]
 
 
 def _append_certified(path: Path, certified) -> list[Path]:
@@ -334,6 +414,20 @@ def run(args) -> int:
         from semianalytic.coefficients.corners_report import run_corners
 
         return run_corners(out, args.force, args.quick)
+    if getattr(args, "reach", False):
+        for p in write_reach_report(out, args.force, args.quick):
+            print(f"wrote {p}")
+        return 0
+    if getattr(args, "baseline_only", False):
+        if not getattr(args, "baseline_python", None):
+            raise InputError("--baseline-only", "needs --baseline-python (the interpreter of the checkout to compare with)")
+        if not (out / "bench_bem.md").is_file():
+            raise InputError("--out", f"no bench_bem.md in {str(out)!r} to add the comparison to; run bench-bem without "
+                                      "--baseline-only first")
+        written = _append_interleaved(out / "bench_bem.md", interleaved_ratio(args.baseline_python, 2 if args.quick else 5))
+        for p in written:
+            print(f"wrote {p}")
+        return 0
     names = ["bench_bem.md", "bem_convergence.md", "bem_convergence.png", "bem_coefficients.md"]
     existing = [n for n in names if (out / n).exists()]
     if existing and not args.force:
@@ -353,7 +447,8 @@ def run(args) -> int:
     study, contact, certified = _table_studies(args.quick)
     written += _append_certified(out / "bench_bem.md", certified)
     if getattr(args, "baseline_python", None):
-        written += _append_interleaved(out / "bench_bem.md", interleaved_ratio(args.baseline_python, 2 if args.quick else 5))
+        written += _append_interleaved(out / "bench_bem.md", interleaved_ratio(args.baseline_python, 2 if args.quick else 5),
+                                       only=False)
     written += write_coefficients_report(out, n_depths=16 if args.quick else None, table_study=study, contact=contact)
     for p in written:
         print(f"wrote {p}")

@@ -11,7 +11,8 @@ import time
 
 import numpy as np
 
-__all__ = ["STUDY_NOSES", "study_nose", "random_depths", "table_error_study", "certified_timing", "contact_effect"]
+__all__ = ["STUDY_NOSES", "study_nose", "random_depths", "table_error_study", "certified_timing", "contact_effect",
+           "reach_depths", "reach_study"]
 
 
 def study_nose(kind: str, diameter: float = 7.11e-3):
@@ -68,6 +69,38 @@ def table_error_study(nose, table, depths) -> dict:
             "n": len(depths),
         }
     return out
+
+
+def reach_depths(nose, n: int = 1000, seed: int = 1000) -> np.ndarray:
+    """Issue 24's check of tight tables: n seeded random depths, a third in 0.9-1.3 L_h, the rest
+    log-uniform from 1e-6 to 300 nose lengths (below the first knot and past the default range too)."""
+    rng = np.random.default_rng(seed)
+    L = nose.depth_unit
+    k = n // 3
+    return np.sort(np.concatenate([rng.uniform(0.9, 1.3, k) * L,
+                                   np.exp(rng.uniform(math.log(1e-6), math.log(300.0), n - k)) * L]))
+
+
+def reach_study(kind: str, tolerance: float = 1e-8, n: int = 1000, seed: int = 1000) -> dict:
+    """A certified table of a study nose at ``tolerance`` with the default options (the depth
+    range extending itself as the deep limit needs), and :func:`table_error_study` at
+    :func:`reach_depths`: knots, solves' time, whether the range extended, noise-limited
+    intervals, and per coefficient the largest error and the smallest estimate/error ratio."""
+    import warnings
+
+    from semianalytic.coefficients.table import coefficient_table
+
+    nose = study_nose(kind)
+    t = time.process_time()
+    with warnings.catch_warnings():
+        warnings.simplefilter("ignore")  # the range extending itself warns; recorded below
+        table = coefficient_table(nose, tolerance=tolerance)
+    build = time.process_time() - t
+    t = time.process_time()
+    study = table_error_study(nose, table, reach_depths(nose, n, seed))
+    return {"nose": kind, "knots": len(table.depth), "cpu_table_s": build, "cpu_check_s": time.process_time() - t,
+            "max_depth_nose_lengths": table.options.get("max_depth_nose_lengths", 300.0),
+            "noise_limited": table.options.get("noise_limited_intervals", 0), "study": study}
 
 
 def certified_timing(kind: str, repeats: int = 2, tolerance: float = 1e-5) -> dict:

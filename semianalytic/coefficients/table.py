@@ -352,6 +352,14 @@ def _coef6(f, v0: float, fallback: float) -> list:
     return [float(f(v0, nu=i)) / math.factorial(i) for i in range(5, -1, -1)]
 
 
+def _coef6_all(f, v0: np.ndarray, fallback: float) -> list:
+    """:func:`_coef6` at every v0 at once (one evaluation per derivative order: the same numbers)."""
+    if f is None:
+        return [[0.0] * 5 + [fallback] for _ in v0]
+    cols = [np.asarray(f(v0, nu=i), float) / math.factorial(i) for i in range(5, -1, -1)]
+    return [[float(c[k]) for c in cols] for k in range(len(v0))]
+
+
 @dataclass
 class _PieceKnots:
     """Knots of one piece while the table is built (v ascending)."""
@@ -913,6 +921,7 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
         sp = pk.splines()
         deep = p.kind == "deep"
         order = range(len(v) - 1)
+        taylor = {q: _coef6_all(sp[q], v[:-1], pk.rows[0][q]) for q in INTERPOLATED}
         for k in order:
             a, b = v[k], v[k + 1]
             P_lo = float(p.P(b)) if deep else float(p.P(a))
@@ -924,7 +933,7 @@ def assemble_table(nose, knots, kinks, limit_err, bem_err, options, tolerance) -
                     errs[q].append(shallow[q])
             rows.append({"P_lo": P_lo, "kind": _KINDS[p.kind], "scale": p.scale, "v0": float(a),
                          "origin": p.origin, "power": p.power,
-                         **{f"coef_{q}": _coef6(sp[q], float(a), pk.rows[0][q]) for q in INTERPOLATED}})
+                         **{f"coef_{q}": taylor[q][k] for q in INTERPOLATED}})
             e = pk.err.get((float(a), float(b)), {})
             for q in INTERPOLATED:
                 extra = limit_err.get(q, 0.0) if deep else 0.0
@@ -1015,7 +1024,13 @@ def coefficient_table(
         from tqdm import tqdm
 
         bar = tqdm(desc="BEM depths", unit="depth", leave=False)
+    import contextlib
+
+    from semianalytic.bem.solve import _single_threaded_blas
+
+    blas = contextlib.ExitStack()
     try:
+        blas.enter_context(_single_threaded_blas())  # once for all the table's solves
         b = _Builder(nose, opts, tol, P_max, bar)
         options = {"order": order, "refinement": refinement, "levels": levels}
         if depths is None and n_depths is not None:
@@ -1039,6 +1054,7 @@ def coefficient_table(
         bem_err = b.bem_errors() if bem_error else {}
         return b.table(options, bem_err)
     finally:
+        blas.close()
         if bar is not None:
             bar.close()
 
