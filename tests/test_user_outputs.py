@@ -63,7 +63,7 @@ def test_wrong_choice_lists_the_valid_ones_in_the_projects_words(tmp_path):
 def test_wrong_nose_and_unknown_section(tmp_path):
     case = _case_with(tmp_path, 'nose = "ogive"', 'nose = "ogiv"')
     line = _run(["semianalytic", "penetrate", str(case)], tmp_path).stderr.strip()
-    assert line.startswith("error: projectile.nose: 'ogiv' is not one of ogive, sphere, cone, flat, table, power; "
+    assert line.startswith("error: projectile.nose: 'ogiv' is not one of ogive, sphere, cone, flat, table, power, spline; "
                            "did you mean 'ogive'?"), line
     case = _case_with(tmp_path, "[impact]", "[impakt]")
     line = _run(["semianalytic", "penetrate", str(case)], tmp_path).stderr.strip()
