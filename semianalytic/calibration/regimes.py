@@ -1,20 +1,24 @@
 """The whole-range regime model, its posterior and its transfer between projectile materials.
 
-Model (per shot i of striking velocity U_i, mass m_i, Rockwell C hardness H_i; one calibrated
-constant, the dynamic factor f, and the discrepancy sigma):
+Model (per shot i of striking velocity U_i, mass m_i, Rockwell C hardness H_i; calibrated: the
+dynamic factor f, with ``deforming = "two_stage"`` (the default) the breakup factor b, the
+discrepancy sigma and the transition scatter tau):
 
 * projectile dynamic yield stress Y_p,i = f sigma_y(H_i) (ASTM E140 + Pavlina & Van Tyne 2008,
   :mod:`semianalytic.penetration.hardness`);
 * rigid -> deforming at U_y,i by the criterion ``onset`` (:data:`.regime.ONSET_CRITERIA`: Tate's
-  (1967) tip pressure against Tabor's (1951) constrained yield stress 3 Y_p,i, the default, or
-  U_sC(Y_p,i) of Part I, eqs. (33)/(36), shot's mass);
+  (1967) tip pressure against the rod's static Meyer hardness H_M(H_i), the default, with no fitted
+  constant; against Tabor's (1951) constrained yield stress 3 Y_p,i; or U_sC(Y_p,i) of Part I,
+  eqs. (33)/(36), shot's mass);
 * deforming -> eroding at U_e,i by the criterion ``erosion`` (:data:`.regime.EROSION_CRITERIA`:
   the same tip pressure against 3 f sigma_u(H_i), the default, Tate's flat-rod criterion, or
   this project's nose-length rule);
 * depth: Part I (elastic projectile, exact-rod W2) when rigid; the Alekseevskii-Tate rod with
   R_t from ``resistance`` (:data:`.regime.RESISTANCE_RELATIONS`: Part I eq. (16) or Tate 1986) and
   the rod strength ``rod_strength`` (Y_p,i or, the default, f sigma_u(H_i)) when eroding; in the
-  deforming band the model ``deforming`` (:data:`.regime.DEFORMING_MODELS`; default: the eroding rod);
+  deforming band the model ``deforming`` (:data:`.regime.DEFORMING_MODELS`; default ``two_stage``:
+  the Part I depth of a bent rod that keeps its nose until the tip pressure reaches b H_M, the
+  eroding rod's beyond -- this project's own, with b fitted);
 * ln P_i = ln D_i(f) + eps_i, eps_i ~ N(0, sigma^2); and the recorded response of each shot
   matches the predicted regime with probability 1 - epsilon (:data:`LABEL_ERROR`).
 

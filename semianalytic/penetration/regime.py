@@ -279,7 +279,11 @@ shank reaches Y_p).  ``tate_tip``: Tate's criterion (Tate 1967, J. Mech. Phys. S
 a rod deforms and erodes once the interface pressure (1/2) rho_t U^2 + R_t exceeds its strength)
 applied to the nose tip, whose strength as a constrained indenter is C Y_p (Tabor 1951,
 C = 3): U_y = sqrt(2 (C Y_p - R_t)/rho_t).  The combination (Tate's pressure against Tabor's
-constrained strength of the tip) is this project's reading of the two published relations."""
+constrained strength of the tip) is this project's reading of the two published relations.
+``meyer_tip`` (the default, chosen by transfer): the same pressure against the rod's static Meyer
+hardness H_M (:func:`.hardness.meyer_hardness_from_vickers`), the mean pressure at which the tip
+indents plastically (Tabor 1951): U_y = sqrt(2 (H_M - R_t)/rho_t), no fitted constant; again this
+project's reading of Tate's and Tabor's relations."""
 
 EROSION_CRITERIA = ("tate", "tate_tip_uts", "nose_length")
 """Deforming -> eroding.  ``tate`` (published): Tate (1967): a flat-ended rod of strength Y_p
@@ -301,7 +305,9 @@ ROD_STRENGTHS = ("yield", "ultimate")
 the ultimate strength (a flow stress at the large strains of an eroding nose) from the hardness."""
 
 DEFORMING_MODELS = ("part1_upper", "eroding", "breakup", "two_stage")
-"""Depth in the deforming band: ``part1_upper`` (this project's own reading: the Part I depth of a
+"""Depth in the deforming band (``two_stage``, the default: the Part I depth of a bent rod that
+keeps its nose until the tip pressure reaches b H_M, the eroding rod's beyond; b fitted, this
+project's own, :data:`DEFAULT_BREAKUP_FACTOR`): ``part1_upper`` (this project's own reading: the Part I depth of a
 nose that keeps its shape, an upper bound); ``eroding`` (the Alekseevskii-Tate rod with its
 rigid-rod phase, Tate 1967 / Part IV eqs. (2)-(3), which covers a rod that erodes while it
 decelerates and penetrates rigidly below v_e); ``breakup`` (this project's own combination of
