@@ -87,4 +87,4 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic optimize cases/optimize_power_into_fig15a.toml --report reports/optimize_constrained_power.md --force --vary projectile.exponent=0.3:1 --objective depth --constraint mass --constraint length --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_spline_into_fig15a.toml --report reports/optimize_constrained_spline.md --force --vary projectile.control_radii.0=0.3:0.6 --vary projectile.control_radii.1=0.5:0.8 --vary projectile.control_radii.2=0.7:0.95 --objective depth --constraint mass --constraint length --method de --popsize 6 --maxiter 30 --confirm 3 --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_power_deep_drag.toml --report reports/optimize_power.md --force --vary projectile.exponent=0.3:1 --objective deep_drag --scheduler inline --no-progress
-	$(PY) -m semianalytic.optimize.bench
+	$(PY) -m semianalytic.optimize.bench --force

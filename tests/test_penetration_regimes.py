@@ -305,7 +305,7 @@ def test_default_regime_rule_is_meyer(tmp_path, capsys, nose, keys):
     U_y = math.sqrt(2.0 * (H_M - R) / rho_t)
     U_b = math.sqrt(2.0 * (1.15 * H_M - R) / rho_t)
     U_e = math.sqrt(2.0 * (3.0 * 1.5e6 * (3.734 * HV - 99.8) - R) / rho_t)
-    assert res["regime_rule"] == "meyer"
+    assert res["regime_rule"] == "meyer" and res["breakup_factor"] == 1.15
     assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
     assert res["breakup_velocity_m_s"] == pytest.approx(min(U_b, U_e), rel=1e-12)
     assert res["erosion_velocity_m_s"] == pytest.approx(U_e, rel=1e-12)

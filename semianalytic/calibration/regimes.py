@@ -208,7 +208,7 @@ def model_outcome(f, shots: RegimeShots, opt: Options, b=None):
         if b is None:
             raise ValueError("deforming = 'two_stage' needs breakup factors b")
         bb = np.broadcast_to(np.atleast_1d(np.asarray(b, float)), f.shape)
-        Ux = np.clip(rg.tate_erosion_velocity(bb[:, None] * shots.meyer_hardness[None, :], R1, rho_t), Uy, Ue)
+        Ux = rg.breakup_velocity(bb[:, None], shots.meyer_hardness[None, :], R1, rho_t, Uy, Ue)
     else:
         raise ValueError(f"unknown deforming-band model {opt.deforming!r}")
     depth = np.where(shots.velocity[None, :] >= Ux, eroding, part1)
@@ -267,25 +267,38 @@ TAU_PRIOR_SCALE = 0.1
 _TAU_GRID = np.exp(np.linspace(np.log(0.003), np.log(0.4), 24))
 
 
+def _state_weights(shots: RegimeShots, out: Thresholds, tau) -> list:
+    """Per state (rigid; deforming, Part I depth; deforming, eroding depth; eroding) the probability
+    of the state (:func:`state_probabilities`, transition scatter ``tau`` per row) times the
+    probability of the recorded response given the state (right with 1 - epsilon, :data:`LABEL_ERROR`)."""
+    rec = shots.recorded[None, :]
+    probs = state_probabilities(shots.velocity, out, tau)
+    return [p * np.where(rec < 0, 1.0, np.where(rec == lab, 1.0 - LABEL_ERROR, 0.5 * LABEL_ERROR))
+            for p, lab in zip(probs, (0, 1, 1, 2))]
+
+
+def _loglik_from_weights(shots: RegimeShots, out: Thresholds, w: list, sig_r, sig_d):
+    """ln p(depths, responses) per row from the state weights ``w`` (:func:`_state_weights`): each
+    measured depth log-normal about its state's depth (Part I for the first two states, the
+    eroding rod for the last two), sigma ``sig_r`` in the rigid state and ``sig_d`` in the others
+    (scalars or (rows, 1)); a shot without a depth contributes its response only."""
+    has_d = np.isfinite(shots.depth)
+    lnP = np.log(np.where(has_d, shots.depth, 1.0))[None, :]
+
+    def dens(D, sg):
+        r = lnP - np.log(D)
+        return np.where(has_d[None, :], np.exp(-0.5 * (r / sg) ** 2) / sg, 1.0)
+
+    total = w[0] * dens(out.part1, sig_r) + w[1] * dens(out.part1, sig_d) + (w[2] + w[3]) * dens(out.eroding, sig_d)
+    return np.sum(np.log(np.maximum(total, 1e-300)), axis=1)
+
+
 def _log_likelihood(shots: RegimeShots, out: Thresholds, sigma, tau):
     """ln p(depths, responses | f, sigma, tau) per row (out rows match sigma and tau rows, or
     broadcast): over the four states of :func:`state_probabilities`, each response and depth
-    jointly (depth log-normal about the state's depth, response right with 1 - epsilon).  ``sigma``
-    (rows,) is shared by the states; (rows, 2) is (rigid state, deformed states)."""
+    jointly.  ``sigma`` (rows,) is shared by the states; (rows, 2) is (rigid state, deformed states)."""
     sp = _sigma_pair(sigma)
-    probs = state_probabilities(shots.velocity, out, tau)
-    labels = (0, 1, 1, 2)
-    has_d = np.isfinite(shots.depth)
-    lnP = np.log(np.where(has_d, shots.depth, 1.0))[None, :]
-    total = 0.0
-    for st, (p, lab, D) in enumerate(zip(probs, labels, (out.part1, out.part1, out.eroding, out.eroding))):
-        sig = sp[:, 0:1] if st == 0 else sp[:, 1:2]
-        r = lnP - np.log(D)
-        dens = np.where(has_d[None, :], np.exp(-0.5 * (r / sig) ** 2) / sig, 1.0)
-        lab_p = np.where(shots.recorded[None, :] < 0, 1.0,
-                         np.where(shots.recorded[None, :] == lab, 1.0 - LABEL_ERROR, 0.5 * LABEL_ERROR))
-        total = total + p * dens * lab_p
-    return np.sum(np.log(np.maximum(total, 1e-300)), axis=1)
+    return _loglik_from_weights(shots, out, _state_weights(shots, out, tau), sp[:, 0:1], sp[:, 1:2])
 
 
 BREAKUP_PRIOR = (1.0, 3.0)
@@ -312,32 +325,17 @@ def _sigma_pair(sigma):
 
 def _grid_loglik(shots: RegimeShots, out: Thresholds, sig_r, sig_d, tau):
     """ln p(data | row, sigma_r[i], sigma_d[j], tau_k) for every grid row: (rows, n_r, n_d, n_tau);
-    ``sig_d = None``: one sigma shared by every state (n_d = 1).  The state densities are computed
-    once per sigma and the state probabilities once per tau (:func:`_log_likelihood` is the same sum
-    for one (sigma, tau) per row)."""
-    has_d = np.isfinite(shots.depth)
-    lnP = np.log(np.where(has_d, shots.depth, 1.0))[None, :]
-    labels = (0, 1, 1, 2)
-    lab_p = [np.where(shots.recorded[None, :] < 0, 1.0, np.where(shots.recorded[None, :] == lab, 1.0 - LABEL_ERROR,
-                                                                 0.5 * LABEL_ERROR)) for lab in labels]
-    rp, re = lnP - np.log(out.part1), lnP - np.log(out.eroding)
-
-    def dens(r, sg):
-        return np.where(has_d[None, :], np.exp(-0.5 * (r / sg) ** 2) / sg, 1.0)
-
+    ``sig_d = None``: one sigma shared by every state (n_d = 1).  The same sum as
+    :func:`_log_likelihood`, with the state weights computed once per tau."""
     rows = out.Uy.shape[0]
     shared = sig_d is None
     nd = 1 if shared else len(sig_d)
     lp = np.empty((rows, len(sig_r), nd, len(tau)))
     for k, t in enumerate(tau):
-        probs = state_probabilities(shots.velocity, out, np.full(rows, t))
-        w = [p * lab for p, lab in zip(probs, lab_p)]
+        w = _state_weights(shots, out, np.full(rows, t))
         for i, sr in enumerate(sig_r):
-            rig = w[0] * dens(rp, sr)
             for j in range(nd):
-                sd = sr if shared else sig_d[j]
-                total = rig + w[1] * dens(rp, sd) + (w[2] + w[3]) * dens(re, sd)
-                lp[:, i, j, k] = np.sum(np.log(np.maximum(total, 1e-300)), axis=1)
+                lp[:, i, j, k] = _loglik_from_weights(shots, out, w, sr, sr if shared else sig_d[j])
     return lp
 
 

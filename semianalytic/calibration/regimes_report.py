@@ -215,9 +215,11 @@ def build_regimes_report(result: dict, prefix: str = "") -> tuple[Document, dict
                          f"against the default's {_p(d0['rigid']['mean_abs_error'])}, deforming "
                          f"{_p(c['deforming']['mean_abs_error'])} against {_p(d0['deforming']['mean_abs_error'])}; its 90 % "
                          f"intervals cover {_p(c['deforming']['coverage_90'])} of the deforming and "
-                         f"{_p(c['eroding']['coverage_90'])} of the eroding shots. On this target the Part I depth of the "
-                         "rigid rod is the less accurate of the two: the paper's model does not win here, and is kept as "
-                         "the default for the reason given in the rule.")
+                         f"{_p(c['eroding']['coverage_90'])} of the eroding shots. "
+                         + ("On this target the Part I depth of the rigid rod is the less accurate of the two: the paper's "
+                            "model does not win here, and is kept as the default for the reason given in the rule."
+                            if c["rigid"]["mean_abs_error"] < d0["rigid"]["mean_abs_error"] else
+                            "The Part I depth of the rigid rod is the more accurate of the two on this target."))
         for g, curve in result["curves"].items():
             shots = curve["shots"]
             resp = [r for r in _responses(best, g)]

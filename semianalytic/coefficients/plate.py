@@ -60,6 +60,8 @@ from semianalytic.coefficients.table import (
     check_tolerance,
     flat_tip,
     graded_breakpoints,
+    settle_interval,
+    settle_unfinished,
 )
 from semianalytic.geometry import Nose
 
@@ -519,18 +521,10 @@ class _Builder:
                         nxt += [(a, m), (m, b)]
                         parent[(i, a, m)] = parent[(i, m, b)] = (worst, disc)
                     else:
-                        if worst > 1.0:
-                            self.noise_limited += 1
-                            if up is not None:
-                                disc = {q: max(disc[q], up[1][q]) for q in INTERPOLATED}
-                        pk.err[(a, m)] = pk.err[(m, b)] = disc
+                        self.noise_limited += settle_interval(pk, a, m, b, disc, worst, up)
                 new[i] = nxt
             pending = new
-        for i, ivs in pending.items():  # out of rounds: the parent's discrepancy
-            for a, b in ivs:
-                up = parent.get((i, a, b))
-                self.knots[i].err[(a, b)] = up[1] if up else {q: math.inf for q in INTERPOLATED}
-                self.noise_limited += 1
+        self.noise_limited += settle_unfinished(self.knots, pending, parent)  # out of rounds
 
     def fixed_errors(self):
         """Fixed knots (``depths``): every other knot left out and predicted (as the table)."""

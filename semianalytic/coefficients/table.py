@@ -664,6 +664,31 @@ class CoefficientTable(CoefficientAccessors):
 # building
 
 
+
+def settle_interval(pk, a: float, m: float, b: float, disc: dict, worst: float, up) -> int:
+    """Accept the halves (a, m) and (m, b) of an interval of the adaptive refinement, each with the
+    midpoint discrepancy ``disc`` as its error estimate.  An interval still above the tolerance
+    (``worst`` > 1: noise-limited, or out of solves) keeps the larger of its and its parent's
+    discrepancy (``up`` = (worst, disc) of the parent, or None).  Returns 1 if noise-limited, else 0
+    (the half-space and the plate tables share it)."""
+    noisy = worst > 1.0
+    if noisy and up is not None:
+        disc = {q: max(disc[q], up[1][q]) for q in INTERPOLATED}
+    pk.err[(a, m)] = pk.err[(m, b)] = disc
+    return int(noisy)
+
+
+def settle_unfinished(knots, pending: dict, parent: dict) -> int:
+    """Intervals still pending when the rounds run out: each keeps its parent's discrepancy as its
+    estimate (infinite without a parent).  Returns how many (all count as noise-limited)."""
+    n = 0
+    for i, ivs in pending.items():
+        for a, b in ivs:
+            up = parent.get((i, a, b))
+            knots[i].err[(a, b)] = up[1] if up else {q: math.inf for q in INTERPOLATED}
+            n += 1
+    return n
+
 class _Builder:
     """Adaptive construction of a table (see the module docstring)."""
 
@@ -802,22 +827,14 @@ class _Builder:
                         nxt += [(a, m), (m, b)]
                         parent[(i, a, m)] = parent[(i, m, b)] = (worst, disc)
                     else:
-                        if worst > 1.0:
-                            self.noise_limited += 1
-                            if up is not None:
-                                disc = {q: max(disc[q], up[1][q]) for q in INTERPOLATED}
-                        pk.err[(a, m)] = pk.err[(m, b)] = disc
+                        self.noise_limited += settle_interval(pk, a, m, b, disc, worst, up)
                 new[i] = nxt
             self.update_limit()
             self.extend_deep(new, scale)
             self.extend_shallow(new, scale)
             pending = new
         else:
-            for i, ivs in pending.items():  # out of rounds: the parent's discrepancy, honestly
-                for a, b in ivs:
-                    up = parent.get((i, a, b))
-                    self.knots[i].err[(a, b)] = up[1] if up else {q: math.inf for q in INTERPOLATED}
-                    self.noise_limited += 1
+            self.noise_limited += settle_unfinished(self.knots, pending, parent)
 
     @staticmethod
     def shallow_estimate(pk: "_PieceKnots") -> dict:

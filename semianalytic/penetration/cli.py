@@ -72,8 +72,8 @@ def add_arguments(parser) -> None:
                              "posterior of calibrate --model regimes adds regime_probability and the regime mixture")
     parser.add_argument("--regime-rule", choices=("meyer", "tate_tabor", "nose_length"), default="meyer",
                         help="regime labels without a posterior: meyer (default, chosen by transfer: Tate's tip "
-                             "pressure against the rod's static Meyer hardness for the onset, 1.15 x it for the breakup "
-                             "where the depth drops to the eroding rod's, 3 x the dynamic ultimate strength for erosion), "
+                             "pressure against the rod's static Meyer hardness for the onset, a breakup factor times it "
+                             "(printed, and breakup_factor in the JSON) for the breakup where the depth drops to the eroding rod's, 3 x the dynamic ultimate strength for erosion), "
                              "tate_tabor (the previous default: 3 x the dynamic yield stress for the onset) or nose_length "
                              "(the earlier rule: U_sC of eqs. (33)/(36), then the shank eroded to the nose length)")
     parser.add_argument("--csv", metavar="FILE", default=None,
@@ -125,7 +125,7 @@ def _print_text(result: dict, desc: str, file=None) -> None:
     elif result.get("regime_rule") == "meyer":
         p(f"  regimes (Tate 1967 tip pressure against the rod's Meyer hardness H_M and 3 x its dynamic ultimate strength, "
           f"Tabor 1951): rigid below U_y = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, the rod breaks up "
-          f"(tip pressure 1.15 H_M, this project's own) from U_b = {_fmt(result['breakup_velocity_m_s'], 1, 0)} m/s, eroding "
+          f"(tip pressure {result['breakup_factor']:g} H_M, this project's own) from U_b = {_fmt(result['breakup_velocity_m_s'], 1, 0)} m/s, eroding "
           f"from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s; depth = {result['part1_model']} below U_b, "
           f"Alekseevskii-Tate rod above (Y_p = {result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = "
           f"{result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")

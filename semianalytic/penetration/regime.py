@@ -331,6 +331,14 @@ def tate_erosion_velocity(rod_strength, target_resistance, target_density: float
     return np.sqrt(np.maximum(2.0 * (constraint * Y - R) / target_density, 0.0))[()]
 
 
+def breakup_velocity(breakup_factor, meyer_hardness, target_resistance, target_density: float, onset, erosion):
+    """U_b [m/s] of ``deforming = "two_stage"`` (this project's own, :data:`DEFORMING_MODELS`): where
+    Tate's (1967) tip pressure (1/2) rho_t U^2 + R_t reaches b H_M, kept between the onset U_y and
+    the erosion U_e (U_y <= U_b <= U_e); vectorised (b, H_M, R_t, U_y, U_e broadcast)."""
+    b, H = np.asarray(breakup_factor, float), np.asarray(meyer_hardness, float)
+    return np.clip(tate_erosion_velocity(b * H, target_resistance, target_density), onset, erosion)[()]
+
+
 def tate_resistance(yield_stress: float, youngs_modulus: float) -> float:
     """R_t [Pa] of Tate (1986), Int. J. Mech. Sci. 28:599-612: R_t = Y_t (2/3 + ln(0.57 E_t/Y_t))
     from the target's yield stress Y_t and Young's modulus E_t."""

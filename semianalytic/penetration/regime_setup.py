@@ -138,9 +138,9 @@ kept as a named option; it lost on transfer."""
 DEFAULT_REGIME_RULE = "meyer"
 
 
-def rod_strengths(case, setup, meyer: bool = False):
-    """(dynamic yield stress, dynamic ultimate strength [Pa], dynamic factor f) of the projectile,
-    and its static Meyer hardness [Pa] as a fourth element with ``meyer=True``.
+def rod_strengths(case, setup) -> tuple[float, float, float, float]:
+    """(dynamic yield stress, dynamic ultimate strength [Pa], dynamic factor f, static Meyer
+    hardness [Pa], Tabor 1951 via :func:`.hardness.meyer_hardness_from_vickers`) of the projectile.
 
     With ``[projectile] hardness`` the yield stress is already f sigma_y(HV) (case layer) and the
     ultimate strength is f sigma_u(HV) (ASTM E140, Pavlina & Van Tyne 2008, eqs. (4)-(5)).  With a
@@ -160,8 +160,7 @@ def rod_strengths(case, setup, meyer: bool = False):
         HV = float(vickers_from_rockwell_c(parse_hardness(psec.hardness)))
     else:
         HV = float(vickers_from_yield_stress(Y / f))
-    out = (float(Y), float(f * ultimate_strength_from_vickers(HV)), f)
-    return (*out, float(meyer_hardness_from_vickers(HV))) if meyer else out
+    return float(Y), float(f * ultimate_strength_from_vickers(HV)), f, float(meyer_hardness_from_vickers(HV))
 
 
 def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
@@ -174,7 +173,7 @@ def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
     ei = eroding_inputs(case, setup)
     U_b = None
     if rule in ("tate_tabor", "meyer"):
-        Y_dyn, Yu_dyn, f, H_M = rod_strengths(case, setup, meyer=True)
+        Y_dyn, Yu_dyn, f, H_M = rod_strengths(case, setup)
         R1 = setup.resistance_pa  # the onset criteria are about the rigid nose: Part I's R_t
         rho_t = ei.target_density
         if rule == "meyer":
@@ -182,7 +181,7 @@ def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
         else:
             U_y = float(rg.tate_erosion_velocity(Y_dyn, R1, rho_t, rg.TABOR_CONSTRAINT))
         U_e = max(U_y, float(rg.tate_erosion_velocity(Yu_dyn, R1, rho_t, rg.TABOR_CONSTRAINT)))
-        U_b = (min(max(float(rg.tate_erosion_velocity(rg.DEFAULT_BREAKUP_FACTOR * H_M, R1, rho_t)), U_y), U_e)
+        U_b = (float(rg.breakup_velocity(rg.DEFAULT_BREAKUP_FACTOR, H_M, R1, rho_t, U_y, U_e))
                if rule == "meyer" else U_y)
         if case.projectile.dynamic_yield_stress is None:  # the eroding rod flows at its ultimate strength
             ei = ErodingInputs(**{**ei.__dict__, "rod_strength": Yu_dyn,
@@ -263,6 +262,7 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         "transition_velocity_m_s": U_y,
         "erosion_velocity_m_s": U_e,
         "breakup_velocity_m_s": U_b,
+        "breakup_factor": rg.DEFAULT_BREAKUP_FACTOR if rule == "meyer" else None,
         "part1_model": part1_model,
         "regime_rule": rule,
         "eroding_inputs": {"rod_strength_Pa": ei.rod_strength, "target_resistance_Pa": ei.target_resistance,
