@@ -41,8 +41,6 @@ error (two depths solved again at order - 2), as in :mod:`semianalytic.coefficie
 from __future__ import annotations
 
 import bisect
-import io
-import json
 import math
 from dataclasses import dataclass, field, replace
 
@@ -55,13 +53,16 @@ from semianalytic.coefficients.table import (
     FLAT_TIP_DEPTH,
     NEAR_BREAK,
     ROUND_OFF,
+    _PieceKnots,
     _coef6,
     breakpoints,
     check_tolerance,
     flat_tip,
     graded_breakpoints,
+    read_table_npz,
     settle_interval,
     settle_unfinished,
+    table_npz_bytes,
 )
 from semianalytic.geometry import Nose
 
@@ -301,21 +302,9 @@ def _spline(v: np.ndarray, y: np.ndarray, dy=None):
     return PPoly.from_spline(make_interp_spline(v, y, k=k))
 
 
-@dataclass
-class _Knots:
-    piece: PlatePiece
-    v: list = field(default_factory=list)
-    rows: list = field(default_factory=list)
-    nodes: list = field(default_factory=list)
-    unknowns: list = field(default_factory=list)
-    err: dict = field(default_factory=dict)
-
-    def add(self, v, row, nodes=None, n=0):
-        k = bisect.bisect_left(self.v, v)
-        self.v.insert(k, v)
-        self.rows.insert(k, row)
-        self.nodes.insert(k, nodes)
-        self.unknowns.insert(k, n)
+class _Knots(_PieceKnots):
+    """Knots of one plate piece while the table is built (the half-space table's, with A by a
+    Hermite spline of dA/dP only: a plate piece has no deep limit)."""
 
     def splines(self) -> dict:
         v = np.array(self.v)
@@ -353,12 +342,9 @@ class PlateCoefficientTable(CoefficientAccessors):
     kinks: tuple = ()
 
     def __post_init__(self):
-        if self.reading not in READINGS:
-            raise ValueError(f"reading must be one of {READINGS}")
+        self._init_intervals()
         iv = self.intervals
-        object.__setattr__(self, "_breaks", list(map(float, iv["P_lo"])))
         object.__setattr__(self, "_geo", [tuple(map(float, t)) for t in zip(iv["a"], iv["b"], iv["m"], iv["side"], iv["v0"])])
-        object.__setattr__(self, "_coef", {k: np.asarray(iv[f"coef_{k}"]).tolist() for k in INTERPOLATED})
         object.__setattr__(self, "_end", self.thickness + self.nose_length)
 
     @property
@@ -378,7 +364,7 @@ class PlateCoefficientTable(CoefficientAccessors):
         h = v - v0
         c5, c4, c3, c2, c1, c0 = self._coef[name][j]
         if not deriv:
-            return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
+            return self._quintic(self._coef[name][j], h)
         if m > 1.0 and (v < 1e-6 if side == 0 else v > 1.0 - 1e-6):
             # dP/dv = 0 at the clustered end: the limit of dy/dv / dP/dv, taken 1e-6 inside
             v = 1e-6 if side == 0 else 1.0 - 1e-6
@@ -418,34 +404,14 @@ class PlateCoefficientTable(CoefficientAccessors):
     # --- persistence ------------------------------------------------------------------
 
     def to_npz_bytes(self) -> bytes:
-        keys = list(self.nodes[0]) if self.nodes else []
-        counts = np.array([len(n["x"]) for n in self.nodes], int)
-        buf = io.BytesIO()
-        np.savez(
-            buf,
-            meta=json.dumps({"nose_kind": self.nose_kind, "diameter": self.diameter, "nose_length": self.nose_length,
-                             "thickness": self.thickness, "version": PLATE_VERSION, "node_keys": keys,
-                             "bem_errors": self.bem_errors, "options": self.options, "tolerance": self.tolerance,
-                             "kinks": list(self.kinks)}),
-            depth=self.depth, unknowns=self.unknowns, counts=counts,
-            **{f"v_{k}": v for k, v in self.values.items()},
-            **{f"i_{k}": np.asarray(v) for k, v in self.intervals.items()},
-            **{f"n_{k}": np.concatenate([n[k] for n in self.nodes]) for k in keys},
-        )
-        return buf.getvalue()
+        return table_npz_bytes(self, {"thickness": self.thickness, "version": PLATE_VERSION})
 
     @classmethod
     def from_npz(cls, source) -> "PlateCoefficientTable":
         with np.load(source, allow_pickle=False) as z:
-            meta = json.loads(str(z["meta"]))
-            if meta.get("version") != PLATE_VERSION:
-                raise ValueError("plate coefficient table cache has another version")
-            bounds = np.concatenate([[0], np.cumsum(z["counts"])])
-            arrays = {k: z[f"n_{k}"] for k in meta["node_keys"]}
-            nodes = tuple({k: v[a:b] for k, v in arrays.items()} for a, b in zip(bounds[:-1], bounds[1:]))
+            meta, nodes, values, intervals = read_table_npz(z, PLATE_VERSION, "plate coefficient table")
             return cls(meta["nose_kind"], meta["diameter"], meta["nose_length"], meta["thickness"], z["depth"],
-                       {k[2:]: z[k] for k in z.files if k.startswith("v_")}, z["unknowns"], nodes,
-                       {k[2:]: z[k] for k in z.files if k.startswith("i_")}, meta["bem_errors"], meta["options"],
+                       values, z["unknowns"], nodes, intervals, meta["bem_errors"], meta["options"],
                        tolerance=meta["tolerance"], kinks=tuple(meta["kinks"]))
 
 

@@ -410,10 +410,58 @@ def _evaluate_splines(splines: dict, v: np.ndarray) -> dict:
 # the table
 
 
+def table_npz_bytes(table, meta: dict) -> bytes:
+    """A coefficient table (half-space or plate) as the bytes of an ``.npz`` archive: ``meta`` (its
+    own keys) with the keys both tables share, the depths, unknowns, knot values, intervals and the
+    surface nodes of every knot concatenated (``counts`` per knot)."""
+    keys = list(table.nodes[0]) if table.nodes else []
+    counts = np.array([len(n["x"]) for n in table.nodes], int)
+    meta = {"nose_kind": table.nose_kind, "diameter": table.diameter, "nose_length": table.nose_length,
+            "options": table.options, "node_keys": keys, "bem_errors": table.bem_errors,
+            "tolerance": table.tolerance, "kinks": list(table.kinks), **meta}
+    buf = io.BytesIO()
+    np.savez(
+        buf, meta=json.dumps(meta), depth=table.depth, unknowns=table.unknowns, counts=counts,
+        **{f"v_{k}": v for k, v in table.values.items()},
+        **{f"i_{k}": np.asarray(v) for k, v in table.intervals.items()},
+        **{f"n_{k}": np.concatenate([n[k] for n in table.nodes]) for k in keys},
+    )
+    return buf.getvalue()
+
+
+def read_table_npz(z, version: int, what: str) -> tuple[dict, tuple, dict, dict]:
+    """(meta, nodes per knot, values, intervals) of an archive of :func:`table_npz_bytes`; ValueError
+    if it holds another ``version`` (the cache then rebuilds the table)."""
+    meta = json.loads(str(z["meta"]))
+    if meta.get("version") != version:
+        raise ValueError(f"{what} cache has another version")
+    bounds = np.concatenate([[0], np.cumsum(z["counts"])])
+    arrays = {k: z[f"n_{k}"] for k in meta["node_keys"]}
+    nodes = tuple({k: v[a:b] for k, v in arrays.items()} for a, b in zip(bounds[:-1], bounds[1:]))
+    values = {k[2:]: z[k] for k in z.files if k.startswith("v_")}
+    intervals = {k[2:]: z[k] for k in z.files if k.startswith("i_")}
+    return meta, nodes, values, intervals
+
+
 class CoefficientAccessors:
     """A(P), B(P), C(P) and phi at the tip of a table that interpolates by ``self._eval(name, P)``
     (the half-space :class:`CoefficientTable` and the plate table of
     :mod:`semianalytic.coefficients.plate`); ``self.reading`` is the default B reading."""
+
+    def _init_intervals(self) -> None:
+        """Check the default reading and keep the interval breaks and the per-interval quintic
+        coefficients as Python lists (the scalar path of ``_eval`` reads them without numpy)."""
+        if self.reading not in READINGS:
+            raise ValueError(f"reading must be one of {READINGS}")
+        iv = self.intervals
+        object.__setattr__(self, "_breaks", list(map(float, iv["P_lo"])))
+        object.__setattr__(self, "_coef", {k: np.asarray(iv[f"coef_{k}"]).tolist() for k in INTERPOLATED})
+
+    @staticmethod
+    def _quintic(c, h: float) -> float:
+        """sum_i c_i h^(5-i) by Horner (c = (c5, .., c0), the local polynomial of an interval)."""
+        c5, c4, c3, c2, c1, c0 = c
+        return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
 
     def A(self, P):
         """Added-mass volume A(P) = integral phi n_x dS [m^3] (Part I, eq. (12))."""
@@ -486,10 +534,8 @@ class CoefficientTable(CoefficientAccessors):
     kinks: tuple = ()
 
     def __post_init__(self):
-        if self.reading not in READINGS:
-            raise ValueError(f"reading must be one of {READINGS}")
+        self._init_intervals()
         iv = self.intervals
-        object.__setattr__(self, "_breaks", list(map(float, iv["P_lo"])))
         object.__setattr__(self, "_kind", list(map(int, iv["kind"])))
         object.__setattr__(self, "_scale", list(map(float, iv["scale"])))
         object.__setattr__(self, "_v0", list(map(float, iv["v0"])))
@@ -497,7 +543,6 @@ class CoefficientTable(CoefficientAccessors):
         object.__setattr__(self, "_origin", np.asarray(iv.get("origin", np.zeros(n)), float))
         object.__setattr__(self, "_power", np.asarray(iv.get("power", np.ones(n)), float))
         object.__setattr__(self, "_graded", bool(np.any(np.asarray(iv["kind"]) == _KINDS["graded"])))
-        object.__setattr__(self, "_coef", {k: np.asarray(iv[f"coef_{k}"]).tolist() for k in INTERPOLATED})
 
     # --- evaluation -----------------------------------------------------------------
 
@@ -522,9 +567,7 @@ class CoefficientTable(CoefficientAccessors):
                 v = max((P - float(self._origin[j])) / sc, 0.0) ** (1.0 / float(self._power[j]))
             else:
                 v = math.sqrt(P / sc) if kind == 0 else (P / sc if kind == 1 else sc / P)
-            h = v - self._v0[j]
-            c5, c4, c3, c2, c1, c0 = self._coef[name][j]
-            return ((((c5 * h + c4) * h + c3) * h + c2) * h + c1) * h + c0
+            return self._quintic(self._coef[name][j], v - self._v0[j])
         P = np.asarray(P, dtype=float)
         if np.any(np.isnan(P)) or np.any(P < 0):
             raise ValueError("depth P must be >= 0")
@@ -621,39 +664,14 @@ class CoefficientTable(CoefficientAccessors):
 
     def to_npz_bytes(self) -> bytes:
         """The table as the bytes of an ``.npz`` archive (persisted by :mod:`semianalytic.cache`)."""
-        keys = list(self.nodes[0])
-        counts = np.array([len(n["x"]) for n in self.nodes])
-        buf = io.BytesIO()
-        np.savez(
-            buf,
-            meta=json.dumps(
-                {"nose_kind": self.nose_kind, "diameter": self.diameter, "nose_length": self.nose_length,
-                 "limits": self.limits, "options": self.options, "version": TABLE_VERSION, "node_keys": keys,
-                 "limit_errors": self.limit_errors, "bem_errors": self.bem_errors, "tolerance": self.tolerance,
-                 "kinks": list(self.kinks)}
-            ),
-            depth=self.depth,
-            unknowns=self.unknowns,
-            counts=counts,
-            **{f"v_{k}": v for k, v in self.values.items()},
-            **{f"i_{k}": np.asarray(v) for k, v in self.intervals.items()},
-            **{f"n_{k}": np.concatenate([n[k] for n in self.nodes]) for k in keys},
-        )
-        return buf.getvalue()
+        return table_npz_bytes(self, {"limits": self.limits, "version": TABLE_VERSION,
+                                      "limit_errors": self.limit_errors})
 
     @classmethod
     def from_npz(cls, source) -> "CoefficientTable":
         """The table from an ``.npz`` archive (a path or a binary file object)."""
         with np.load(source, allow_pickle=False) as z:
-            meta = json.loads(str(z["meta"]))
-            if meta.get("version") != TABLE_VERSION:
-                raise ValueError("coefficient table cache has another version")
-            counts = z["counts"]
-            bounds = np.concatenate([[0], np.cumsum(counts)])
-            node_arrays = {k: z[f"n_{k}"] for k in meta["node_keys"]}
-            nodes = tuple({k: v[a:b] for k, v in node_arrays.items()} for a, b in zip(bounds[:-1], bounds[1:]))
-            values = {k[2:]: z[k] for k in z.files if k.startswith("v_")}
-            intervals = {k[2:]: z[k] for k in z.files if k.startswith("i_")}
+            meta, nodes, values, intervals = read_table_npz(z, TABLE_VERSION, "coefficient table")
             return cls(meta["nose_kind"], meta["diameter"], meta["nose_length"], z["depth"], values,
                        meta["limits"], z["unknowns"], nodes, meta["options"], intervals=intervals,
                        limit_errors=meta["limit_errors"], bem_errors=meta["bem_errors"],
