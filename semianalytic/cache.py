@@ -24,20 +24,10 @@ import json
 import os
 from pathlib import Path
 
+from semianalytic.native import CACHE_ENV, cache_root  # lives below the models (their compiled kernels use it)
+
 __all__ = ["CACHE_ENV", "cache_root", "table_dir", "table_key", "cached_coefficient_table", "coefficients_for_case",
            "case_table_request", "case_table_key", "plate_table_key", "cached_plate_table"]
-
-CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
-
-
-def cache_root() -> Path:
-    """``$SEMIANALYTIC_CACHE_DIR`` if set, else the per-user cache folder (platformdirs)."""
-    env = os.environ.get(CACHE_ENV)
-    if env:
-        return Path(env).expanduser()
-    from platformdirs import user_cache_dir
-
-    return Path(user_cache_dir("semianalytic", appauthor=False))
 
 
 def table_dir(cache_dir: str | os.PathLike | None = None) -> Path:

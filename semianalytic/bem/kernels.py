@@ -24,10 +24,16 @@ spurious singularity on the axis (where 1 - m -> 1) into both parts of the split
 
 from __future__ import annotations
 
+import ctypes
+import functools
 import math
+import os
+from pathlib import Path
 
 import numpy as np
 from scipy.special import ellipe, ellipk
+
+from semianalytic.native import load_library
 
 # Complete elliptic integrals as functions of the complementary parameter q = 1 - m,
 # K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q): the Cephes approximations
@@ -110,7 +116,7 @@ def _geometry(x, r, x1, r1, delta=None):
     return dx, dr, d2, D
 
 
-def single_double(x, r, x1, r1, nx1, nr1, delta=None):
+def _single_double_numpy(x, r, x1, r1, nx1, nr1, delta=None):
     """Single-layer and double-layer ring kernels (Part I, eqs. (20)-(22); errata items 1, 1a).
 
     S = integral over the ring of G r1 dtheta = r1 K(m) / (pi sqrt(D)),
@@ -139,7 +145,7 @@ _KME_Q_SERIES = (math.pi / 2) * _C2 * np.array([2 * n / (2 * n - 1) for n in ran
 _SPLIT_MATRIX = _poly_matrix(_PK, _QK, _PE, _QE, _K_SERIES[::-1], _KME_Q_SERIES[::-1])
 
 
-def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
+def _single_double_split_numpy(x, r, x1, r1, nx1, nr1, delta=None):
     """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2."""
     dx, dr, d2, D = _geometry(x, r, x1, r1, delta)
     m1 = d2 / D
@@ -152,6 +158,98 @@ def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     QS = r1 * _TWO_OVER_PI * Kc * inv
     QD = _TWO_OVER_PI * (KcmEc * bracket_over_d2 - 0.5 * nr1 * Kc) * inv
     return S, Dl, QS, QD
+
+
+# ------------------------------------------------------------------------------------
+# the compiled kernels (_ring.c) and the dispatch between them and the numpy code above
+
+KERNEL_ENV = "SEMIANALYTIC_KERNEL"  # "numpy": the numpy kernels even where the C ones would load
+_SOURCE = Path(__file__).with_name("_ring.c")
+_P = ctypes.c_void_p
+_N = ctypes.c_ssize_t
+
+
+@functools.cache
+def compiled():
+    """The compiled ring kernels (ctypes library), or None: ``$SEMIANALYTIC_KERNEL=numpy``, no C
+    compiler or a failed build (:func:`semianalytic.native.load_library`; cached per user)."""
+    if os.environ.get(KERNEL_ENV, "").strip().lower() == "numpy":
+        return None
+    lib = load_library(_SOURCE)
+    if lib is None:
+        return None
+    lib.ring_set_series.argtypes = [_P, _P]
+    lib.ring_set_series.restype = None
+    lib.ring_single_double.argtypes = [_N] + [_P] * 10
+    lib.ring_single_double.restype = None
+    lib.ring_single_double_split.argtypes = [_N] + [_P] * 12
+    lib.ring_single_double_split.restype = None
+    lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
+    lib.ring_dense.restype = None
+    series = [np.ascontiguousarray(a, dtype=float) for a in (_K_SERIES, _KME_Q_SERIES)]
+    lib.ring_set_series(*(a.ctypes.data for a in series))
+    return lib
+
+
+def backend() -> str:
+    """"c" when the compiled kernels are in use, else "numpy"."""
+    return "numpy" if compiled() is None else "c"
+
+
+def _flat_inputs(x, r, x1, r1, nx1, nr1, delta):
+    """The inputs broadcast together, as contiguous float64 arrays (copies only where needed),
+    and their common shape; ``delta`` a pair of such arrays or None."""
+    args = (x, r, x1, r1, nx1, nr1) + (() if delta is None else tuple(delta))
+    arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in args))
+    shape = arrays[0].shape
+    flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
+    ptrs = [a.ctypes.data for a in flat] + ([None, None] if delta is None else [])
+    return shape, flat, ptrs
+
+
+def single_double(x, r, x1, r1, nx1, nr1, delta=None):
+    """Single-layer and double-layer ring kernels (Part I, eqs. (20)-(22); errata items 1, 1a):
+    :func:`_single_double_numpy` (formulas there), compiled (``_ring.c``) when available."""
+    lib = compiled()
+    if lib is None:
+        return _single_double_numpy(x, r, x1, r1, nx1, nr1, delta)
+    shape, keep, ptrs = _flat_inputs(x, r, x1, r1, nx1, nr1, delta)
+    S, Dl = np.empty(shape), np.empty(shape)
+    lib.ring_single_double(S.size, *ptrs, S.ctypes.data, Dl.ctypes.data)
+    return S, Dl
+
+
+def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
+    """As :func:`single_double`, plus the coefficients QS, QD of L = -ln(1 - m)/2
+    (:func:`_single_double_split_numpy`, compiled when available)."""
+    lib = compiled()
+    if lib is None:
+        return _single_double_split_numpy(x, r, x1, r1, nx1, nr1, delta)
+    shape, keep, ptrs = _flat_inputs(x, r, x1, r1, nx1, nr1, delta)
+    out = [np.empty(shape) for _ in range(4)]
+    lib.ring_single_double_split(out[0].size, *ptrs, *(a.ctypes.data for a in out))
+    return tuple(out)
+
+
+def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
+    """S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` for the targets (xr, rr)[i] against
+    the source rings (xc, rc, normal (nxc, nrc), weight wc)[j]: the dense block of the assembly
+    (Part I, eqs. (20)-(22)).  Compiled: one fused pass writing the two (rows, cols) arrays;
+    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small."""
+    xr, rr, xc, rc, nxc, nrc, wc = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (xr, rr, xc, rc, nxc, nrc, wc))
+    S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
+    lib = compiled()
+    if lib is not None:
+        lib.ring_dense(xr.size, xr.ctypes.data, rr.ctypes.data, xc.size,
+                       *(a.ctypes.data for a in (xc, rc, nxc, nrc, wc)), S.ctypes.data, Dl.ctypes.data)
+        return S, Dl
+    step = max(1, chunk // max(xc.size, 1))
+    for a in range(0, xr.size, step):
+        with np.errstate(divide="ignore", invalid="ignore"):
+            S[a:a + step], Dl[a:a + step] = _single_double_numpy(xr[a:a + step, None], rr[a:a + step, None], xc, rc, nxc, nrc)
+    S *= wc
+    Dl *= wc
+    return S, Dl
 
 
 # Series of (K(m) - E(m))/m = (pi/2) sum_n c_n^2 2n/(2n - 1) m^(n-1), c_n = (2n)!/(4^n n!^2)

@@ -37,7 +37,7 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg
 
-from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_split
+from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_dense, single_double_split
 from semianalytic.bem.panels import PanelSet
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -575,16 +575,8 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     xt, rt = X[:N], R[:N]
 
     def dense(rows, cols):
-        xr, rr = xt[rows], rt[rows]
-        xc, rc, nxc, nrc, wc = X[cols], R[cols], NX[cols], NR[cols], W[cols]
-        S, D = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
-        step = max(1, DENSE_CHUNK // max(xc.size, 1))
-        for a in range(0, xr.size, step):  # row blocks: temporaries stay small (see DENSE_CHUNK)
-            with np.errstate(divide="ignore", invalid="ignore"):
-                S[a:a + step], D[a:a + step] = single_double(xr[a:a + step, None], rr[a:a + step, None], xc, rc, nxc, nrc)
-        S *= wc
-        D *= wc
-        return S, D
+        # compiled: one fused pass; numpy: row blocks, so that temporaries stay small (DENSE_CHUNK)
+        return single_double_dense(xt[rows], rt[rows], X[cols], R[cols], NX[cols], NR[cols], W[cols], DENSE_CHUNK)
 
     if plan.fixed is None:
         S, D = dense(slice(None), slice(None))

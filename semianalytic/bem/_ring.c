@@ -1,0 +1,174 @@
+/* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22);
+ * errata items 1, 1a), compiled: the same formulas, in the same order of operations, as
+ * single_double and single_double_split of semianalytic/bem/kernels.py (read their docstrings
+ * for the notation), and the dense block of assemble() (semianalytic/bem/solve.py) with the
+ * column weights applied.  The numpy code of kernels.py is the reference and the fallback.
+ *
+ * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
+ * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the
+ * numpy code sums the same polynomials by powers: the two agree to a few units of 1e-16).
+ * Compile without -ffast-math: IEEE arithmetic, inf/nan where numpy gives them (q = 0). */
+
+#include <math.h>
+#include <stddef.h>
+
+static const double PK[11] = {
+    1.37982864606273237150e-4, 2.28025724005875567385e-3, 7.97404013220415179367e-3,
+    9.85821379021226008714e-3, 6.87489687449949877925e-3, 6.18901033637687613229e-3,
+    8.79078273952743772254e-3, 1.49380448916805252718e-2, 3.08851465246711995998e-2,
+    9.65735902811690126535e-2, 1.38629436111989062502e0};
+static const double QK[11] = {
+    2.94078955048598507511e-5, 9.14184723865917226571e-4, 5.94058303753167793257e-3,
+    1.54850516649762399335e-2, 2.39089602715924892727e-2, 3.01204715227604046988e-2,
+    3.73774314173823228969e-2, 4.88280347570998239232e-2, 7.03124996963957469739e-2,
+    1.24999999999870820058e-1, 4.99999999999999999821e-1};
+static const double PE[11] = {
+    1.53552577301013293365e-4, 2.50888492163602060990e-3, 8.68786816565889628429e-3,
+    1.07350949056076193403e-2, 7.77395492516787092951e-3, 7.58395289413514708519e-3,
+    1.15688436810574127319e-2, 2.18317996015557253103e-2, 5.68051945617860553470e-2,
+    4.43147180560990850618e-1, 1.00000000000000000299e0};
+static const double QE[10] = {
+    3.27954898576485872656e-5, 1.00962792679356715133e-3, 6.50609489976927491433e-3,
+    1.68862163993311317300e-2, 2.61769742454493659583e-2, 3.34833904888224918614e-2,
+    4.27180926518931511717e-2, 5.85936634471101055642e-2, 9.37499997197644278445e-2,
+    2.49999999999888314361e-1};
+
+#define PI 3.14159265358979323846
+#define SPLIT_TERMS 10
+
+/* Coefficients of the truncated series of K(q) and K(q) - E(q) in q, lowest power first,
+ * filled by the loader from kernels.py (_K_SERIES, _KME_Q_SERIES): one home for them. */
+static double KSER[SPLIT_TERMS];
+static double KMESER[SPLIT_TERMS];
+
+void ring_set_series(const double *k, const double *kme)
+{
+    for (int i = 0; i < SPLIT_TERMS; i++) {
+        KSER[i] = k[i];
+        KMESER[i] = kme[i];
+    }
+}
+
+static inline double horner(double q, const double *c, int n)
+{
+    double s = c[0];
+    for (int i = 1; i < n; i++)
+        s = s * q + c[i];
+    return s;
+}
+
+static inline double series(double q, const double *c)
+{
+    double s = c[SPLIT_TERMS - 1];
+    for (int i = SPLIT_TERMS - 2; i >= 0; i--)
+        s = s * q + c[i];
+    return s;
+}
+
+/* Points are taken in blocks of BLK: the logarithms (a library call) in one loop, everything
+ * else in loops without calls that the compiler vectorises, so that the Horner chains of many
+ * points overlap instead of waiting on each other.  The arithmetic of each point is the same. */
+#define BLK 64
+
+/* S, Dl (and, with QS != NULL, the coefficients QS, QD of L = -ln(1 - m)/2) of n <= BLK points:
+ * differences dx = x - x1, dr = r - r1, sums s = r + r1, source radius r1 and normal (nx1, nr1);
+ * with w != NULL, S and Dl are multiplied by w. */
+static void block(int n, const double *dx, const double *dr, const double *s, const double *r1,
+                  const double *nx1, const double *nr1, const double *w,
+                  double *restrict S, double *restrict Dl, double *restrict QS, double *restrict QD)
+{
+    double d2[BLK], D[BLK], q[BLK], lnq[BLK];
+    const double two_over_pi = 2.0 / PI;
+    for (int i = 0; i < n; i++) {
+        d2[i] = dx[i] * dx[i] + dr[i] * dr[i];
+        D[i] = dx[i] * dx[i] + s[i] * s[i];
+        q[i] = d2[i] / D[i];
+    }
+    for (int i = 0; i < n; i++)
+        lnq[i] = log(q[i]);
+    if (QS == NULL) {
+        for (int i = 0; i < n; i++) {
+            double K = horner(q[i], PK, 11) - lnq[i] * horner(q[i], QK, 11);
+            double E = horner(q[i], PE, 11) - lnq[i] * q[i] * horner(q[i], QE, 10);
+            double inv = 1.0 / (PI * sqrt(D[i]));
+            double bracket = r1[i] * (dx[i] * nx1[i] + dr[i] * nr1[i]) + 0.5 * nr1[i] * d2[i];
+            S[i] = r1[i] * K * inv;
+            Dl[i] = (E * bracket / d2[i] - 0.5 * nr1[i] * K) * inv;
+        }
+        if (w)
+            for (int i = 0; i < n; i++) {
+                S[i] *= w[i];
+                Dl[i] *= w[i];
+            }
+        return;
+    }
+    for (int i = 0; i < n; i++) {
+        double K = horner(q[i], PK, 11) - lnq[i] * horner(q[i], QK, 11);
+        double E = horner(q[i], PE, 11) - lnq[i] * q[i] * horner(q[i], QE, 10);
+        double Kc = series(q[i], KSER);
+        double KcmEc = series(q[i], KMESER);
+        double inv = 1.0 / (PI * sqrt(D[i]));
+        double bracket_over_d2 = (r1[i] * (dx[i] * nx1[i] + dr[i] * nr1[i]) + 0.5 * nr1[i] * d2[i]) / d2[i];
+        S[i] = r1[i] * K * inv;
+        Dl[i] = (E * bracket_over_d2 - 0.5 * nr1[i] * K) * inv;
+        QS[i] = r1[i] * two_over_pi * Kc * inv;
+        QD[i] = two_over_pi * (KcmEc * bracket_over_d2 - 0.5 * nr1[i] * Kc) * inv;
+    }
+}
+
+/* single_double (QS == NULL) or single_double_split on n points (every array contiguous, of
+ * length n); ddx, ddr NULL or the `delta` differences. */
+static void points(ptrdiff_t n, const double *x, const double *r, const double *x1, const double *r1,
+                   const double *nx1, const double *nr1, const double *ddx, const double *ddr,
+                   double *S, double *Dl, double *QS, double *QD)
+{
+    double dx[BLK], dr[BLK], s[BLK];
+    for (ptrdiff_t a = 0; a < n; a += BLK) {
+        int m = n - a < BLK ? (int)(n - a) : BLK;
+        for (int i = 0; i < m; i++) {
+            dx[i] = ddx ? ddx[a + i] : x[a + i] - x1[a + i];
+            dr[i] = ddr ? ddr[a + i] : r[a + i] - r1[a + i];
+            s[i] = r[a + i] + r1[a + i];
+        }
+        block(m, dx, dr, s, r1 + a, nx1 + a, nr1 + a, NULL, S + a, Dl + a,
+              QS ? QS + a : NULL, QD ? QD + a : NULL);
+    }
+}
+
+void ring_single_double(ptrdiff_t n, const double *x, const double *r, const double *x1,
+                        const double *r1, const double *nx1, const double *nr1,
+                        const double *ddx, const double *ddr, double *S, double *Dl)
+{
+    points(n, x, r, x1, r1, nx1, nr1, ddx, ddr, S, Dl, NULL, NULL);
+}
+
+void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, const double *x1,
+                              const double *r1, const double *nx1, const double *nr1,
+                              const double *ddx, const double *ddr, double *S, double *Dl,
+                              double *QS, double *QD)
+{
+    points(n, x, r, x1, r1, nx1, nr1, ddx, ddr, S, Dl, QS, QD);
+}
+
+/* The dense block of assemble(): S[i, j], D[i, j] (row-major, nrow x ncol) of the targets
+ * (xr[i], rr[i]) against the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the
+ * column weight wc[j]. */
+void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                const double *xc, const double *rc, const double *nxc, const double *nrc,
+                const double *wc, double *S, double *D)
+{
+    double dx[BLK], dr[BLK], s[BLK];
+    for (ptrdiff_t i = 0; i < nrow; i++) {
+        double x = xr[i], r = rr[i];
+        for (ptrdiff_t a = 0; a < ncol; a += BLK) {
+            int m = ncol - a < BLK ? (int)(ncol - a) : BLK;
+            for (int j = 0; j < m; j++) {
+                dx[j] = x - xc[a + j];
+                dr[j] = r - rc[a + j];
+                s[j] = r + rc[a + j];
+            }
+            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
+                  NULL, NULL);
+        }
+    }
+}
