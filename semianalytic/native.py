@@ -26,20 +26,19 @@ the same home folder (clusters).  ``-fno-math-errno`` only lets ``sqrt`` be one 
 
 from __future__ import annotations
 
-import ctypes
-import hashlib
-import logging
 import os
-import shutil
-import subprocess
-import tempfile
 from pathlib import Path
 
 __all__ = ["CACHE_ENV", "cache_root", "native_dir", "load_library", "CFLAGS"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 CFLAGS = ("-O3", "-fPIC", "-shared", "-fno-fast-math", "-ffp-contract=off", "-fno-math-errno")
-_LOG = logging.getLogger(__name__)
+
+
+def _debug(msg: str, *args) -> None:
+    import logging  # here: the cache module imports this one, and a command's start-up need not pay for it
+
+    logging.getLogger(__name__).debug(msg, *args)
 
 
 def cache_root() -> Path:
@@ -61,6 +60,7 @@ def _compiler() -> list[str] | None:
     """The C compiler command: ``$CC`` when set (and then only it), else sysconfig's ``CC`` or
     ``cc``, the first found on the PATH; None when there is none."""
     import shlex
+    import shutil
     import sysconfig
 
     env = os.environ.get("CC")
@@ -72,17 +72,25 @@ def _compiler() -> list[str] | None:
 
 
 def _compile(source: Path, target: Path) -> bool:
+    import subprocess
+    import tempfile
+
     cmd = _compiler()
     if cmd is None:
-        _LOG.debug("no C compiler found ($CC, sysconfig CC, cc): numpy kernels")
+        _debug("no C compiler found ($CC, sysconfig CC, cc): numpy kernels")
         return False
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     os.close(fd)
     try:
-        proc = subprocess.run([*cmd, *CFLAGS, "-o", tmp, str(source), "-lm"], capture_output=True, text=True)
+        try:
+            proc = subprocess.run([*cmd, *CFLAGS, "-o", tmp, str(source), "-lm"], capture_output=True, text=True,
+                                  timeout=300)
+        except subprocess.SubprocessError as exc:  # a compiler that hangs
+            _debug("compiling %s failed (%s): numpy kernels", source.name, exc)
+            return False
         if proc.returncode != 0:
-            _LOG.debug("compiling %s failed (%s): numpy kernels\n%s", source.name, " ".join(cmd), proc.stderr)
+            _debug("compiling %s failed (%s): numpy kernels\n%s", source.name, " ".join(cmd), proc.stderr)
             return False
         os.chmod(tmp, 0o755)
         os.replace(tmp, target)
@@ -92,8 +100,12 @@ def _compile(source: Path, target: Path) -> bool:
             os.unlink(tmp)
 
 
-def load_library(source: Path) -> ctypes.CDLL | None:
-    """The C ``source`` compiled (on first use) into the per-user cache and loaded, or None."""
+def load_library(source: Path):
+    """The C ``source`` compiled (on first use) into the per-user cache and loaded (a
+    ``ctypes.CDLL``), or None."""
+    import ctypes
+    import hashlib
+
     try:
         data = source.read_bytes()
         key = hashlib.sha256(data + "\0".join(CFLAGS).encode()).hexdigest()[:20]
@@ -102,5 +114,5 @@ def load_library(source: Path) -> ctypes.CDLL | None:
             return None
         return ctypes.CDLL(str(target))
     except OSError as exc:  # unwritable cache, a library that does not load
-        _LOG.debug("compiled %s unavailable (%s): numpy kernels", source.name, exc)
+        _debug("compiled %s unavailable (%s): numpy kernels", source.name, exc)
         return None

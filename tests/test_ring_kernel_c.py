@@ -23,7 +23,7 @@ from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no C compiler: the numpy kernels only")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
 
 
 @pytest.fixture
@@ -136,7 +136,7 @@ def test_kernels_match_independent_references(case, tol, path, monkeypatch):
     if path == "numpy":
         monkeypatch.setattr(kernels, "compiled", lambda: None)
     elif kernels.compiled() is None:
-        pytest.skip("no C compiler")
+        pytest.skip("no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
     S, Dl = (float(v) for v in kernels.single_double(*case))
     Se, De = _elliptic_reference(*case)
     Sq, Dq = _quad_reference(*case)

@@ -12,40 +12,29 @@
 #include <math.h>
 #include <stddef.h>
 
-static const double PK[11] = {
-    1.37982864606273237150e-4, 2.28025724005875567385e-3, 7.97404013220415179367e-3,
-    9.85821379021226008714e-3, 6.87489687449949877925e-3, 6.18901033637687613229e-3,
-    8.79078273952743772254e-3, 1.49380448916805252718e-2, 3.08851465246711995998e-2,
-    9.65735902811690126535e-2, 1.38629436111989062502e0};
-static const double QK[11] = {
-    2.94078955048598507511e-5, 9.14184723865917226571e-4, 5.94058303753167793257e-3,
-    1.54850516649762399335e-2, 2.39089602715924892727e-2, 3.01204715227604046988e-2,
-    3.73774314173823228969e-2, 4.88280347570998239232e-2, 7.03124996963957469739e-2,
-    1.24999999999870820058e-1, 4.99999999999999999821e-1};
-static const double PE[11] = {
-    1.53552577301013293365e-4, 2.50888492163602060990e-3, 8.68786816565889628429e-3,
-    1.07350949056076193403e-2, 7.77395492516787092951e-3, 7.58395289413514708519e-3,
-    1.15688436810574127319e-2, 2.18317996015557253103e-2, 5.68051945617860553470e-2,
-    4.43147180560990850618e-1, 1.00000000000000000299e0};
-static const double QE[10] = {
-    3.27954898576485872656e-5, 1.00962792679356715133e-3, 6.50609489976927491433e-3,
-    1.68862163993311317300e-2, 2.61769742454493659583e-2, 3.34833904888224918614e-2,
-    4.27180926518931511717e-2, 5.85936634471101055642e-2, 9.37499997197644278445e-2,
-    2.49999999999888314361e-1};
-
 #define PI 3.14159265358979323846
 #define SPLIT_TERMS 10
 
-/* Coefficients of the truncated series of K(q) and K(q) - E(q) in q, lowest power first,
- * filled by the loader from kernels.py (_K_SERIES, _KME_Q_SERIES): one home for them. */
+/* The polynomials, filled once by the loader from kernels.py (one home for the numbers):
+ * the Cephes P_K, Q_K, P_E (11 coefficients) and Q_E (10), highest power first, and the
+ * truncated series of K(q) and K(q) - E(q) in q (SPLIT_TERMS), lowest power first. */
+static double PK[11], QK[11], PE[11], QE[10];
 static double KSER[SPLIT_TERMS];
 static double KMESER[SPLIT_TERMS];
 
-void ring_set_series(const double *k, const double *kme)
+void ring_set_coefficients(const double *pk, const double *qk, const double *pe, const double *qe,
+                           const double *kser, const double *kmeser)
 {
+    for (int i = 0; i < 11; i++) {
+        PK[i] = pk[i];
+        QK[i] = qk[i];
+        PE[i] = pe[i];
+    }
+    for (int i = 0; i < 10; i++)
+        QE[i] = qe[i];
     for (int i = 0; i < SPLIT_TERMS; i++) {
-        KSER[i] = k[i];
-        KMESER[i] = kme[i];
+        KSER[i] = kser[i];
+        KMESER[i] = kmeser[i];
     }
 }
 

@@ -178,16 +178,18 @@ def compiled():
     lib = load_library(_SOURCE)
     if lib is None:
         return None
-    lib.ring_set_series.argtypes = [_P, _P]
-    lib.ring_set_series.restype = None
+    lib.ring_set_coefficients.argtypes = [_P] * 6
+    lib.ring_set_coefficients.restype = None
     lib.ring_single_double.argtypes = [_N] + [_P] * 10
     lib.ring_single_double.restype = None
     lib.ring_single_double_split.argtypes = [_N] + [_P] * 12
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
-    series = [np.ascontiguousarray(a, dtype=float) for a in (_K_SERIES, _KME_Q_SERIES)]
-    lib.ring_set_series(*(a.ctypes.data for a in series))
+    if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
+        raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")
+    coefs = [np.ascontiguousarray(a, dtype=float) for a in (_PK, _QK, _PE, _QE, _K_SERIES, _KME_Q_SERIES)]
+    lib.ring_set_coefficients(*(a.ctypes.data for a in coefs))  # copied by the library
     return lib
 
 
