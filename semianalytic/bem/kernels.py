@@ -20,6 +20,13 @@ so that quadrature can integrate the logarithm exactly.  K(1 - m) and E(1 - m) a
 as their power series in 1 - m truncated after ``SPLIT_TERMS`` terms: the remainder
 multiplies L by (1 - m)^SPLIT_TERMS, which is smooth, while the full K(1 - m) would put a
 spurious singularity on the axis (where 1 - m -> 1) into both parts of the split.
+
+:func:`single_double`, :func:`single_double_split` and the dense block of the assembly
+(:func:`single_double_dense`) run compiled from ``_ring.c`` (the same polynomials, passed from
+here, and the same formulas; built on first use into the per-user cache by
+:mod:`semianalytic.native`) when a C compiler is at hand, else, or with
+``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
+the two agree to a few units of 1e-16).
 """
 
 from __future__ import annotations
