@@ -158,6 +158,13 @@ def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.n
     panel mask): pairs of both masks are left out (their block is reused, see
     :class:`AssemblyCache`).
     """
+    return _near_pairs_with(ps, xt, rt, exclude_panel, exclude_block)[:4]
+
+
+def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=None, also=None):
+    """:func:`near_pairs`, and the nearest points of the further queries ``also`` = (panel,
+    x, r) if given (fifth and sixth outputs, u and du): all found by one call of
+    :func:`closest_points` (the same numbers as separate calls, a third of the calls)."""
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
     near = np.hypot(xt[:, None] - cx[None, :], rt[:, None] - cr[None, :]) < reach
@@ -171,16 +178,23 @@ def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.n
         near &= ~skip
         near_img &= ~skip
     tgt, pan = np.nonzero(near | near_img)
-    if tgt.size == 0:
-        return tgt, pan, np.empty(0), np.empty(0)
-    u, du = closest_points(ps, pan, xt[tgt], rt[tgt])
     img = np.nonzero(near_img[tgt, pan])[0]
-    if img.size:
-        u_img, du_img = closest_points(ps, pan[img], xt[tgt[img]], -rt[tgt[img]])
+    n, m = tgt.size, img.size
+    if also is None:
+        also = (np.empty(0, int), np.empty(0), np.empty(0))
+    qp = np.concatenate([pan, pan[img], also[0]])
+    if qp.size == 0:
+        return tgt, pan, np.empty(0), np.empty(0), np.empty(0), np.empty(0)
+    qx = np.concatenate([xt[tgt], xt[tgt[img]], also[1]])
+    qr = np.concatenate([rt[tgt], -rt[tgt[img]], also[2]])
+    uq, duq = closest_points(ps, qp, qx, qr)
+    u, du = uq[:n], duq[:n]
+    if m:
+        u_img, du_img = uq[n:n + m], duq[n:n + m]
         use = du_img < du[img]
         u[img[use]] = u_img[use]
         du[img[use]] = du_img[use]
-    return tgt, pan, u, du
+    return tgt, pan, u, du, uq[n + m:], duq[n + m:]
 
 
 def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
@@ -238,23 +252,21 @@ class PairQuadrature:
         numbers)."""
         if not self.blocks or self.target_u is not None:
             return self
-        rows_p, rows_u, index = [], [], []
-        at = 0
-        for f, n, Q, lag in self.blocks:
-            s0, s1 = self._points_of(f, n)
-            if lag is not None and lag.ndim == 2:
-                first = self.panel[f:f + n]
-                upan, inv = np.unique(first, return_inverse=True)
-                rows_p.append(np.repeat(upan, Q))
-                rows_u.append(np.tile(self.u[s0:s0 + Q], upan.size))
-                index.append((at + inv[:, None] * Q + np.arange(Q)).ravel())
-                at += upan.size * Q
-            else:
-                rows_p.append(self.panel[self.pair[s0:s1]])
-                rows_u.append(self.u[s0:s1])
-                index.append(np.arange(at, at + s1 - s0))
-                at += s1 - s0
-        distinct = (np.concatenate(rows_p), np.concatenate(rows_u), np.concatenate(index))
+        npairs, npoints = len(self.target), self.u.size
+        shared = np.zeros(npairs, bool)
+        block = np.empty(npairs, dtype=np.int64)
+        for k, (f, n, _, lag) in enumerate(self.blocks):
+            block[f:f + n] = k
+            shared[f:f + n] = lag is not None and lag.ndim == 2
+        span = int(self.panel.max()) + 1
+        key = np.where(shared, block * span + self.panel, len(self.blocks) * span + np.arange(npairs))
+        _, first, inv = np.unique(key, return_index=True, return_inverse=True)
+        counts = np.diff(np.append(self.starts, npoints))
+        size = counts[first]
+        at = np.cumsum(size) - size  # first distinct point of each distinct pair
+        src = np.repeat(self.starts[first] - at, size) + np.arange(int(size.sum()))
+        within = np.arange(npoints) - self.starts[self.pair]
+        distinct = (self.panel[self.pair[src]], self.u[src], at[inv.ravel()][self.pair] + within)
         return dataclasses.replace(self, distinct=distinct)
 
     @staticmethod
@@ -530,8 +542,13 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     free_node = np.ones(N, bool) if fixed is None else ~fixed[own_panel]
     close = np.nonzero(free_node & (np.hypot(xt - cx[own_panel], rt + cr[own_panel])
                                     < (IMAGE_MARGIN + 1) * ps.lengths[own_panel]))[0]
+    block = None
+    if fixed is not None:
+        block = (~free_node, np.concatenate([fixed, np.zeros(ps.n_panels - ps.n_primary, bool)]))
+    # the near pairs and the self pairs' axis images: one search of the nearest points
+    tgt, pan, ustar, du, _, du_img = _near_pairs_with(ps, xt, rt, own_panel, block,
+                                                      (own_panel[close], xt[close], -rt[close]))
     if close.size:
-        _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
     mapped = np.nonzero(np.isin(own_panel, ps.mapped))[0]
@@ -542,10 +559,6 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
         gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
         levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
         levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
-    block = None
-    if fixed is not None:
-        block = (~free_node, np.concatenate([fixed, np.zeros(ps.n_panels - ps.n_primary, bool)]))
-    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel, exclude_block=block)
     self_rule = self_quadrature(levels, p)
     if fixed is not None:
         self_rule = self_rule.subset(free_node[self_rule.target])
