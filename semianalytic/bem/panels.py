@@ -167,7 +167,7 @@ class PanelSet:
         """(curve, mask into ``panel``, the panels on that curve) for each curve used."""
         curves, group = self._curves
         if len(curves) == 1:
-            yield curves[0], np.ones(panel.shape, bool), panel
+            yield curves[0], slice(None), panel  # every point: a view, not a masked copy
             return
         seg_of = group[panel]
         for s, seg in enumerate(curves):
@@ -213,14 +213,17 @@ class PanelSet:
         dr = np.empty(u_from.shape)
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
-            t_from = self.base[pk] + self.da[pk] + half * (u_from[mask] + 1.0)
-            step = half * (u_to[mask] - u_from[mask])  # exact for plain panels
-            if self.cluster is not None and np.any(self.cluster[pk] != 0):
-                dt_from = self._param(pk, u_from[mask])[0]
-                dt_to = self._param(pk, u_to[mask])[0]
-                on = self.cluster[pk] != 0
-                t_from = np.where(on, self.base[pk] + dt_from, t_from)
-                step = np.where(on, dt_to - dt_from, step)
+            uf, ut = u_from[mask], u_to[mask]
+            base = self.base[pk]
+            t_from = base + self.da[pk] + half * (uf + 1.0)
+            step = half * (ut - uf)  # exact for plain panels
+            if self.cluster is not None:
+                on = np.nonzero(self._clustered[pk])[0]  # corner panels: through the substitution
+                if on.size:
+                    pko = pk[on]
+                    dt_from = self._param(pko, uf[on])[0]
+                    t_from[on] = base[on] + dt_from
+                    step[on] = self._param(pko, ut[on])[0] - dt_from
             ex, er = seg.displacement(t_from, step)
             dx[mask] = self.sign[pk] * ex
             dr[mask] = er
