@@ -483,14 +483,7 @@ def _self_quadrature(key: bytes, N: int, order: int) -> PairQuadrature:
         sel = np.nonzero(key == k)[0]
         t = _self_rule_table(order, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
         qs = q[sel]
-        su = t["su"][qs]
-        lnu = np.log(np.abs(su - uq[sel, None]))
-        sw, swl = t["sw"][qs], t["swl"][qs]
-        # split nodes: w (K + ln|u - u_q| Q) + wl Q; log nodes: w Q; outer pieces: w K
-        u = np.concatenate([su, t["lu"][qs], t["fu"][qs]], axis=1)
-        a = np.concatenate([sw, np.zeros_like(t["lw"][qs]), t["fw"][qs]], axis=1)
-        b = np.concatenate([sw * lnu + swl, t["lw"][qs], np.zeros_like(t["fw"][qs])], axis=1)
-        parts.append((sel, u, a, b, t["L"][qs]))
+        parts.append((sel, t["u"][qs], t["a"][qs], t["b"][qs], t["L"][qs]))
     own = np.arange(N) // order
     return PairQuadrature.build(np.arange(N), own, order, parts, target_u=uq)
 
@@ -710,6 +703,13 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
         parts["fw"].append((a * gw01).reshape(p, -1))
     table = {k: np.concatenate(v, axis=1) for k, v in parts.items()}
     table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
+    # the rows of each node's rule as :func:`_self_quadrature` sums them: split nodes
+    # w (K + ln|u - u_q| Q) + wl Q, log nodes w Q, outer pieces w K
+    su, sw, swl, lw, fw = (table[k] for k in ("su", "sw", "swl", "lw", "fw"))
+    lnu = np.log(np.abs(su - uq))
+    table["u"] = np.concatenate([su, table["lu"], table["fu"]], axis=1)
+    table["a"] = np.concatenate([sw, np.zeros_like(lw), fw], axis=1)
+    table["b"] = np.concatenate([sw * lnu + swl, lw, np.zeros_like(fw)], axis=1)
     return table
 
 
