@@ -644,14 +644,23 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
         if cache is None:
             raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
         fix = np.repeat(plan.fixed, p)
-        fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
-        other = np.concatenate([fr, np.arange(N, X.size)])
         S, D = np.empty((N, X.size)), np.empty((N, X.size))
-        S[:, other], D[:, other] = dense(slice(None), other)
-        if fr.size:
-            S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
-        S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
-        D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
+        k = int(np.count_nonzero(fix))
+        if fix[:k].all():  # the fixed panels lead (the nose before the moving ones): blocks by slices
+            fi, fr, other = slice(0, k), slice(k, N), slice(k, None)
+            S[:, other], D[:, other] = dense(slice(None), other)
+            if k < N:
+                S[fr, fi], D[fr, fi] = dense(fr, fi)
+            S[fi, fi] = cache.S[fi, fi]
+            D[fi, fi] = cache.D[fi, fi]
+        else:
+            fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
+            other = np.concatenate([fr, np.arange(N, X.size)])
+            S[:, other], D[:, other] = dense(slice(None), other)
+            if fr.size:
+                S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
+            S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
+            D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
@@ -661,10 +670,9 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
             D[rows, cols] = Db
     if cache is not None:
         cache.store(ps, S, D)
-    mirror = ps.mirror_node_index()
-    if mirror.size:
-        S = S[:, :N] + S[:, mirror]
-        D = D[:, :N] + D[:, mirror]
+    if ps.n_panels > ps.n_primary:  # the mirror node of primary node i is node 2N - 1 - i
+        S = S[:, :N] + S[:, :N - 1:-1]
+        D = D[:, :N] + D[:, :N - 1:-1]
     # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
     # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
     # that near a corner the error follows the local variation of phi, not phi itself
