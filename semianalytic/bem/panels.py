@@ -112,11 +112,12 @@ class PanelSet:
             d2[on] = np.where(c > 0, -so * d2w, so * d2w)
         return dt, dtdu, d2
 
-    def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False):
+    def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False, split: bool = False):
         """Points and derivatives d/du at reference coordinates ``u`` of panels ``panel``.
 
         ``panel`` and ``u`` broadcast together; returns x, r, x_u, r_u (and x_uu, r_uu
-        with ``second=True``).
+        with ``second=True``; and then the four arrays of :meth:`split` with ``split=True``,
+        from the same evaluation of the curve).
         """
         panel = np.asarray(panel)
         u = np.asarray(u, dtype=float)
@@ -124,14 +125,14 @@ class PanelSet:
             panel, u = np.broadcast_arrays(panel, u)
         curves, group = self._curves
         if len(curves) == 1:
-            return self._evaluate_segment(curves[0], panel, u, second)
-        out = [np.empty(u.shape) for _ in range(6 if second else 4)]
+            return self._evaluate_segment(curves[0], panel, u, second, split)
+        out = [np.empty(u.shape) for _ in range((6 if second else 4) + (4 if split else 0))]
         for seg, mask, pk in self._by_segment(panel):
-            for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second)):
+            for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second, split)):
                 o[mask] = v
         return tuple(out)
 
-    def _evaluate_segment(self, seg, pk, u, second):
+    def _evaluate_segment(self, seg, pk, u, second, split=False):
         base, sg = self.base[pk], self.sign[pk]
         dt, half, d2t = self._param(pk, u, second)
         ex, er = seg.displacement(base, dt)
@@ -141,6 +142,8 @@ class PanelSet:
         if second:
             ddx, ddr = seg.second_derivative(base + dt)
             out += [sg * (ddx * half * half + dx * d2t), ddr * half * half + dr * d2t]
+        if split:  # as split() computes them
+            out += [sg * self.anchor_x[pk] + (sg - 1.0) * self.offset, self.anchor_r[pk], sg * ex, er]
         return tuple(out)
 
     @cached_property
@@ -262,7 +265,8 @@ class PanelSet:
     def nodes(self) -> "NodeGeometry":
         u, w = gauss_legendre(self.order)
         panel = np.repeat(np.arange(self.n_panels), self.order).reshape(self.n_panels, self.order)
-        x, r, xu, ru = self.evaluate(panel, np.broadcast_to(u, panel.shape))
+        x, r, xu, ru, *parts = self.evaluate(panel, np.broadcast_to(u, panel.shape), split=True)
+        self.__dict__["node_split"] = tuple(a.ravel() for a in parts)  # the same points: node_split for free
         J = np.hypot(xu, ru)
         return NodeGeometry(x=x, r=r, tx=xu / J, tr=ru / J, J=J, w=w * J)
 

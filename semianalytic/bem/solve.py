@@ -362,30 +362,34 @@ class PairQuadrature:
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
         pairs when the rule carries logarithms (b != 0)."""
         pan = self._point_panel
+        sel = None
+        if self.target_u is None and node_targets and ps.tiny_panels.any():
+            # targets are nodes of ps: on panels graded far below their distance from the
+            # origin, differences through the shared anchors (a corner) keep their digits
+            sel = np.nonzero(ps.tiny_panels[pan])[0]
+        tiny = sel is not None and sel.size > 0
         if self.distinct is not None:
             dpan, du, index = self.distinct
-            x, r, xu, ru = ps.evaluate(dpan, du)
+            x, r, xu, ru, *parts = ps.evaluate(dpan, du, split=tiny)
             J = np.hypot(xu, ru)
             x, r, J, nx, nr = x[index], r[index], J[index], (ru / J)[index], (-xu / J)[index]
+            at = index[sel] if tiny else None
         else:
-            x, r, xu, ru = ps.evaluate(pan, self.u)
+            x, r, xu, ru, *parts = ps.evaluate(pan, self.u, split=tiny)
             J = np.hypot(xu, ru)
             nx, nr = ru / J, -xu / J
+            at = sel
         t = self._point_target
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif node_targets and ps.tiny_panels.any():
-            # targets are nodes of ps: on panels graded far below their distance from the
-            # origin, differences through the shared anchors (a corner) keep their digits
-            sel = np.nonzero(ps.tiny_panels[pan])[0]
-            if sel.size:
-                ax, ar, ex, er = ps.split(pan[sel], self.u[sel])
-                tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
-                dx, dr = xt[t] - x, rt[t] - r
-                dx[sel] = (tax - ax) + (tex - ex)
-                dr[sel] = (tar - ar) + (ter - er)
-                delta = (dx, dr)
+        elif tiny:
+            ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
+            tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
+            dx, dr = xt[t] - x, rt[t] - r
+            dx[sel] = (tax - ax) + (tex - ex)
+            dr[sel] = (tar - ar) + (ter - er)
+            delta = (dx, dr)
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
