@@ -451,20 +451,38 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     n_l = np.where(left > 0, _levels(left, du) + 1, 0)
     n_r = np.where(right > 0, _levels(right, du) + 1, 0)
     at_end = (n_l == 0) | (n_r == 0)
-    parts = []
     key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
-    for k in np.unique(key[at_end]):
-        sel = np.nonzero(at_end & (key == k))[0]
-        u, w, lag = _end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k)))
-        uu = np.broadcast_to(u, (sel.size, u.size))
-        parts.append((sel, uu, np.broadcast_to(w, uu.shape), np.zeros(uu.shape), lag))
+    # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
+    # point's u and w gathered from the rules' concatenated points; then the other pairs
+    ends = np.nonzero(at_end)[0]
+    ends = ends[np.argsort(key[ends], kind="stable")]
+    keys, first, per_key = np.unique(key[ends], return_index=True, return_counts=True)
+    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in keys.tolist()]
+    size = np.array([r[0].size for r in rules], dtype=np.int64)
+    blocks = tuple((int(f), int(c), int(q), r[2]) for f, c, q, r in zip(first, per_key, size, rules))
+    counts = np.repeat(size, per_key)  # points of each end pair
     inner = np.nonzero(~at_end)[0]
+    if rules:
+        rule_at = np.repeat(np.cumsum(size) - size, per_key)  # each pair's rule in the concatenation
+        pair_at = np.cumsum(counts) - counts
+        src = np.repeat(rule_at - pair_at, counts) + np.arange(int(counts.sum()))
+        u_end = np.concatenate([r[0] for r in rules])[src]
+        w_end = np.concatenate([r[1] for r in rules])[src]
+    else:
+        u_end = w_end = np.empty(0)
+    flat = np.empty((0, order))
     if inner.size:
         pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
-        counts = np.bincount(pair, minlength=inner.size)
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
-        parts.append((inner, u[pts], w[pts], np.zeros(u.size), lagrange_matrix(gauss_legendre(order)[0], u[pts]), counts))
-    return PairQuadrature.build(target, panel, order, parts).with_distinct_points()
+        u, w = u[pts], w[pts]
+        flat = lagrange_matrix(gauss_legendre(order)[0], u)
+        blocks += ((ends.size, inner.size, 0, None),)
+        counts = np.concatenate([counts, np.bincount(pair, minlength=inner.size)])
+        u_end, w_end = np.concatenate([u_end, u]), np.concatenate([w_end, w])
+    order_idx = np.concatenate([ends, inner])
+    rule = PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
+                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks)
+    return rule.with_distinct_points()
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
