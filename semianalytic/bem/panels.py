@@ -79,6 +79,11 @@ class PanelSet:
         return 0.5 * (self.db - self.da)
 
     @cached_property
+    def _span(self) -> np.ndarray:
+        """Parameter span db - da of each panel."""
+        return self.db - self.da
+
+    @cached_property
     def _clustered(self) -> np.ndarray:
         """Panels with a corner substitution (a mask)."""
         return np.zeros(self.n_panels, bool) if self.cluster is None else self.cluster != 0
@@ -99,9 +104,9 @@ class PanelSet:
         on = np.nonzero(self._clustered[pk])  # the few nodes on corner panels
         if on[0].size == 0:
             return dt, half, d2
-        dtdu = np.array(np.broadcast_to(half, dt.shape), dtype=float)
+        dtdu = half.copy() if half.shape == dt.shape else np.array(np.broadcast_to(half, dt.shape), dtype=float)
         pko, uo = pk[on], u[on]
-        so = self.db[pko] - self.da[pko]
+        so = self._span[pko]
         c, q = self.cluster[pko], self.power[pko]
         lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
         w = lo**q
