@@ -338,22 +338,33 @@ class PairQuadrature:
         """First and past-the-last point of the pairs f .. f + n - 1."""
         return int(self.starts[f]), int(self.starts[f + n]) if f + n < len(self.starts) else self.u.size
 
-    def _reduce(self, wk: np.ndarray) -> np.ndarray:
-        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
-        out = np.empty((len(self.target), self.lag.shape[1]))
+    @cached_property
+    def _block_slices(self) -> tuple:
+        """Per block: (pairs, points, Q, Lagrange matrix, flat rows and reduceat offsets of a
+        block without a matrix), worked out once for the rule's every reduction."""
+        out = []
         flat_at = 0
         blocks = self.blocks or (((0, len(self.target), 0, None),) if len(self.target) else ())  # all rows flat
         for f, n, Q, lag in blocks:
-            s0 = self.starts[f]
+            s0, s1 = self._points_of(f, n)
             if lag is None:
-                s1 = self._points_of(f, n)[1]
                 rows = self.lag[flat_at:flat_at + (s1 - s0)]
                 flat_at += s1 - s0
-                out[f:f + n] = np.add.reduceat(wk[s0:s1, None] * rows, self.starts[f:f + n] - s0, axis=0)
-            elif lag.ndim == 2:
-                out[f:f + n] = wk[s0:s0 + n * Q].reshape(n, Q) @ lag
+                out.append((slice(f, f + n), slice(s0, s1), Q, None, rows, self.starts[f:f + n] - s0))
             else:
-                out[f:f + n] = np.matmul(wk[s0:s0 + n * Q].reshape(n, 1, Q), lag)[:, 0, :]
+                out.append((slice(f, f + n), slice(s0, s0 + n * Q), Q, lag, None, n))
+        return tuple(out)
+
+    def _reduce(self, wk: np.ndarray) -> np.ndarray:
+        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
+        out = np.empty((len(self.target), self.lag.shape[1]))
+        for pairs, points, Q, lag, rows, at in self._block_slices:
+            if lag is None:
+                out[pairs] = np.add.reduceat(wk[points, None] * rows, at, axis=0)
+            elif lag.ndim == 2:
+                out[pairs] = wk[points].reshape(at, Q) @ lag
+            else:
+                out[pairs] = np.matmul(wk[points].reshape(at, 1, Q), lag)[:, 0, :]
         return out
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
