@@ -628,10 +628,12 @@ class AssemblyCache:
         out[:n] = close & wclose
         return out
 
-    def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray) -> None:
+    def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray, copy: bool = True) -> None:
+        """Keep the primary block of S and D (``copy=False``: views, for a caller that no longer
+        writes to S and D)."""
         N = ps.n_primary * ps.order
         self.nodes = self._signature(ps)
-        self.S, self.D = S[:, :N].copy(), D[:, :N].copy()
+        self.S, self.D = (S[:, :N].copy(), D[:, :N].copy()) if copy else (S[:, :N], D[:, :N])
 
 
 def _layers(X, R, x, r, nx, nr, delta=None):
@@ -701,9 +703,10 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
             cols = rule.panel[:, None] * p + np.arange(p)[None, :]
             S[rows, cols] = Sb
             D[rows, cols] = Db
+    mirrored = ps.n_panels > ps.n_primary
     if cache is not None:
-        cache.store(ps, S, D)
-    if ps.n_panels > ps.n_primary:  # the mirror node of primary node i is node 2N - 1 - i
+        cache.store(ps, S, D, copy=not mirrored)  # folding the mirror columns makes new matrices
+    if mirrored:  # the mirror node of primary node i is node 2N - 1 - i
         S = S[:, :N] + S[:, :N - 1:-1]
         D = D[:, :N] + D[:, :N - 1:-1]
     # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
@@ -756,6 +759,14 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
 
 # ------------------------------------------------------------------------------------
 # solution
+
+
+@functools.cache
+def _tip_row(order: int) -> np.ndarray:
+    """The Lagrange basis of a panel's Gauss nodes at u = -1 (its first end)."""
+    row = lagrange_matrix(gauss_legendre(order)[0], np.array([-1.0]))[0]
+    row.setflags(write=False)
+    return row
 
 
 @dataclass(frozen=True)
@@ -846,8 +857,7 @@ class SurfaceSolution:
     @property
     def phi_tip(self) -> float:
         """phi at the front pole (the nose tip): the first panel's interpolant at u = -1."""
-        u, _ = gauss_legendre(self.panels.order)
-        return float(lagrange_matrix(u, np.array([-1.0]))[0] @ self.phi_nodes[0])
+        return float(_tip_row(self.panels.order) @ self.phi_nodes[0])
 
     # --- field ------------------------------------------------------------------------
 
@@ -939,8 +949,10 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
+    A = -D
+    A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
     with _single_threaded_blas():
-        phi = scipy.linalg.solve(0.5 * np.eye(S.shape[0]) - D, -S @ g, overwrite_a=True, check_finite=False)
+        phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
     if not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
