@@ -108,9 +108,9 @@ class PanelSet:
         pko, uo = pk[on], u[on]
         so = self._span[pko]
         c, q = self.cluster[pko], self.power[pko]
-        lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
-        w = lo**q
-        dt[on] = np.where(c > 0, self.db[pko] - so * w, da[on] + so * w)
+        lo = 0.5 * (1.0 - c * uo)  # distance from the corner end: (1 + u)/2 (c = -1) or (1 - u)/2 (c = +1)
+        sw = so * lo**q
+        dt[on] = np.where(c > 0, self.db[pko] - sw, da[on] + sw)
         dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
         if second:
             d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)
