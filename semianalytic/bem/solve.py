@@ -245,6 +245,16 @@ class PairQuadrature:
     def _point_target(self) -> np.ndarray:
         return self.target[self.pair]
 
+    def entries(self, order: int, columns: int) -> np.ndarray:
+        """Flat indices, in a C-ordered matrix of ``columns`` columns, of the (target, node)
+        entries of each pair's block (n_pairs, order): row target, columns panel * order + j
+        (kept per rule: the solves of a difference in P share it)."""
+        key = (order, columns)
+        got = self.__dict__.setdefault("_entries", {})
+        if key not in got:
+            got[key] = (self.target[:, None] * columns + self.panel[:, None] * order + np.arange(order)[None, :]).ravel()
+        return got[key]
+
     def with_distinct_points(self) -> "PairQuadrature":
         """This rule with :attr:`distinct` set: the points of the pairs of a shared end rule
         (a block with one (Q, p) matrix) on one panel are one set (this project's own
@@ -699,10 +709,9 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
-            rows = rule.target[:, None]
-            cols = rule.panel[:, None] * p + np.arange(p)[None, :]
-            S[rows, cols] = Sb
-            D[rows, cols] = Db
+            flat = rule.entries(p, S.shape[1])
+            S.put(flat, Sb)
+            D.put(flat, Db)
     mirrored = ps.n_panels > ps.n_primary
     if cache is not None:
         cache.store(ps, S, D, copy=not mirrored)  # folding the mirror columns makes new matrices
