@@ -735,35 +735,50 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
     piece carries the log split (Gauss-Legendre nodes for the smooth part with weights w
     and wl = -ln(piece length) w, and -ln(s) Gauss nodes for the logarithm); the outer
     pieces integrate the full kernel.  Returns arrays indexed by q, and the Lagrange
-    matrices of each node set.
+    matrices of each node set.  The two sides are built once per level (:func:`_self_side`)
+    and joined here.
     """
+    right, left = _self_side(p, 1.0, lev_right, n), _self_side(p, -1.0, lev_left, n)
+    table = {k: np.concatenate([right[k], left[k]], axis=1) for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
+    order = [(side, k) for k in ("su", "lu", "fu") for side in (right, left)]  # points: su, lu, fu; right, left
+    table["L"] = np.concatenate([side["L" + k] for side, k in order], axis=1)
+    # the rows of each node's rule as :func:`_self_quadrature` sums them: split nodes
+    # w (K + ln|u - u_q| Q) + wl Q, log nodes w Q, outer pieces w K
+    su, sw, swl, lw, fw = (table[k] for k in ("su", "sw", "swl", "lw", "fw"))
+    lnu = np.concatenate([right["lnu"], left["lnu"]], axis=1)
+    table["u"] = np.concatenate([su, table["lu"], table["fu"]], axis=1)
+    table["a"] = np.concatenate([sw, np.zeros_like(lw), fw], axis=1)
+    table["b"] = np.concatenate([sw * lnu + swl, lw, np.zeros_like(fw)], axis=1)
+    return table
+
+
+@functools.cache
+def _self_side(p: int, sign: float, lev: int, n: int):
+    """One side of :func:`_self_rule_table` (sign +1: [u_q, 1], -1: [-1, u_q]) with ``lev``
+    levels, for all p nodes at once: the points, weights, ln|u - u_q| at the split nodes and
+    the Lagrange matrices of each node set."""
     uq_all, _ = gauss_legendre(p)
     g, gw = gauss_legendre(n)
     g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
     t01, tw01 = gauss_log(n)
     uq = uq_all[:, None]
-    parts = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
-    for h, sign, lev in ((1.0 - uq_all, 1.0, lev_right), (1.0 + uq_all, -1.0, lev_left)):  # all nodes at once
-        inner = (h * 2.0**-lev)[:, None]
-        neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
-        parts["su"].append(uq + sign * inner * g01)
-        parts["sw"].append(inner * gw01)
-        parts["swl"].append(neglog * inner * gw01)
-        parts["lu"].append(uq + sign * inner * t01)
-        parts["lw"].append(inner * tw01)
-        a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
-        parts["fu"].append((uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1))
-        parts["fw"].append((a * gw01).reshape(p, -1))
-    table = {k: np.concatenate(v, axis=1) for k, v in parts.items()}
-    table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
-    # the rows of each node's rule as :func:`_self_quadrature` sums them: split nodes
-    # w (K + ln|u - u_q| Q) + wl Q, log nodes w Q, outer pieces w K
-    su, sw, swl, lw, fw = (table[k] for k in ("su", "sw", "swl", "lw", "fw"))
-    lnu = np.log(np.abs(su - uq))
-    table["u"] = np.concatenate([su, table["lu"], table["fu"]], axis=1)
-    table["a"] = np.concatenate([sw, np.zeros_like(lw), fw], axis=1)
-    table["b"] = np.concatenate([sw * lnu + swl, lw, np.zeros_like(fw)], axis=1)
-    return table
+    h = 1.0 - uq_all if sign > 0 else 1.0 + uq_all
+    inner = (h * 2.0**-lev)[:, None]
+    neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
+    a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
+    side = {
+        "su": uq + sign * inner * g01,
+        "sw": inner * gw01,
+        "swl": neglog * inner * gw01,
+        "lu": uq + sign * inner * t01,
+        "lw": inner * tw01,
+        "fu": (uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1),
+        "fw": (a * gw01).reshape(p, -1),
+    }
+    for k in ("su", "lu", "fu"):
+        side["L" + k] = lagrange_matrix(uq_all, side[k])
+    side["lnu"] = np.log(np.abs(side["su"] - uq))
+    return side
 
 
 # ------------------------------------------------------------------------------------
