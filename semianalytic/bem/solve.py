@@ -587,7 +587,7 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     if close.size:
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
-    mapped = np.nonzero(np.isin(own_panel, ps.mapped))[0]
+    mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels (ps.mapped)
     if mapped.size:
         # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
         # the node; keep the self rule's innermost pieces within half of that
