@@ -79,6 +79,11 @@ class PanelSet:
         return 0.5 * (self.db - self.da)
 
     @cached_property
+    def _span(self) -> np.ndarray:
+        """Parameter span db - da of each panel."""
+        return self.db - self.da
+
+    @cached_property
     def _clustered(self) -> np.ndarray:
         """Panels with a corner substitution (a mask)."""
         return np.zeros(self.n_panels, bool) if self.cluster is None else self.cluster != 0
@@ -99,24 +104,25 @@ class PanelSet:
         on = np.nonzero(self._clustered[pk])  # the few nodes on corner panels
         if on[0].size == 0:
             return dt, half, d2
-        dtdu = np.array(np.broadcast_to(half, dt.shape), dtype=float)
+        dtdu = half.copy() if half.shape == dt.shape else np.array(np.broadcast_to(half, dt.shape), dtype=float)
         pko, uo = pk[on], u[on]
-        so = self.db[pko] - self.da[pko]
+        so = self._span[pko]
         c, q = self.cluster[pko], self.power[pko]
-        lo = np.where(c < 0, 0.5 * (1.0 + uo), 0.5 * (1.0 - uo))  # distance from the corner end
-        w = lo**q
-        dt[on] = np.where(c > 0, self.db[pko] - so * w, da[on] + so * w)
+        lo = 0.5 * (1.0 - c * uo)  # distance from the corner end: (1 + u)/2 (c = -1) or (1 - u)/2 (c = +1)
+        sw = so * lo**q
+        dt[on] = np.where(c > 0, self.db[pko] - sw, da[on] + sw)
         dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
         if second:
             d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)
             d2[on] = np.where(c > 0, -so * d2w, so * d2w)
         return dt, dtdu, d2
 
-    def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False):
+    def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False, split: bool = False):
         """Points and derivatives d/du at reference coordinates ``u`` of panels ``panel``.
 
         ``panel`` and ``u`` broadcast together; returns x, r, x_u, r_u (and x_uu, r_uu
-        with ``second=True``).
+        with ``second=True``; and then the four arrays of :meth:`split` with ``split=True``,
+        from the same evaluation of the curve).
         """
         panel = np.asarray(panel)
         u = np.asarray(u, dtype=float)
@@ -124,14 +130,14 @@ class PanelSet:
             panel, u = np.broadcast_arrays(panel, u)
         curves, group = self._curves
         if len(curves) == 1:
-            return self._evaluate_segment(curves[0], panel, u, second)
-        out = [np.empty(u.shape) for _ in range(6 if second else 4)]
+            return self._evaluate_segment(curves[0], panel, u, second, split)
+        out = [np.empty(u.shape) for _ in range((6 if second else 4) + (4 if split else 0))]
         for seg, mask, pk in self._by_segment(panel):
-            for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second)):
+            for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second, split)):
                 o[mask] = v
         return tuple(out)
 
-    def _evaluate_segment(self, seg, pk, u, second):
+    def _evaluate_segment(self, seg, pk, u, second, split=False):
         base, sg = self.base[pk], self.sign[pk]
         dt, half, d2t = self._param(pk, u, second)
         ex, er = seg.displacement(base, dt)
@@ -141,6 +147,8 @@ class PanelSet:
         if second:
             ddx, ddr = seg.second_derivative(base + dt)
             out += [sg * (ddx * half * half + dx * d2t), ddr * half * half + dr * d2t]
+        if split:  # as split() computes them
+            out += [sg * self.anchor_x[pk] + (sg - 1.0) * self.offset, self.anchor_r[pk], sg * ex, er]
         return tuple(out)
 
     @cached_property
@@ -167,7 +175,7 @@ class PanelSet:
         """(curve, mask into ``panel``, the panels on that curve) for each curve used."""
         curves, group = self._curves
         if len(curves) == 1:
-            yield curves[0], np.ones(panel.shape, bool), panel
+            yield curves[0], slice(None), panel  # every point: a view, not a masked copy
             return
         seg_of = group[panel]
         for s, seg in enumerate(curves):
@@ -213,14 +221,17 @@ class PanelSet:
         dr = np.empty(u_from.shape)
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
-            t_from = self.base[pk] + self.da[pk] + half * (u_from[mask] + 1.0)
-            step = half * (u_to[mask] - u_from[mask])  # exact for plain panels
-            if self.cluster is not None and np.any(self.cluster[pk] != 0):
-                dt_from = self._param(pk, u_from[mask])[0]
-                dt_to = self._param(pk, u_to[mask])[0]
-                on = self.cluster[pk] != 0
-                t_from = np.where(on, self.base[pk] + dt_from, t_from)
-                step = np.where(on, dt_to - dt_from, step)
+            uf, ut = u_from[mask], u_to[mask]
+            base = self.base[pk]
+            t_from = base + self.da[pk] + half * (uf + 1.0)
+            step = half * (ut - uf)  # exact for plain panels
+            if self.cluster is not None:
+                on = np.nonzero(self._clustered[pk])[0]  # corner panels: through the substitution
+                if on.size:
+                    pko = pk[on]
+                    dt_from = self._param(pko, uf[on])[0]
+                    t_from[on] = base[on] + dt_from
+                    step[on] = self._param(pko, ut[on])[0] - dt_from
             ex, er = seg.displacement(t_from, step)
             dx[mask] = self.sign[pk] * ex
             dr[mask] = er
@@ -259,7 +270,8 @@ class PanelSet:
     def nodes(self) -> "NodeGeometry":
         u, w = gauss_legendre(self.order)
         panel = np.repeat(np.arange(self.n_panels), self.order).reshape(self.n_panels, self.order)
-        x, r, xu, ru = self.evaluate(panel, np.broadcast_to(u, panel.shape))
+        x, r, xu, ru, *parts = self.evaluate(panel, np.broadcast_to(u, panel.shape), split=True)
+        self.__dict__["node_split"] = tuple(a.ravel() for a in parts)  # the same points: node_split for free
         J = np.hypot(xu, ru)
         return NodeGeometry(x=x, r=r, tx=xu / J, tr=ru / J, J=J, w=w * J)
 

@@ -28,6 +28,7 @@ pairs with dyadically graded rules; assembly vectorised over all pairs.
 from __future__ import annotations
 
 import contextlib
+import dataclasses
 import functools
 import math
 import threading
@@ -157,6 +158,13 @@ def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.n
     panel mask): pairs of both masks are left out (their block is reused, see
     :class:`AssemblyCache`).
     """
+    return _near_pairs_with(ps, xt, rt, exclude_panel, exclude_block)[:4]
+
+
+def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=None, also=None):
+    """:func:`near_pairs`, and the nearest points of the further queries ``also`` = (panel,
+    x, r) if given (fifth and sixth outputs, u and du): all found by one call of
+    :func:`closest_points` (the same numbers as separate calls, a third of the calls)."""
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
     near = np.hypot(xt[:, None] - cx[None, :], rt[:, None] - cr[None, :]) < reach
@@ -170,16 +178,23 @@ def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.n
         near &= ~skip
         near_img &= ~skip
     tgt, pan = np.nonzero(near | near_img)
-    if tgt.size == 0:
-        return tgt, pan, np.empty(0), np.empty(0)
-    u, du = closest_points(ps, pan, xt[tgt], rt[tgt])
     img = np.nonzero(near_img[tgt, pan])[0]
-    if img.size:
-        u_img, du_img = closest_points(ps, pan[img], xt[tgt[img]], -rt[tgt[img]])
+    n, m = tgt.size, img.size
+    if also is None:
+        also = (np.empty(0, int), np.empty(0), np.empty(0))
+    qp = np.concatenate([pan, pan[img], also[0]])
+    if qp.size == 0:
+        return tgt, pan, np.empty(0), np.empty(0), np.empty(0), np.empty(0)
+    qx = np.concatenate([xt[tgt], xt[tgt[img]], also[1]])
+    qr = np.concatenate([rt[tgt], -rt[tgt[img]], also[2]])
+    uq, duq = closest_points(ps, qp, qx, qr)
+    u, du = uq[:n], duq[:n]
+    if m:
+        u_img, du_img = uq[n:n + m], duq[n:n + m]
         use = du_img < du[img]
         u[img[use]] = u_img[use]
         du[img[use]] = du_img[use]
-    return tgt, pan, u, du
+    return tgt, pan, u, du, uq[n + m:], duq[n + m:]
 
 
 def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
@@ -217,6 +232,52 @@ class PairQuadrature:
     lag: np.ndarray  # (points of the blocks without a matrix, p)
     target_u: np.ndarray | None = None  # self rules: the target's own panel coordinate
     blocks: tuple = ()
+    # distinct points (panel, u) and the distinct point of each point: the pairs of one end rule
+    # on one panel (the nodes of its neighbour) share their points, whose geometry is then
+    # evaluated once (None: every point evaluated)
+    distinct: tuple | None = None
+
+    @cached_property
+    def _point_panel(self) -> np.ndarray:
+        return self.panel[self.pair]
+
+    @cached_property
+    def _point_target(self) -> np.ndarray:
+        return self.target[self.pair]
+
+    def entries(self, order: int, columns: int) -> np.ndarray:
+        """Flat indices, in a C-ordered matrix of ``columns`` columns, of the (target, node)
+        entries of each pair's block (n_pairs, order): row target, columns panel * order + j
+        (kept per rule: the solves of a difference in P share it)."""
+        key = (order, columns)
+        got = self.__dict__.setdefault("_entries", {})
+        if key not in got:
+            got[key] = (self.target[:, None] * columns + self.panel[:, None] * order + np.arange(order)[None, :]).ravel()
+        return got[key]
+
+    def with_distinct_points(self) -> "PairQuadrature":
+        """This rule with :attr:`distinct` set: the points of the pairs of a shared end rule
+        (a block with one (Q, p) matrix) on one panel are one set (this project's own
+        shortcut: the geometry is evaluated at a fifth to a ninth of the points, the same
+        numbers)."""
+        if not self.blocks or self.target_u is not None:
+            return self
+        npairs, npoints = len(self.target), self.u.size
+        shared = np.zeros(npairs, bool)
+        block = np.empty(npairs, dtype=np.int64)
+        for k, (f, n, _, lag) in enumerate(self.blocks):
+            block[f:f + n] = k
+            shared[f:f + n] = lag is not None and lag.ndim == 2
+        span = int(self.panel.max()) + 1
+        key = np.where(shared, block * span + self.panel, len(self.blocks) * span + np.arange(npairs))
+        _, first, inv = np.unique(key, return_index=True, return_inverse=True)
+        counts = np.diff(np.append(self.starts, npoints))
+        size = counts[first]
+        at = np.cumsum(size) - size  # first distinct point of each distinct pair
+        src = np.repeat(self.starts[first] - at, size) + np.arange(int(size.sum()))
+        within = np.arange(npoints) - self.starts[self.pair]
+        distinct = (self.panel[self.pair[src]], self.u[src], at[inv.ravel()][self.pair] + within)
+        return dataclasses.replace(self, distinct=distinct)
 
     @staticmethod
     def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
@@ -287,22 +348,33 @@ class PairQuadrature:
         """First and past-the-last point of the pairs f .. f + n - 1."""
         return int(self.starts[f]), int(self.starts[f + n]) if f + n < len(self.starts) else self.u.size
 
-    def _reduce(self, wk: np.ndarray) -> np.ndarray:
-        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
-        out = np.empty((len(self.target), self.lag.shape[1]))
+    @cached_property
+    def _block_slices(self) -> tuple:
+        """Per block: (pairs, points, Q, Lagrange matrix, flat rows and reduceat offsets of a
+        block without a matrix), worked out once for the rule's every reduction."""
+        out = []
         flat_at = 0
         blocks = self.blocks or (((0, len(self.target), 0, None),) if len(self.target) else ())  # all rows flat
         for f, n, Q, lag in blocks:
-            s0 = self.starts[f]
+            s0, s1 = self._points_of(f, n)
             if lag is None:
-                s1 = self._points_of(f, n)[1]
                 rows = self.lag[flat_at:flat_at + (s1 - s0)]
                 flat_at += s1 - s0
-                out[f:f + n] = np.add.reduceat(wk[s0:s1, None] * rows, self.starts[f:f + n] - s0, axis=0)
-            elif lag.ndim == 2:
-                out[f:f + n] = wk[s0:s0 + n * Q].reshape(n, Q) @ lag
+                out.append((slice(f, f + n), slice(s0, s1), Q, None, rows, self.starts[f:f + n] - s0))
             else:
-                out[f:f + n] = np.matmul(wk[s0:s0 + n * Q].reshape(n, 1, Q), lag)[:, 0, :]
+                out.append((slice(f, f + n), slice(s0, s0 + n * Q), Q, lag, None, n))
+        return tuple(out)
+
+    def _reduce(self, wk: np.ndarray) -> np.ndarray:
+        """Sum of each pair's weighted kernel values against the Lagrange basis: (n_pairs, p)."""
+        out = np.empty((len(self.target), self.lag.shape[1]))
+        for pairs, points, Q, lag, rows, at in self._block_slices:
+            if lag is None:
+                out[pairs] = np.add.reduceat(wk[points, None] * rows, at, axis=0)
+            elif lag.ndim == 2:
+                out[pairs] = wk[points].reshape(at, Q) @ lag
+            else:
+                out[pairs] = np.matmul(wk[points].reshape(at, 1, Q), lag)[:, 0, :]
         return out
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
@@ -310,26 +382,37 @@ class PairQuadrature:
 
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
         pairs when the rule carries logarithms (b != 0)."""
-        pan = self.panel[self.pair]
-        x, r, xu, ru = ps.evaluate(pan, self.u)
-        J = np.hypot(xu, ru)
-        t = self.target[self.pair]
-        delta = None
-        if self.target_u is not None:  # target and source on one panel: exact differences
-            delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif node_targets and ps.tiny_panels.any():
+        pan = self._point_panel
+        sel = None
+        if self.target_u is None and node_targets and ps.tiny_panels.any():
             # targets are nodes of ps: on panels graded far below their distance from the
             # origin, differences through the shared anchors (a corner) keep their digits
             sel = np.nonzero(ps.tiny_panels[pan])[0]
-            if sel.size:
-                ax, ar, ex, er = ps.split(pan[sel], self.u[sel])
-                tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
-                dx, dr = xt[t] - x, rt[t] - r
-                dx[sel] = (tax - ax) + (tex - ex)
-                dr[sel] = (tar - ar) + (ter - er)
-                delta = (dx, dr)
+        tiny = sel is not None and sel.size > 0
+        if self.distinct is not None:
+            dpan, du, index = self.distinct
+            x, r, xu, ru, *parts = ps.evaluate(dpan, du, split=tiny)
+            J = np.hypot(xu, ru)
+            x, r, J, nx, nr = x[index], r[index], J[index], (ru / J)[index], (-xu / J)[index]
+            at = index[sel] if tiny else None
+        else:
+            x, r, xu, ru, *parts = ps.evaluate(pan, self.u, split=tiny)
+            J = np.hypot(xu, ru)
+            nx, nr = ru / J, -xu / J
+            at = sel
+        t = self._point_target
+        delta = None
+        if self.target_u is not None:  # target and source on one panel: exact differences
+            delta = ps.relative(pan, self.u, self.target_u[self.pair])
+        elif tiny:
+            ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
+            tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
+            dx, dr = xt[t] - x, rt[t] - r
+            dx[sel] = (tax - ax) + (tex - ex)
+            dr[sel] = (tar - ar) + (ter - er)
+            delta = (dx, dr)
         out = []
-        for ker in kernels(xt[t], rt[t], x, r, ru / J, -xu / J, delta):
+        for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
                 K, Q = ker
                 wk = (self.a * K + self.b * Q) * J
@@ -389,20 +472,38 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     n_l = np.where(left > 0, _levels(left, du) + 1, 0)
     n_r = np.where(right > 0, _levels(right, du) + 1, 0)
     at_end = (n_l == 0) | (n_r == 0)
-    parts = []
     key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
-    for k in np.unique(key[at_end]):
-        sel = np.nonzero(at_end & (key == k))[0]
-        u, w, lag = _end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k)))
-        uu = np.broadcast_to(u, (sel.size, u.size))
-        parts.append((sel, uu, np.broadcast_to(w, uu.shape), np.zeros(uu.shape), lag))
+    # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
+    # point's u and w gathered from the rules' concatenated points; then the other pairs
+    ends = np.nonzero(at_end)[0]
+    ends = ends[np.argsort(key[ends], kind="stable")]
+    keys, first, per_key = np.unique(key[ends], return_index=True, return_counts=True)
+    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in keys.tolist()]
+    size = np.array([r[0].size for r in rules], dtype=np.int64)
+    blocks = tuple((int(f), int(c), int(q), r[2]) for f, c, q, r in zip(first, per_key, size, rules))
+    counts = np.repeat(size, per_key)  # points of each end pair
     inner = np.nonzero(~at_end)[0]
+    if rules:
+        rule_at = np.repeat(np.cumsum(size) - size, per_key)  # each pair's rule in the concatenation
+        pair_at = np.cumsum(counts) - counts
+        src = np.repeat(rule_at - pair_at, counts) + np.arange(int(counts.sum()))
+        u_end = np.concatenate([r[0] for r in rules])[src]
+        w_end = np.concatenate([r[1] for r in rules])[src]
+    else:
+        u_end = w_end = np.empty(0)
+    flat = np.empty((0, order))
     if inner.size:
         pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
-        counts = np.bincount(pair, minlength=inner.size)
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
-        parts.append((inner, u[pts], w[pts], np.zeros(u.size), lagrange_matrix(gauss_legendre(order)[0], u[pts]), counts))
-    return PairQuadrature.build(target, panel, order, parts)
+        u, w = u[pts], w[pts]
+        flat = lagrange_matrix(gauss_legendre(order)[0], u)
+        blocks += ((ends.size, inner.size, 0, None),)
+        counts = np.concatenate([counts, np.bincount(pair, minlength=inner.size)])
+        u_end, w_end = np.concatenate([u_end, u]), np.concatenate([w_end, w])
+    order_idx = np.concatenate([ends, inner])
+    rule = PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
+                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks)
+    return rule.with_distinct_points()
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
@@ -425,14 +526,7 @@ def _self_quadrature(key: bytes, N: int, order: int) -> PairQuadrature:
         sel = np.nonzero(key == k)[0]
         t = _self_rule_table(order, int(k // (MAX_LEVELS + 1)), int(k % (MAX_LEVELS + 1)))
         qs = q[sel]
-        su = t["su"][qs]
-        lnu = np.log(np.abs(su - uq[sel, None]))
-        sw, swl = t["sw"][qs], t["swl"][qs]
-        # split nodes: w (K + ln|u - u_q| Q) + wl Q; log nodes: w Q; outer pieces: w K
-        u = np.concatenate([su, t["lu"][qs], t["fu"][qs]], axis=1)
-        a = np.concatenate([sw, np.zeros_like(t["lw"][qs]), t["fw"][qs]], axis=1)
-        b = np.concatenate([sw * lnu + swl, t["lw"][qs], np.zeros_like(t["fw"][qs])], axis=1)
-        parts.append((sel, u, a, b, t["L"][qs]))
+        parts.append((sel, t["u"][qs], t["a"][qs], t["b"][qs], t["L"][qs]))
     own = np.arange(N) // order
     return PairQuadrature.build(np.arange(N), own, order, parts, target_u=uq)
 
@@ -484,11 +578,16 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     free_node = np.ones(N, bool) if fixed is None else ~fixed[own_panel]
     close = np.nonzero(free_node & (np.hypot(xt - cx[own_panel], rt + cr[own_panel])
                                     < (IMAGE_MARGIN + 1) * ps.lengths[own_panel]))[0]
+    block = None
+    if fixed is not None:
+        block = (~free_node, np.concatenate([fixed, np.zeros(ps.n_panels - ps.n_primary, bool)]))
+    # the near pairs and the self pairs' axis images: one search of the nearest points
+    tgt, pan, ustar, du, _, du_img = _near_pairs_with(ps, xt, rt, own_panel, block,
+                                                      (own_panel[close], xt[close], -rt[close]))
     if close.size:
-        _, du_img = closest_points(ps, own_panel[close], xt[close], -rt[close])
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
-    mapped = np.nonzero(np.isin(own_panel, ps.mapped))[0]
+    mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels (ps.mapped)
     if mapped.size:
         # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
         # the node; keep the self rule's innermost pieces within half of that
@@ -496,10 +595,6 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
         gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
         levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
         levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
-    block = None
-    if fixed is not None:
-        block = (~free_node, np.concatenate([fixed, np.zeros(ps.n_panels - ps.n_primary, bool)]))
-    tgt, pan, ustar, du = near_pairs(ps, xt, rt, exclude_panel=own_panel, exclude_block=block)
     self_rule = self_quadrature(levels, p)
     if fixed is not None:
         self_rule = self_rule.subset(free_node[self_rule.target])
@@ -543,10 +638,12 @@ class AssemblyCache:
         out[:n] = close & wclose
         return out
 
-    def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray) -> None:
+    def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray, copy: bool = True) -> None:
+        """Keep the primary block of S and D (``copy=False``: views, for a caller that no longer
+        writes to S and D)."""
         N = ps.n_primary * ps.order
         self.nodes = self._signature(ps)
-        self.S, self.D = S[:, :N].copy(), D[:, :N].copy()
+        self.S, self.D = (S[:, :N].copy(), D[:, :N].copy()) if copy else (S[:, :N], D[:, :N])
 
 
 def _layers(X, R, x, r, nx, nr, delta=None):
@@ -584,27 +681,35 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
         if cache is None:
             raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
         fix = np.repeat(plan.fixed, p)
-        fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
-        other = np.concatenate([fr, np.arange(N, X.size)])
         S, D = np.empty((N, X.size)), np.empty((N, X.size))
-        S[:, other], D[:, other] = dense(slice(None), other)
-        if fr.size:
-            S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
-        S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
-        D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
+        k = int(np.count_nonzero(fix))
+        if fix[:k].all():  # the fixed panels lead (the nose before the moving ones): blocks by slices
+            fi, fr, other = slice(0, k), slice(k, N), slice(k, None)
+            S[:, other], D[:, other] = dense(slice(None), other)
+            if k < N:
+                S[fr, fi], D[fr, fi] = dense(fr, fi)
+            S[fi, fi] = cache.S[fi, fi]
+            D[fi, fi] = cache.D[fi, fi]
+        else:
+            fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
+            other = np.concatenate([fr, np.arange(N, X.size)])
+            S[:, other], D[:, other] = dense(slice(None), other)
+            if fr.size:
+                S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
+            S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
+            D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
-            rows = rule.target[:, None]
-            cols = rule.panel[:, None] * p + np.arange(p)[None, :]
-            S[rows, cols] = Sb
-            D[rows, cols] = Db
+            flat = rule.entries(p, S.shape[1])
+            S.put(flat, Sb)
+            D.put(flat, Db)
+    mirrored = ps.n_panels > ps.n_primary
     if cache is not None:
-        cache.store(ps, S, D)
-    mirror = ps.mirror_node_index()
-    if mirror.size:
-        S = S[:, :N] + S[:, mirror]
-        D = D[:, :N] + D[:, mirror]
+        cache.store(ps, S, D, copy=not mirrored)  # folding the mirror columns makes new matrices
+    if mirrored:  # the mirror node of primary node i is node 2N - 1 - i
+        S = S[:, :N] + S[:, :N - 1:-1]
+        D = D[:, :N] + D[:, :N - 1:-1]
     # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
     # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
     # that near a corner the error follows the local variation of phi, not phi itself
@@ -622,32 +727,62 @@ def _self_rule_table(p: int, lev_right: int, lev_left: int, n: int = N_SELF):
     piece carries the log split (Gauss-Legendre nodes for the smooth part with weights w
     and wl = -ln(piece length) w, and -ln(s) Gauss nodes for the logarithm); the outer
     pieces integrate the full kernel.  Returns arrays indexed by q, and the Lagrange
-    matrices of each node set.
+    matrices of each node set.  The two sides are built once per level (:func:`_self_side`)
+    and joined here.
     """
+    right, left = _self_side(p, 1.0, lev_right, n), _self_side(p, -1.0, lev_left, n)
+    table = {k: np.concatenate([right[k], left[k]], axis=1) for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
+    order = [(side, k) for k in ("su", "lu", "fu") for side in (right, left)]  # points: su, lu, fu; right, left
+    table["L"] = np.concatenate([side["L" + k] for side, k in order], axis=1)
+    # the rows of each node's rule as :func:`_self_quadrature` sums them: split nodes
+    # w (K + ln|u - u_q| Q) + wl Q, log nodes w Q, outer pieces w K
+    su, sw, swl, lw, fw = (table[k] for k in ("su", "sw", "swl", "lw", "fw"))
+    lnu = np.concatenate([right["lnu"], left["lnu"]], axis=1)
+    table["u"] = np.concatenate([su, table["lu"], table["fu"]], axis=1)
+    table["a"] = np.concatenate([sw, np.zeros_like(lw), fw], axis=1)
+    table["b"] = np.concatenate([sw * lnu + swl, lw, np.zeros_like(fw)], axis=1)
+    return table
+
+
+@functools.cache
+def _self_side(p: int, sign: float, lev: int, n: int):
+    """One side of :func:`_self_rule_table` (sign +1: [u_q, 1], -1: [-1, u_q]) with ``lev``
+    levels, for all p nodes at once: the points, weights, ln|u - u_q| at the split nodes and
+    the Lagrange matrices of each node set."""
     uq_all, _ = gauss_legendre(p)
     g, gw = gauss_legendre(n)
     g01, gw01 = 0.5 * (g + 1.0), 0.5 * gw
     t01, tw01 = gauss_log(n)
     uq = uq_all[:, None]
-    parts = {k: [] for k in ("su", "sw", "swl", "lu", "lw", "fu", "fw")}
-    for h, sign, lev in ((1.0 - uq_all, 1.0, lev_right), (1.0 + uq_all, -1.0, lev_left)):  # all nodes at once
-        inner = (h * 2.0**-lev)[:, None]
-        neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
-        parts["su"].append(uq + sign * inner * g01)
-        parts["sw"].append(inner * gw01)
-        parts["swl"].append(neglog * inner * gw01)
-        parts["lu"].append(uq + sign * inner * t01)
-        parts["lw"].append(inner * tw01)
-        a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
-        parts["fu"].append((uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1))
-        parts["fw"].append((a * gw01).reshape(p, -1))
-    table = {k: np.concatenate(v, axis=1) for k, v in parts.items()}
-    table["L"] = lagrange_matrix(uq_all, np.concatenate([table["su"], table["lu"], table["fu"]], axis=1))
-    return table
+    h = 1.0 - uq_all if sign > 0 else 1.0 + uq_all
+    inner = (h * 2.0**-lev)[:, None]
+    neglog = np.array([-math.log(v) for v in inner[:, 0]])[:, None]
+    a = (h[:, None] * 2.0 ** -np.arange(lev, 0, -1.0))[:, :, None]  # outer pieces, innermost first
+    side = {
+        "su": uq + sign * inner * g01,
+        "sw": inner * gw01,
+        "swl": neglog * inner * gw01,
+        "lu": uq + sign * inner * t01,
+        "lw": inner * tw01,
+        "fu": (uq[:, :, None] + sign * (a + a * g01)).reshape(p, -1),
+        "fw": (a * gw01).reshape(p, -1),
+    }
+    for k in ("su", "lu", "fu"):
+        side["L" + k] = lagrange_matrix(uq_all, side[k])
+    side["lnu"] = np.log(np.abs(side["su"] - uq))
+    return side
 
 
 # ------------------------------------------------------------------------------------
 # solution
+
+
+@functools.cache
+def _tip_row(order: int) -> np.ndarray:
+    """The Lagrange basis of a panel's Gauss nodes at u = -1 (its first end)."""
+    row = lagrange_matrix(gauss_legendre(order)[0], np.array([-1.0]))[0]
+    row.setflags(write=False)
+    return row
 
 
 @dataclass(frozen=True)
@@ -738,8 +873,7 @@ class SurfaceSolution:
     @property
     def phi_tip(self) -> float:
         """phi at the front pole (the nose tip): the first panel's interpolant at u = -1."""
-        u, _ = gauss_legendre(self.panels.order)
-        return float(lagrange_matrix(u, np.array([-1.0]))[0] @ self.phi_nodes[0])
+        return float(_tip_row(self.panels.order) @ self.phi_nodes[0])
 
     # --- field ------------------------------------------------------------------------
 
@@ -831,8 +965,10 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
+    A = -D
+    A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
     with _single_threaded_blas():
-        phi = scipy.linalg.solve(0.5 * np.eye(S.shape[0]) - D, -S @ g, overwrite_a=True, check_finite=False)
+        phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
     if not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)

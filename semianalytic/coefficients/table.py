@@ -340,8 +340,24 @@ def _spline(v: np.ndarray, y: np.ndarray, derivs=None):
     if derivs is not None:
         dy, d2y = derivs
         return PPoly.from_bernstein_basis(BPoly.from_derivatives(v, np.column_stack([y, dy, d2y])))
-    k = 5 if n >= 6 else (3 if n >= 4 else 1)
-    return make_interp_spline(v, y, k=k)
+    return make_interp_spline(v, y, k=_degree(n))
+
+
+def _degree(n: int) -> int:
+    """Degree of the interpolating spline through n knots: 5, or 3 or 1 when there are too few."""
+    return 5 if n >= 6 else (3 if n >= 4 else 1)
+
+
+def _splines(v: np.ndarray, Y: np.ndarray) -> list:
+    """:func:`_spline` of each column of ``Y`` (n, m) without derivatives: one fit of all the
+    columns (the banded system factorised once; the same coefficients column by column)."""
+    from scipy.interpolate import BSpline, make_interp_spline  # building only: not on a cached table's path
+
+    n = len(v)
+    if n == 1:
+        return [None] * Y.shape[1]
+    both = make_interp_spline(v, Y, k=_degree(n))
+    return [BSpline(both.t, np.ascontiguousarray(both.c[:, j]), both.k) for j in range(Y.shape[1])]
 
 
 def _coef6(f, v0: float, fallback: float) -> list:
@@ -382,15 +398,16 @@ class _PieceKnots:
         v = np.array(self.v)
         p = self.piece
         out = {}
-        for name in INTERPOLATED:
-            if name != "A":
-                out[name] = _spline(v, np.array([r[name] for r in self.rows]))
+        names = [name for name in INTERPOLATED if name != "A"] + ["dA_dP"]
+        # one interpolating spline per column, fitted together (the same coefficients as one by one)
+        fitted = _splines(v, np.array([[r[name] for name in names] for r in self.rows]))
+        out.update(zip(names, fitted))
         # A: quintic Hermite with dA/dP (= B_bernoulli) and d2A/dP2 from the spline of dA/dP
         y = np.array([r["A"] for r in self.rows])
         dA = np.array([r["dA_dP"] for r in self.rows])
         with np.errstate(divide="ignore", invalid="ignore"):
             Pv, Pvv = p.dP_dv(v), p.d2P_dv2(v)
-            ddA = _spline(v, dA)
+            ddA = out.pop("dA_dP")
             ddA_dv = ddA.derivative()(v) if ddA is not None else np.zeros_like(v)
             dy = np.where(np.isfinite(Pv), dA * Pv, 0.0)
             d2y = np.where(np.isfinite(Pvv), ddA_dv * Pv + dA * Pvv, 0.0)
