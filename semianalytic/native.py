@@ -29,7 +29,7 @@ from __future__ import annotations
 import os
 from pathlib import Path
 
-__all__ = ["CACHE_ENV", "cache_root", "native_dir", "load_library", "CFLAGS"]
+__all__ = ["CACHE_ENV", "NATIVE_ENV", "cache_root", "native_dir", "load_library", "CFLAGS"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 CFLAGS = ("-O3", "-fPIC", "-shared", "-fno-fast-math", "-ffp-contract=off", "-fno-math-errno")
@@ -51,9 +51,16 @@ def cache_root() -> Path:
     return Path(user_cache_dir("semianalytic", appauthor=False))
 
 
+NATIVE_ENV = "SEMIANALYTIC_NATIVE_DIR"
+
+
 def native_dir() -> Path:
-    """The folder of the compiled libraries: ``cache_root()/native``."""
-    return cache_root() / "native"
+    """The folder of the compiled libraries: ``$SEMIANALYTIC_NATIVE_DIR`` if set, else
+    ``cache_root()/native``.  The variable lets processes with their own table caches (the test
+    suite gives many tests a fresh ``$SEMIANALYTIC_CACHE_DIR``) share one compiled library
+    instead of compiling it again in each (about 0.25 s)."""
+    env = os.environ.get(NATIVE_ENV)
+    return Path(env).expanduser() if env else cache_root() / "native"
 
 
 def _compiler() -> list[str] | None:

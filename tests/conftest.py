@@ -15,6 +15,15 @@ try:
 except ImportError:  # the property tests skip themselves without hypothesis
     settings = None
 
+# One folder of compiled kernels for the whole session (and the subprocesses that inherit the
+# environment): many tests give a command a fresh $SEMIANALYTIC_CACHE_DIR, and each would
+# otherwise compile the C ring kernels again (semianalytic/native.py, about 0.25 s each).  The
+# tests of the compilation itself set their own folder.
+if not os.environ.get("SEMIANALYTIC_NATIVE_DIR"):
+    import tempfile
+
+    os.environ["SEMIANALYTIC_NATIVE_DIR"] = os.path.join(tempfile.gettempdir(), f"semianalytic-native-test-{os.getuid()}")
+
 if settings is not None:
     settings.register_profile("ci", derandomize=True, print_blob=True, deadline=None)
     settings.register_profile("dev", print_blob=True, deadline=None)

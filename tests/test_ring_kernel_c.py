@@ -161,7 +161,10 @@ def test_sphere_added_mass_on_both_paths(monkeypatch):
 
 
 def _backend_in_fresh_process(tmp_path, **env):
-    full = {**os.environ, "PYTHONPATH": str(ROOT), "SEMIANALYTIC_CACHE_DIR": str(tmp_path), **env}
+    # the suite's shared folder of compiled kernels (conftest.py) is left out: each test here
+    # compiles (or not) into its own fresh cache folder, unless it names a folder itself
+    base = {k: v for k, v in os.environ.items() if k != "SEMIANALYTIC_NATIVE_DIR"}
+    full = {**base, "PYTHONPATH": str(ROOT), "SEMIANALYTIC_CACHE_DIR": str(tmp_path), **env}
     code = ("import logging, warnings; warnings.simplefilter('error');"
             "from semianalytic.bem import kernels; import numpy as np;"
             "S, D = kernels.single_double(0.3, 0.8, -0.2, 0.5, 0.6, 0.8); print(kernels.backend(), float(S))")
@@ -193,3 +196,13 @@ def test_compiled_once_into_the_cache_folder(tmp_path):
     assert _backend_in_fresh_process(tmp_path, CC="/nonexistent/bin/cc") == "c"  # loaded, not rebuilt
     assert lib.stat().st_mtime_ns == mtime
     assert not list((ROOT / "semianalytic" / "bem").glob("*.so"))  # never in the source tree
+
+
+def test_native_dir_is_shared_across_table_caches(tmp_path):
+    """$SEMIANALYTIC_NATIVE_DIR names the folder of the compiled kernels: a process with another
+    table cache loads the library compiled there instead of compiling its own."""
+    shared = tmp_path / "native-shared"
+    assert _backend_in_fresh_process(tmp_path / "a", SEMIANALYTIC_NATIVE_DIR=str(shared)) == "c"
+    assert len(list(shared.glob("ring-*.so"))) == 1 and not (tmp_path / "a" / "native").exists()
+    # a missing compiler in the second process: it can only have loaded the shared library
+    assert _backend_in_fresh_process(tmp_path / "b", SEMIANALYTIC_NATIVE_DIR=str(shared), CC="/nonexistent/bin/cc") == "c"
