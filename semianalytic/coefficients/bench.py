@@ -283,6 +283,11 @@ def interleaved_ratio(baseline_python: str, repeats: int = 5, noses=INTERLEAVED_
     best = {(name, kind): [math.inf, math.inf, 0] for name in ("this", "baseline") for kind in noses}
     import tempfile
 
+    # which ring kernels this side runs (C or numpy); a first use compiles them into the per-user
+    # cache here, not inside a timed run
+    with tempfile.TemporaryDirectory() as neutral:
+        kernel = subprocess.run([sys.executable, "-c", "from semianalytic.bem.kernels import backend; print(backend())"],
+                                capture_output=True, text=True, env=env, timeout=300, cwd=neutral).stdout.strip()
     load0 = os.getloadavg()
     for _ in range(repeats):
         for kind in noses:
@@ -295,7 +300,7 @@ def interleaved_ratio(baseline_python: str, repeats: int = 5, noses=INTERLEAVED_
                 wall, cpu, knots = out.stdout.split()
                 b = best[(name, kind)]
                 b[0], b[1], b[2] = min(b[0], float(wall)), min(b[1], float(cpu)), int(knots)
-    return {"best": best, "noses": tuple(noses), "load": (load0, os.getloadavg()), "repeats": repeats,
+    return {"best": best, "noses": tuple(noses), "load": (load0, os.getloadavg()), "repeats": repeats, "kernel": kernel,
             "revisions": {"this": _revision(sys.executable), "baseline": _revision(baseline_python)}}
 
 
@@ -310,7 +315,10 @@ def interleaved_section(r: dict, only: bool = True) -> list[str]:
              f"process, one BLAS thread, alternately, {r['repeats']} times; best of each. Load average (1, 5, 15 min) "
              f"{l0[0]:.1f}, {l0[1]:.1f}, {l0[2]:.1f} before and {l1[0]:.1f}, {l1[1]:.1f}, {l1[2]:.1f} after, on a "
              "2-core machine shared with other jobs: the absolute times are inflated by the load, the ratios are the "
-             "comparable numbers.", "",
+             "comparable numbers." + {"c": " This side's ring kernels were the compiled ones (`_ring.c`, built "
+                                      "into the per-user cache before the runs).",
+                                      "numpy": " This side's ring kernels were the numpy ones (no C compiler, or "
+                                      "`SEMIANALYTIC_KERNEL=numpy`)."}.get(r.get("kernel", ""), ""), "",
              "| nose | knots before | knots after | before wall [s] | after wall [s] | before CPU [s] | after CPU [s] "
              "| ratio wall | ratio CPU | after / ogive after (CPU) |",
              "|---|---|---|---|---|---|---|---|---|---|"]
