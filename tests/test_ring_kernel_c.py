@@ -198,6 +198,7 @@ def test_compiled_once_into_the_cache_folder(tmp_path):
     assert not list((ROOT / "semianalytic" / "bem").glob("*.so"))  # never in the source tree
 
 
+@needs_c
 def test_native_dir_is_shared_across_table_caches(tmp_path):
     """$SEMIANALYTIC_NATIVE_DIR names the folder of the compiled kernels: a process with another
     table cache loads the library compiled there instead of compiling its own."""
