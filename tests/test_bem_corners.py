@@ -193,8 +193,23 @@ def test_unknowns_without_assembly():
 def test_non_finite_solve_names_nose_and_depth(monkeypatch):
     import semianalytic.bem.solve as solve_mod
 
-    monkeypatch.setattr(solve_mod.scipy.linalg, "solve", lambda a, b, **kw: np.full(b.shape, np.nan))
+    monkeypatch.setattr(solve_mod, "_dense_solve", lambda a, b: np.full(b.shape, np.nan))
     with pytest.raises(ModelError) as err:  # a model error (the CLI turns it into exit 2), not the case layer's
         solve_halfspace(NOSES["cone30"](), 5e-3, 8, 0.3, 4)
     assert err.value.field == "projectile"
     assert "cone nose" in str(err.value) and "5 mm" in str(err.value)
+    monkeypatch.setattr(solve_mod, "_dense_solve", lambda a, b: None)  # an exactly singular matrix: the same error
+    with pytest.raises(ModelError, match="cone nose"):
+        solve_halfspace(NOSES["cone30"](), 5e-3, 8, 0.3, 4)
+
+
+def test_dense_solve_exact_and_singular():
+    """The dense solve of (**): the exact solution of a small system with integer entries (LU of a
+    3x3 with pivoting rounds to a few ulps), and None (not NaN, not an exception) for an exactly
+    singular matrix, which the solver then reports as a model error (test above)."""
+    from semianalytic.bem.solve import _dense_solve
+
+    A = np.array([[2.0, 1.0, 0.0], [1.0, 3.0, 1.0], [0.0, 1.0, 4.0]])
+    x = _dense_solve(A.copy(), np.array([3.0, 5.0, 5.0]))
+    assert x == pytest.approx([1.0, 1.0, 1.0], rel=1e-15, abs=1e-15)
+    assert _dense_solve(np.array([[1.0, 2.0], [2.0, 4.0]]), np.array([1.0, 1.0])) is None

@@ -968,11 +968,19 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     A = -D
     A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
     with _single_threaded_blas():
-        phi = scipy.linalg.solve(A, -S @ g, overwrite_a=True, check_finite=False)
-    if not np.all(np.isfinite(phi)):
+        phi = _dense_solve(A, -S @ g)
+    if phi is None or not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
     return phi.reshape(shape), g.reshape(shape)
+
+
+def _dense_solve(A: np.ndarray, b: np.ndarray) -> np.ndarray | None:
+    """x with A x = b by LAPACK's dgesv (LU with partial pivoting), or None when A is exactly
+    singular.  The same factorisation as ``scipy.linalg.solve`` without its condition estimate
+    and checks, half its cost at the tables' sizes (N = 100: 57 against 116 us)."""
+    _, _, x, info = scipy.linalg.lapack.dgesv(A, b, overwrite_a=True, overwrite_b=True)
+    return None if info > 0 else x
 
 
 def raise_non_finite(ps: PanelSet, depth: float | None, what: str = "potential"):
