@@ -19,6 +19,7 @@ from scipy.integrate import quad
 from scipy.special import ellipe, ellipk
 
 from semianalytic.bem import kernels, solve_body
+from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -207,3 +208,44 @@ def test_native_dir_is_shared_across_table_caches(tmp_path):
     assert len(list(shared.glob("ring-*.so"))) == 1 and not (tmp_path / "a" / "native").exists()
     # a missing compiler in the second process: it can only have loaded the shared library
     assert _backend_in_fresh_process(tmp_path / "b", SEMIANALYTIC_NATIVE_DIR=str(shared), CC="/nonexistent/bin/cc") == "c"
+
+
+@needs_c
+@pytest.mark.parametrize(("kind", "f"), [("ogive", 3.5), ("cone", 2.0), ("table", 0.7)])
+def test_compiled_rules_agree_with_numpy(kind, f, monkeypatch):
+    """The near and self rules of the assembly (PairQuadrature.integrate) compiled after the
+    geometry (ring_pair_rules of _ring.c) against the numpy path: the same kernels and the same
+    sums against the Lagrange rows, in another order (the numpy path sums by matrix products):
+    each block to round-off of the largest entry, a few units of 1e-16 times the rule's point
+    count per row (~100): 1e-14.  The layouts cover every block kind (shared end-rule matrices,
+    one matrix per self pair, flat rows), the distinct-point shortcut and, on the cone and the
+    table nose, the corner panels whose differences go through their anchors.  (Against an
+    independent quadrature of each entry: tests/test_tables_speed_and_reach.py, on the path in use.)"""
+    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+    from semianalytic.bem.solve import _layers, _layers_split, near_pairs, near_quadrature, plan_assembly
+    from semianalytic.coefficients.study import study_nose
+
+    nose = study_nose(kind)
+    ps = halfspace_layout(nose, f * nose.depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+    N = ps.n_primary * ps.order
+    xt, rt = ps.nodes.x.ravel()[:N], ps.nodes.r.ravel()[:N]
+    plan = plan_assembly(ps)
+    # and field points off the surface (the near rules of varying length of the field evaluation:
+    # flat Lagrange rows), a small step along the normal from the nodes
+    xu, ru = (a.ravel()[:N] for a in ps.evaluate(np.repeat(np.arange(ps.n_primary), ps.order),
+                                                   np.tile(gauss_legendre(ps.order)[0], ps.n_primary))[2:4])
+    step = 0.3 * np.min(ps.lengths)
+    xf, rf = xt + step * ru / np.hypot(xu, ru), np.abs(rt - step * xu / np.hypot(xu, ru))
+    field = near_quadrature(*near_pairs(ps, xf, rf), ps.order)
+    rules = ((plan.near_rule, _layers, xt, rt, True), (plan.self_rule, _layers_split, xt, rt, True),
+             (field, _layers, xf, rf, False))
+    got = [rule.integrate(ps, x, r, k, node_targets=nt) for rule, k, x, r, nt in rules]
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    ref = [rule.integrate(ps, x, r, k, node_targets=nt) for rule, k, x, r, nt in rules]
+    kinds = set()
+    for (rule, *_), g, e in zip(rules, got, ref):
+        kinds |= {0 if lag is None else lag.ndim for *_, lag in rule.blocks}
+        for a, b in zip(g, e):
+            assert a.shape == b.shape == (len(rule.target), ps.order)
+            assert np.max(np.abs(a - b)) <= 1e-14 * np.max(np.abs(b))
+    assert kinds == {0, 2, 3}

@@ -1,8 +1,10 @@
 /* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22);
  * errata items 1, 1a), compiled: the same formulas, in the same order of operations, as
  * single_double and single_double_split of semianalytic/bem/kernels.py (read their docstrings
- * for the notation), and the dense block of assemble() (semianalytic/bem/solve.py) with the
- * column weights applied.  The numpy code of kernels.py is the reference and the fallback.
+ * for the notation), the dense block of assemble() (semianalytic/bem/solve.py) with the
+ * column weights applied, and the near and self rules of PairQuadrature.integrate after the
+ * panel geometry (ring_pair_rules, the kernels of the same block() as the others).  The numpy
+ * code of kernels.py and solve.py is the reference and the fallback.
  *
  * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
  * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the
@@ -158,6 +160,84 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
             }
             block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
                   NULL, NULL);
+        }
+    }
+}
+
+/* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:
+ * the rows of a block are consecutive in `rows` (Q == 0) or repeat every Q points (Q > 0, one
+ * matrix shared by the block's pairs).  P is a constant where inlined (the compiler unrolls). */
+static inline __attribute__((always_inline)) void
+accumulate(ptrdiff_t s0, ptrdiff_t s1, ptrdiff_t Q, const double *rows, const ptrdiff_t *pair,
+           const double *ws, const double *wd, ptrdiff_t P, double *restrict outS, double *restrict outD)
+{
+    ptrdiff_t q = 0;
+    for (ptrdiff_t k = s0; k < s1; k++) {
+        const double *row = rows + (Q ? q : k - s0) * P;
+        double *os = outS + pair[k] * P, *od = outD + pair[k] * P;
+        double a = ws[k], b = wd[k];
+        for (ptrdiff_t c = 0; c < P; c++) {
+            os[c] += a * row[c];
+            od[c] += b * row[c];
+        }
+        if (Q && ++q == Q)
+            q = 0;
+    }
+}
+
+/* The near and self rules of PairQuadrature.integrate (semianalytic/bem/solve.py) after the
+ * panel geometry: for each of n quadrature points k, the source point (x, r) and its
+ * derivative (xu, ru) d/du (point j = index[k] of the arrays, or k when index is NULL), the
+ * Jacobian J = |(xu, ru)| and normal (ru, -xu)/J, the target (xt, rt)[tgt[k]] (or the
+ * differences ddx, ddr[k] when given), the kernels S, Dl of single_double, weighted
+ * (a S + b QS) J and (a Dl + b QD) J with the split kernels when b != NULL, else a S J and
+ * a Dl J (into work[0 .. 2n-1]), summed against the point's Lagrange row into row pair[k] of
+ * the (n_pairs, p) blocks outS, outD (zeroed by the caller).  The rows come in nblk blocks of
+ * points bstart[i] .. bstart[i + 1] - 1 with rows brows[i] (consecutive, bq[i] == 0, or
+ * repeating every bq[i] points). */
+void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
+                     const double *xu, const double *ru, const ptrdiff_t *tgt, const double *xt,
+                     const double *rt, const double *ddx, const double *ddr, const double *a,
+                     const double *b, const ptrdiff_t *pair, ptrdiff_t nblk, const ptrdiff_t *bstart,
+                     const ptrdiff_t *bq, const double *const *brows, ptrdiff_t p, double *work,
+                     double *outS, double *outD)
+{
+    double dx[BLK], dr[BLK], s[BLK], r1[BLK], nx1[BLK], nr1[BLK], J[BLK];
+    double S[BLK], Dl[BLK], QS[BLK], QD[BLK];
+    double *ws = work, *wd = work + n;
+    for (ptrdiff_t a0 = 0; a0 < n; a0 += BLK) {
+        int m = n - a0 < BLK ? (int)(n - a0) : BLK;
+        for (int i = 0; i < m; i++) {
+            ptrdiff_t k = a0 + i, j = index ? index[k] : k, t = tgt[k];
+            double xs = x[j], rs = r[j], xus = xu[j], rus = ru[j];
+            double Jk = hypot(xus, rus);
+            J[i] = Jk;
+            nx1[i] = rus / Jk;
+            nr1[i] = -xus / Jk;
+            r1[i] = rs;
+            dx[i] = ddx ? ddx[k] : xt[t] - xs;
+            dr[i] = ddr ? ddr[k] : rt[t] - rs;
+            s[i] = rt[t] + rs;
+        }
+        block(m, dx, dr, s, r1, nx1, nr1, NULL, S, Dl, b ? QS : NULL, b ? QD : NULL);
+        if (b)
+            for (int i = 0; i < m; i++) {
+                ws[a0 + i] = (a[a0 + i] * S[i] + b[a0 + i] * QS[i]) * J[i];
+                wd[a0 + i] = (a[a0 + i] * Dl[i] + b[a0 + i] * QD[i]) * J[i];
+            }
+        else
+            for (int i = 0; i < m; i++) {
+                ws[a0 + i] = a[a0 + i] * S[i] * J[i];
+                wd[a0 + i] = a[a0 + i] * Dl[i] * J[i];
+            }
+    }
+    for (ptrdiff_t i = 0; i < nblk; i++) {
+        ptrdiff_t s0 = bstart[i], s1 = bstart[i + 1];
+        switch (p) {
+        case 4: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 4, outS, outD); break;
+        case 6: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 6, outS, outD); break;
+        case 8: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 8, outS, outD); break;
+        default: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, p, outS, outD);
         }
     }
 }

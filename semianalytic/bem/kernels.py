@@ -193,6 +193,8 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P]
+    lib.ring_pair_rules.restype = None
     if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
         raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")
     coefs = [np.ascontiguousarray(a, dtype=float) for a in (_PK, _QK, _PE, _QE, _K_SERIES, _KME_Q_SERIES)]
@@ -259,6 +261,43 @@ def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
     S *= wc
     Dl *= wc
     return S, Dl
+
+
+def _c_array(a, dtype=float):
+    return np.ascontiguousarray(a, dtype=dtype)
+
+
+def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blocks, npairs: int):
+    """The near and self rules' sums after the panel geometry, compiled (``ring_pair_rules`` of
+    ``_ring.c``; the kernels of Part I, eqs. (20)-(22)), or None without the compiled kernels.
+
+    Point k: source x, r and derivative xu, ru d/du (entry ``index[k]`` of these arrays, or k
+    when ``index`` is None), Jacobian J = |(xu, ru)|, normal (ru, -xu)/J, target
+    (xt, rt)[tgt[k]] (``delta``: the differences target - source given), rule weights a (and b,
+    the logarithm's, for the split kernels of :func:`single_double_split`; None: the plain
+    kernels); its weighted kernels (a S + b QS) J, (a Dl + b QD) J are summed against its
+    Lagrange row into row ``pair[k]`` of the two (npairs, p) blocks returned.  ``blocks`` is
+    (starts, q, addresses, p, keep): block i holds the points starts[i] .. starts[i + 1] - 1,
+    its rows (C-contiguous float64 (., p) arrays kept alive by ``keep``) at addresses[i],
+    consecutive (q[i] = 0) or repeating every q[i] points (the numpy path:
+    :meth:`semianalytic.bem.solve.PairQuadrature.integrate`)."""
+    lib = compiled()
+    if lib is None:
+        return None
+    starts, q, addresses, p, _ = blocks
+    x, r, xu, ru, xt, rt, a = (_c_array(v) for v in (x, r, xu, ru, xt, rt, a))
+    tgt, pair = (_c_array(v, np.intp) for v in (tgt, pair))
+    index = None if index is None else _c_array(index, np.intp)
+    ddx, ddr = (None, None) if delta is None else (_c_array(v) for v in delta)
+    b = None if b is None else _c_array(b)
+    n = tgt.size
+    if any(v is not None and v.size != n for v in (a, b, pair, ddx, ddr, index)) or starts[-1] != n:
+        raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
+    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
+    ptr = lambda v: None if v is None else v.ctypes.data  # noqa: E731
+    lib.ring_pair_rules(n, ptr(index), *(ptr(v) for v in (x, r, xu, ru, tgt, xt, rt, ddx, ddr, a, b, pair)),
+                        q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D))
+    return S, D
 
 
 # Series of (K(m) - E(m))/m = (pi/2) sum_n c_n^2 2n/(2n - 1) m^(n-1), c_n = (2n)!/(4^n n!^2)
