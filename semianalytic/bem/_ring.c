@@ -241,3 +241,110 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
         }
     }
 }
+
+/* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs and
+ * ellipse arcs, the same formulas in the same order as PanelSet._param, _evaluate_segment,
+ * relative and the segments' displacement and derivative (semianalytic/geometry.py).  Per
+ * panel k: segment parameter of the anchor base, offsets da, db of the ends, half = (db - da)/2,
+ * sign, anchor (ax, ar), the corner substitution (cluster -1, 0 or +1 and power; cluster NULL:
+ * none), the curve kind (0 line with c0, c1 = p1 - p0; 1 arc with c0 = radius; 2 ellipse arc
+ * with semi-axes c0, c1). */
+typedef struct {
+    const double *base, *da, *db, *half, *sign, *ax, *ar, *cluster, *power, *c0, *c1;
+    const ptrdiff_t *kind;
+    double offset;
+} panels_t;
+
+/* Offset dt of the segment parameter from the anchor at u, and d dt/du (PanelSet._param). */
+static inline double param(const panels_t *P, ptrdiff_t k, double uu, double *dtdu)
+{
+    double dt = P->da[k] + P->half[k] * (uu + 1.0);
+    *dtdu = P->half[k];
+    if (P->cluster && P->cluster[k] != 0.0) {
+        double c = P->cluster[k], q = P->power[k], span = P->db[k] - P->da[k];
+        double lo = 0.5 * (1.0 - c * uu);
+        double sw = span * pow(lo, q);
+        dt = c > 0 ? P->db[k] - sw : P->da[k] + sw;
+        *dtdu = 0.5 * span * q * pow(lo, q - 1.0);
+    }
+    return dt;
+}
+
+/* point(t + dt) - point(t) of the curve of panel k (the segments' displacement). */
+static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double dt, double *ex, double *er)
+{
+    if (P->kind[k] == 0) {
+        *ex = P->c0[k] * dt;
+        *er = P->c1[k] * dt;
+    } else if (P->kind[k] == 1) {
+        double s2 = 2.0 * P->c0[k] * sin(0.5 * dt), mid = t + 0.5 * dt;
+        *ex = -s2 * sin(mid);
+        *er = s2 * cos(mid);
+    } else {
+        double s2 = 2.0 * sin(0.5 * dt), mid = t + 0.5 * dt;
+        *ex = -P->c0[k] * s2 * sin(mid);
+        *er = P->c1[k] * s2 * cos(mid);
+    }
+}
+
+/* PanelSet.evaluate: point i on panel k = panel[i] at the reference coordinate u[i]; writes x,
+ * r, x_u, r_u and, with sax != NULL, the split (anchor, offset) of PanelSet.split. */
+void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
+                       const double *da, const double *db, const double *half, const double *sign,
+                       const double *ax, const double *ar, double offset, const double *cluster,
+                       const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                       double *x, double *r, double *xu, double *ru,
+                       double *sax, double *sar, double *sex, double *ser)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = panel[i];
+        double dtdu, dt = param(&P, k, u[i], &dtdu), t = base[k], ex, er, dx, dr;
+        displacement(&P, k, t, dt, &ex, &er);
+        if (kind[k] == 0) {  /* the derivative at t + dt */
+            dx = c0[k];
+            dr = c1[k];
+        } else if (kind[k] == 1) {
+            dx = -c0[k] * sin(t + dt);
+            dr = c0[k] * cos(t + dt);
+        } else {
+            dx = -c0[k] * sin(t + dt);
+            dr = c1[k] * cos(t + dt);
+        }
+        double sg = sign[k];
+        x[i] = sg * (ax[k] + ex) + (sg - 1.0) * offset;
+        r[i] = ar[k] + er;
+        xu[i] = sg * dx * dtdu;
+        ru[i] = dr * dtdu;
+        if (sax) {
+            sax[i] = sg * ax[k] + (sg - 1.0) * offset;
+            sar[i] = ar[k];
+            sex[i] = sg * ex;
+            ser[i] = er;
+        }
+    }
+}
+
+/* PanelSet.relative: point(u_to[i]) - point(u_from[i]) on panel[i], free of cancellation. */
+void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_from, const double *u_to,
+                         const double *base, const double *da, const double *db, const double *half,
+                         const double *sign, const double *cluster, const double *power,
+                         const ptrdiff_t *kind, const double *c0, const double *c1, double *dx, double *dr)
+{
+    panels_t P = {base, da, db, half, sign, NULL, NULL, cluster, power, c0, c1, kind, 0.0};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = panel[i];
+        double uf = u_from[i], ut = u_to[i], t_from, step, ex, er;
+        if (cluster && cluster[k] != 0.0) {
+            double d1, dt_from = param(&P, k, uf, &d1);
+            t_from = base[k] + dt_from;
+            step = param(&P, k, ut, &d1) - dt_from;
+        } else {
+            t_from = base[k] + da[k] + half[k] * (uf + 1.0);
+            step = half[k] * (ut - uf);
+        }
+        displacement(&P, k, t_from, step, &ex, &er);
+        dx[i] = sign[k] * ex;
+        dr[i] = er;
+    }
+}
