@@ -194,13 +194,17 @@ accumulate(ptrdiff_t s0, ptrdiff_t s1, ptrdiff_t Q, const double *rows, const pt
  * a Dl J (into work[0 .. 2n-1]), summed against the point's Lagrange row into row pair[k] of
  * the (n_pairs, p) blocks outS, outD (zeroed by the caller).  The rows come in nblk blocks of
  * points bstart[i] .. bstart[i + 1] - 1 with rows brows[i] (consecutive, bq[i] == 0, or
- * repeating every bq[i] points). */
+ * repeating every bq[i] points).  With tiny != NULL, the points k with tiny[k] != 0 (on panels
+ * graded far below their distance from the origin) take their differences through the anchors:
+ * (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]) and likewise in r with [1], [3],
+ * psplit the points' (anchor x, anchor r, offset x, offset r), tsplit the targets'. */
 void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
                      const double *xu, const double *ru, const ptrdiff_t *tgt, const double *xt,
                      const double *rt, const double *ddx, const double *ddr, const double *a,
                      const double *b, const ptrdiff_t *pair, ptrdiff_t nblk, const ptrdiff_t *bstart,
                      const ptrdiff_t *bq, const double *const *brows, ptrdiff_t p, double *work,
-                     double *outS, double *outD)
+                     double *outS, double *outD, const unsigned char *tiny,
+                     const double *const *psplit, const double *const *tsplit)
 {
     double dx[BLK], dr[BLK], s[BLK], r1[BLK], nx1[BLK], nr1[BLK], J[BLK];
     double S[BLK], Dl[BLK], QS[BLK], QD[BLK];
@@ -215,8 +219,13 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
             nx1[i] = rus / Jk;
             nr1[i] = -xus / Jk;
             r1[i] = rs;
-            dx[i] = ddx ? ddx[k] : xt[t] - xs;
-            dr[i] = ddr ? ddr[k] : rt[t] - rs;
+            if (tiny && tiny[k]) {
+                dx[i] = (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]);
+                dr[i] = (tsplit[1][t] - psplit[1][j]) + (tsplit[3][t] - psplit[3][j]);
+            } else {
+                dx[i] = ddx ? ddx[k] : xt[t] - xs;
+                dr[i] = ddr ? ddr[k] : rt[t] - rs;
+            }
             s[i] = rt[t] + rs;
         }
         block(m, dx, dr, s, r1, nx1, nr1, NULL, S, Dl, b ? QS : NULL, b ? QD : NULL);

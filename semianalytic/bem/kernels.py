@@ -193,7 +193,7 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
-    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P]
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 13
     lib.ring_panel_points.restype = None
@@ -271,7 +271,7 @@ def _c_array(a, dtype=float):
     return np.ascontiguousarray(a, dtype=dtype)
 
 
-def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blocks, npairs: int):
+def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blocks, npairs: int, tiny=None):
     """The near and self rules' sums after the panel geometry, compiled (``ring_pair_rules`` of
     ``_ring.c``; the kernels of Part I, eqs. (20)-(22)), or None without the compiled kernels.
 
@@ -283,7 +283,10 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
     Lagrange row into row ``pair[k]`` of the two (npairs, p) blocks returned.  ``blocks`` is
     (starts, q, addresses, p, keep): block i holds the points starts[i] .. starts[i + 1] - 1,
     its rows (C-contiguous float64 (., p) arrays kept alive by ``keep``) at addresses[i],
-    consecutive (q[i] = 0) or repeating every q[i] points (the numpy path:
+    consecutive (q[i] = 0) or repeating every q[i] points.  ``tiny`` (or None): (mask over the
+    points, the points' split (anchor x, anchor r, offset x, offset r) indexed like x, the
+    targets' split indexed like xt): the masked points take their differences as
+    (anchor - anchor) + (offset - offset) (the numpy path:
     :meth:`semianalytic.bem.solve.PairQuadrature.integrate`)."""
     lib = compiled()
     if lib is None:
@@ -299,8 +302,17 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
         raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
     S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
     ptr = lambda v: None if v is None else v.ctypes.data  # noqa: E731
+    mask = psplit = tsplit = None
+    if tiny is not None:
+        mask = _c_array(tiny[0], np.uint8)
+        ps_, ts_ = [_c_array(v) for v in tiny[1]], [_c_array(v) for v in tiny[2]]
+        if mask.size != n or len(ps_) != 4 or len(ts_) != 4 or any(v.size != x.size for v in ps_) \
+                or any(v.size < xt.size for v in ts_):
+            raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
+        psplit, tsplit = (np.array([v.ctypes.data for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
     lib.ring_pair_rules(n, ptr(index), *(ptr(v) for v in (x, r, xu, ru, tgt, xt, rt, ddx, ddr, a, b, pair)),
-                        q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D))
+                        q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D),
+                        ptr(mask), ptr(psplit), ptr(tsplit))
     return S, D
 
 

@@ -419,7 +419,8 @@ class PairQuadrature:
         if self.target_u is None and node_targets and ps.tiny_panels.any():
             # targets are nodes of ps: on panels graded far below their distance from the
             # origin, differences through the shared anchors (a corner) keep their digits
-            sel = np.nonzero(ps.tiny_panels[pan])[0]
+            on_tiny = ps.tiny_panels[pan]
+            sel = np.nonzero(on_tiny)[0]
         tiny = sel is not None and sel.size > 0
         split = _COMPILED_LAYERS.get(kernels)
         fast = split is not None and self.u.size > 0 and _kernels.compiled() is not None
@@ -428,11 +429,7 @@ class PairQuadrature:
             dpan, du, index = self.distinct
             x, r, xu, ru, *parts = ps.evaluate(dpan, du, split=tiny)
             at = index[sel] if tiny else None
-            if fast:
-                if tiny:  # the points' own coordinates, for the differences below
-                    x, r, xu, ru = x[index], r[index], xu[index], ru[index]
-                    index = None
-            else:
+            if not fast:
                 J = np.hypot(xu, ru)
                 x, r, J, nx, nr = x[index], r[index], J[index], (ru / J)[index], (-xu / J)[index]
         else:
@@ -445,7 +442,7 @@ class PairQuadrature:
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif tiny:
+        elif tiny and not fast:
             ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
             tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
             dx, dr = xt[t] - x, rt[t] - r
@@ -453,8 +450,10 @@ class PairQuadrature:
             dr[sel] = (tar - ar) + (ter - er)
             delta = (dx, dr)
         if fast:
+            # the differences of the points on tiny panels through the anchors, as below
+            through = (on_tiny, parts, ps.node_split) if tiny else None
             return list(pair_rules_compiled(index, x, r, xu, ru, t, xt, rt, delta, self.a, self.b if split else None,
-                                            self.pair, self._row_blocks, len(self.target)))
+                                            self.pair, self._row_blocks, len(self.target), through))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
