@@ -19,6 +19,7 @@ from scipy.integrate import quad
 from scipy.special import ellipe, ellipk
 
 from semianalytic.bem import kernels, solve_body
+from semianalytic.bem.quadrature import gauss_legendre
 from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
@@ -207,3 +208,82 @@ def test_native_dir_is_shared_across_table_caches(tmp_path):
     assert len(list(shared.glob("ring-*.so"))) == 1 and not (tmp_path / "a" / "native").exists()
     # a missing compiler in the second process: it can only have loaded the shared library
     assert _backend_in_fresh_process(tmp_path / "b", SEMIANALYTIC_NATIVE_DIR=str(shared), CC="/nonexistent/bin/cc") == "c"
+
+
+@needs_c
+@pytest.mark.parametrize(("kind", "f"), [("ogive", 3.5), ("cone", 2.0), ("table", 0.7)])
+def test_compiled_rules_agree_with_numpy(kind, f, monkeypatch):
+    """The near and self rules of the assembly (PairQuadrature.integrate) compiled after the
+    geometry (ring_pair_rules of _ring.c) against the numpy path: the same kernels and the same
+    sums against the Lagrange rows, in another order (the numpy path sums by matrix products):
+    each block to round-off of the largest entry, a few units of 1e-16 times the rule's point
+    count per row (~100): 1e-14.  The layouts cover every block kind (shared end-rule matrices,
+    one matrix per self pair, flat rows), the distinct-point shortcut and, on the cone and the
+    table nose, the corner panels whose differences go through their anchors.  (Against an
+    independent quadrature of each entry: tests/test_tables_speed_and_reach.py, on the path in use.)"""
+    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+    from semianalytic.bem.solve import _layers, _layers_split, near_pairs, near_quadrature, plan_assembly
+    from semianalytic.coefficients.study import study_nose
+
+    nose = study_nose(kind)
+    ps = halfspace_layout(nose, f * nose.depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+    N = ps.n_primary * ps.order
+    xt, rt = ps.nodes.x.ravel()[:N], ps.nodes.r.ravel()[:N]
+    plan = plan_assembly(ps)
+    # and field points off the surface (the near rules of varying length of the field evaluation:
+    # flat Lagrange rows), a small step along the normal from the nodes
+    xu, ru = (a.ravel()[:N] for a in ps.evaluate(np.repeat(np.arange(ps.n_primary), ps.order),
+                                                   np.tile(gauss_legendre(ps.order)[0], ps.n_primary))[2:4])
+    step = 0.3 * np.min(ps.lengths)
+    xf, rf = xt + step * ru / np.hypot(xu, ru), np.abs(rt - step * xu / np.hypot(xu, ru))
+    field = near_quadrature(*near_pairs(ps, xf, rf), ps.order)
+    rules = ((plan.near_rule, _layers, xt, rt, True), (plan.self_rule, _layers_split, xt, rt, True),
+             (field, _layers, xf, rf, False))
+    got = [rule.integrate(ps, x, r, k, node_targets=nt) for rule, k, x, r, nt in rules]
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    ref = [rule.integrate(ps, x, r, k, node_targets=nt) for rule, k, x, r, nt in rules]
+    kinds = set()
+    for (rule, *_), g, e in zip(rules, got, ref):
+        kinds |= {0 if lag is None else lag.ndim for *_, lag in rule.blocks}
+        for a, b in zip(g, e):
+            assert a.shape == b.shape == (len(rule.target), ps.order)
+            assert np.max(np.abs(a - b)) <= 1e-14 * np.max(np.abs(b))
+    assert kinds == {0, 2, 3}
+
+
+@needs_c
+def test_compiled_panel_geometry(monkeypatch):
+    """PanelSet.evaluate and relative on lines, arcs and ellipse arcs compiled
+    (ring_panel_points, ring_panel_relative of _ring.c): against an exact property of the
+    curve (the sphere's points at distance R from its centre, tangents perpendicular to the
+    radius, |dy/du| = R dt/du; round-off, 1e-15 of R) and against the numpy path on the layouts of
+    the study noses (corner panels, mirror images, the split into anchor and offset; the same
+    formulas, libm's sin, cos and pow against numpy's, each within an ulp, times up to three
+    rounded factors: a few units of 2.2e-16 of each array's size, 4e-15)."""
+    from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
+    from semianalytic.coefficients.study import study_nose
+    from semianalytic.geometry import spheroid_body
+
+    rng = np.random.default_rng(3)
+    ps = body_panels(sphere_body(2.0))
+    assert ps._compiled_curves is not None
+    pan = rng.integers(0, ps.n_panels, 2000)
+    u = rng.uniform(-1, 1, 2000)
+    x, r, xu, ru = ps.evaluate(pan, u)
+    R = 1.0
+    assert np.max(np.abs(np.hypot(x + ps.offset, r) - R)) <= 1e-15 * 4
+    assert np.max(np.abs((x + ps.offset) * xu + r * ru)) <= 1e-15 * 4 * np.max(np.hypot(xu, ru))
+    layouts = [halfspace_layout(study_nose(k), f * study_nose(k).depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+               for k, f in (("ogive", 3.5), ("cone", 2.0), ("cone", 0.2))] + [body_panels(spheroid_body(3.0, 1.0))]
+    got = []
+    for ps in layouts:
+        assert ps._compiled_curves is not None
+        pan = rng.integers(0, ps.n_panels, 3000)
+        u, step = rng.uniform(-1, 1, 3000), rng.uniform(-1e-3, 1e-3, 3000)
+        got.append((ps, pan, u, step, ps.evaluate(pan, u, split=True) + ps.relative(pan, u, u + step)))
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    for ps, pan, u, step, g in got:
+        e = ps.evaluate(pan, u, split=True) + ps.relative(pan, u, u + step)
+        for a, b in zip(g, e):
+            assert a.shape == b.shape
+            assert np.max(np.abs(a - b)) <= 4e-15 * max(np.max(np.abs(b)), 1e-300)

@@ -1,8 +1,10 @@
 /* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22);
  * errata items 1, 1a), compiled: the same formulas, in the same order of operations, as
  * single_double and single_double_split of semianalytic/bem/kernels.py (read their docstrings
- * for the notation), and the dense block of assemble() (semianalytic/bem/solve.py) with the
- * column weights applied.  The numpy code of kernels.py is the reference and the fallback.
+ * for the notation), the dense block of assemble() (semianalytic/bem/solve.py) with the
+ * column weights applied, and the near and self rules of PairQuadrature.integrate after the
+ * panel geometry (ring_pair_rules, the kernels of the same block() as the others).  The numpy
+ * code of kernels.py and solve.py is the reference and the fallback.
  *
  * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
  * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the
@@ -159,5 +161,199 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
             block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
                   NULL, NULL);
         }
+    }
+}
+
+/* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:
+ * the rows of a block are consecutive in `rows` (Q == 0) or repeat every Q points (Q > 0, one
+ * matrix shared by the block's pairs).  P is a constant where inlined (the compiler unrolls). */
+static inline __attribute__((always_inline)) void
+accumulate(ptrdiff_t s0, ptrdiff_t s1, ptrdiff_t Q, const double *rows, const ptrdiff_t *pair,
+           const double *ws, const double *wd, ptrdiff_t P, double *restrict outS, double *restrict outD)
+{
+    ptrdiff_t q = 0;
+    for (ptrdiff_t k = s0; k < s1; k++) {
+        const double *row = rows + (Q ? q : k - s0) * P;
+        double *os = outS + pair[k] * P, *od = outD + pair[k] * P;
+        double a = ws[k], b = wd[k];
+        for (ptrdiff_t c = 0; c < P; c++) {
+            os[c] += a * row[c];
+            od[c] += b * row[c];
+        }
+        if (Q && ++q == Q)
+            q = 0;
+    }
+}
+
+/* The near and self rules of PairQuadrature.integrate (semianalytic/bem/solve.py) after the
+ * panel geometry: for each of n quadrature points k, the source point (x, r) and its
+ * derivative (xu, ru) d/du (point j = index[k] of the arrays, or k when index is NULL), the
+ * Jacobian J = |(xu, ru)| and normal (ru, -xu)/J, the target (xt, rt)[tgt[k]] (or the
+ * differences ddx, ddr[k] when given), the kernels S, Dl of single_double, weighted
+ * (a S + b QS) J and (a Dl + b QD) J with the split kernels when b != NULL, else a S J and
+ * a Dl J (into work[0 .. 2n-1]), summed against the point's Lagrange row into row pair[k] of
+ * the (n_pairs, p) blocks outS, outD (zeroed by the caller).  The rows come in nblk blocks of
+ * points bstart[i] .. bstart[i + 1] - 1 with rows brows[i] (consecutive, bq[i] == 0, or
+ * repeating every bq[i] points).  With tiny != NULL, the points k with tiny[k] != 0 (on panels
+ * graded far below their distance from the origin) take their differences through the anchors:
+ * (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]) and likewise in r with [1], [3],
+ * psplit the points' (anchor x, anchor r, offset x, offset r), tsplit the targets'. */
+void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
+                     const double *xu, const double *ru, const ptrdiff_t *tgt, const double *xt,
+                     const double *rt, const double *ddx, const double *ddr, const double *a,
+                     const double *b, const ptrdiff_t *pair, ptrdiff_t nblk, const ptrdiff_t *bstart,
+                     const ptrdiff_t *bq, const double *const *brows, ptrdiff_t p, double *work,
+                     double *outS, double *outD, const unsigned char *tiny,
+                     const double *const *psplit, const double *const *tsplit)
+{
+    double dx[BLK], dr[BLK], s[BLK], r1[BLK], nx1[BLK], nr1[BLK], J[BLK];
+    double S[BLK], Dl[BLK], QS[BLK], QD[BLK];
+    double *ws = work, *wd = work + n;
+    for (ptrdiff_t a0 = 0; a0 < n; a0 += BLK) {
+        int m = n - a0 < BLK ? (int)(n - a0) : BLK;
+        for (int i = 0; i < m; i++) {
+            ptrdiff_t k = a0 + i, j = index ? index[k] : k, t = tgt[k];
+            double xs = x[j], rs = r[j], xus = xu[j], rus = ru[j];
+            double Jk = hypot(xus, rus);
+            J[i] = Jk;
+            nx1[i] = rus / Jk;
+            nr1[i] = -xus / Jk;
+            r1[i] = rs;
+            if (tiny && tiny[k]) {
+                dx[i] = (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]);
+                dr[i] = (tsplit[1][t] - psplit[1][j]) + (tsplit[3][t] - psplit[3][j]);
+            } else {
+                dx[i] = ddx ? ddx[k] : xt[t] - xs;
+                dr[i] = ddr ? ddr[k] : rt[t] - rs;
+            }
+            s[i] = rt[t] + rs;
+        }
+        block(m, dx, dr, s, r1, nx1, nr1, NULL, S, Dl, b ? QS : NULL, b ? QD : NULL);
+        if (b)
+            for (int i = 0; i < m; i++) {
+                ws[a0 + i] = (a[a0 + i] * S[i] + b[a0 + i] * QS[i]) * J[i];
+                wd[a0 + i] = (a[a0 + i] * Dl[i] + b[a0 + i] * QD[i]) * J[i];
+            }
+        else
+            for (int i = 0; i < m; i++) {
+                ws[a0 + i] = a[a0 + i] * S[i] * J[i];
+                wd[a0 + i] = a[a0 + i] * Dl[i] * J[i];
+            }
+    }
+    for (ptrdiff_t i = 0; i < nblk; i++) {
+        ptrdiff_t s0 = bstart[i], s1 = bstart[i + 1];
+        switch (p) {
+        case 4: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 4, outS, outD); break;
+        case 6: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 6, outS, outD); break;
+        case 8: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, 8, outS, outD); break;
+        default: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, p, outS, outD);
+        }
+    }
+}
+
+/* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs and
+ * ellipse arcs, the same formulas in the same order as PanelSet._param, _evaluate_segment,
+ * relative and the segments' displacement and derivative (semianalytic/geometry.py).  Per
+ * panel k: segment parameter of the anchor base, offsets da, db of the ends, half = (db - da)/2,
+ * sign, anchor (ax, ar), the corner substitution (cluster -1, 0 or +1 and power; cluster NULL:
+ * none), the curve kind (0 line with c0, c1 = p1 - p0; 1 arc with c0 = radius; 2 ellipse arc
+ * with semi-axes c0, c1). */
+typedef struct {
+    const double *base, *da, *db, *half, *sign, *ax, *ar, *cluster, *power, *c0, *c1;
+    const ptrdiff_t *kind;
+    double offset;
+} panels_t;
+
+/* Offset dt of the segment parameter from the anchor at u, and d dt/du (PanelSet._param). */
+static inline double param(const panels_t *P, ptrdiff_t k, double uu, double *dtdu)
+{
+    double dt = P->da[k] + P->half[k] * (uu + 1.0);
+    *dtdu = P->half[k];
+    if (P->cluster && P->cluster[k] != 0.0) {
+        double c = P->cluster[k], q = P->power[k], span = P->db[k] - P->da[k];
+        double lo = 0.5 * (1.0 - c * uu);
+        double sw = span * pow(lo, q);
+        dt = c > 0 ? P->db[k] - sw : P->da[k] + sw;
+        *dtdu = 0.5 * span * q * pow(lo, q - 1.0);
+    }
+    return dt;
+}
+
+/* point(t + dt) - point(t) of the curve of panel k (the segments' displacement). */
+static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double dt, double *ex, double *er)
+{
+    if (P->kind[k] == 0) {
+        *ex = P->c0[k] * dt;
+        *er = P->c1[k] * dt;
+    } else if (P->kind[k] == 1) {
+        double s2 = 2.0 * P->c0[k] * sin(0.5 * dt), mid = t + 0.5 * dt;
+        *ex = -s2 * sin(mid);
+        *er = s2 * cos(mid);
+    } else {
+        double s2 = 2.0 * sin(0.5 * dt), mid = t + 0.5 * dt;
+        *ex = -P->c0[k] * s2 * sin(mid);
+        *er = P->c1[k] * s2 * cos(mid);
+    }
+}
+
+/* PanelSet.evaluate: point i on panel k = panel[i] at the reference coordinate u[i]; writes x,
+ * r, x_u, r_u and, with sax != NULL, the split (anchor, offset) of PanelSet.split. */
+void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
+                       const double *da, const double *db, const double *half, const double *sign,
+                       const double *ax, const double *ar, double offset, const double *cluster,
+                       const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                       double *x, double *r, double *xu, double *ru,
+                       double *sax, double *sar, double *sex, double *ser)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = panel[i];
+        double dtdu, dt = param(&P, k, u[i], &dtdu), t = base[k], ex, er, dx, dr;
+        displacement(&P, k, t, dt, &ex, &er);
+        if (kind[k] == 0) {  /* the derivative at t + dt */
+            dx = c0[k];
+            dr = c1[k];
+        } else if (kind[k] == 1) {
+            dx = -c0[k] * sin(t + dt);
+            dr = c0[k] * cos(t + dt);
+        } else {
+            dx = -c0[k] * sin(t + dt);
+            dr = c1[k] * cos(t + dt);
+        }
+        double sg = sign[k];
+        x[i] = sg * (ax[k] + ex) + (sg - 1.0) * offset;
+        r[i] = ar[k] + er;
+        xu[i] = sg * dx * dtdu;
+        ru[i] = dr * dtdu;
+        if (sax) {
+            sax[i] = sg * ax[k] + (sg - 1.0) * offset;
+            sar[i] = ar[k];
+            sex[i] = sg * ex;
+            ser[i] = er;
+        }
+    }
+}
+
+/* PanelSet.relative: point(u_to[i]) - point(u_from[i]) on panel[i], free of cancellation. */
+void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_from, const double *u_to,
+                         const double *base, const double *da, const double *db, const double *half,
+                         const double *sign, const double *cluster, const double *power,
+                         const ptrdiff_t *kind, const double *c0, const double *c1, double *dx, double *dr)
+{
+    panels_t P = {base, da, db, half, sign, NULL, NULL, cluster, power, c0, c1, kind, 0.0};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = panel[i];
+        double uf = u_from[i], ut = u_to[i], t_from, step, ex, er;
+        if (cluster && cluster[k] != 0.0) {
+            double d1, dt_from = param(&P, k, uf, &d1);
+            t_from = base[k] + dt_from;
+            step = param(&P, k, ut, &d1) - dt_from;
+        } else {
+            t_from = base[k] + da[k] + half[k] * (uf + 1.0);
+            step = half[k] * (ut - uf);
+        }
+        displacement(&P, k, t_from, step, &ex, &er);
+        dx[i] = sign[k] * ex;
+        dr[i] = er;
     }
 }

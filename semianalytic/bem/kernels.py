@@ -26,7 +26,9 @@ spurious singularity on the axis (where 1 - m -> 1) into both parts of the split
 here, and the same formulas; built on first use into the per-user cache by
 :mod:`semianalytic.native`) when a C compiler is at hand, else, or with
 ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
-the two agree to a few units of 1e-16).
+the two agree to a few units of 1e-16).  The same library, under the same dispatch, sums the
+near and self rules of the assembly after the panel geometry (:func:`pair_rules_compiled`) and
+evaluates the geometry of panels on lines and arcs (``PanelSet.evaluate``, ``relative``).
 """
 
 from __future__ import annotations
@@ -193,6 +195,12 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
+    lib.ring_pair_rules.restype = None
+    lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 13
+    lib.ring_panel_points.restype = None
+    lib.ring_panel_relative.argtypes = [_N] + [_P] * 13 + [_P, _P]
+    lib.ring_panel_relative.restype = None
     if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
         raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")
     coefs = [np.ascontiguousarray(a, dtype=float) for a in (_PK, _QK, _PE, _QE, _K_SERIES, _KME_Q_SERIES)]
@@ -259,6 +267,55 @@ def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
     S *= wc
     Dl *= wc
     return S, Dl
+
+
+def _c_array(a, dtype=float):
+    return np.ascontiguousarray(a, dtype=dtype)
+
+
+def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blocks, npairs: int, tiny=None):
+    """The near and self rules' sums after the panel geometry, compiled (``ring_pair_rules`` of
+    ``_ring.c``; the kernels of Part I, eqs. (20)-(22)), or None without the compiled kernels.
+
+    Point k: source x, r and derivative xu, ru d/du (entry ``index[k]`` of these arrays, or k
+    when ``index`` is None), Jacobian J = |(xu, ru)|, normal (ru, -xu)/J, target
+    (xt, rt)[tgt[k]] (``delta``: the differences target - source given), rule weights a (and b,
+    the logarithm's, for the split kernels of :func:`single_double_split`; None: the plain
+    kernels); its weighted kernels (a S + b QS) J, (a Dl + b QD) J are summed against its
+    Lagrange row into row ``pair[k]`` of the two (npairs, p) blocks returned.  ``blocks`` is
+    (starts, q, addresses, p, keep): block i holds the points starts[i] .. starts[i + 1] - 1,
+    its rows (C-contiguous float64 (., p) arrays kept alive by ``keep``) at addresses[i],
+    consecutive (q[i] = 0) or repeating every q[i] points.  ``tiny`` (or None): (mask over the
+    points, the points' split (anchor x, anchor r, offset x, offset r) indexed like x, the
+    targets' split indexed like xt): the masked points take their differences as
+    (anchor - anchor) + (offset - offset) (the numpy path:
+    :meth:`semianalytic.bem.solve.PairQuadrature.integrate`)."""
+    lib = compiled()
+    if lib is None:
+        return None
+    starts, q, addresses, p, _ = blocks
+    x, r, xu, ru, xt, rt, a = (_c_array(v) for v in (x, r, xu, ru, xt, rt, a))
+    tgt, pair = (_c_array(v, np.intp) for v in (tgt, pair))
+    index = None if index is None else _c_array(index, np.intp)
+    ddx, ddr = (None, None) if delta is None else (_c_array(v) for v in delta)
+    b = None if b is None else _c_array(b)
+    n = tgt.size
+    if any(v is not None and v.size != n for v in (a, b, pair, ddx, ddr, index)) or starts[-1] != n:
+        raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
+    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
+    ptr = lambda v: None if v is None else v.ctypes.data  # noqa: E731
+    mask = psplit = tsplit = None
+    if tiny is not None:
+        mask = _c_array(tiny[0], np.uint8)
+        ps_, ts_ = [_c_array(v) for v in tiny[1]], [_c_array(v) for v in tiny[2]]
+        if mask.size != n or len(ps_) != 4 or len(ts_) != 4 or any(v.size != x.size for v in ps_) \
+                or any(v.size < xt.size for v in ts_):
+            raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
+        psplit, tsplit = (np.array([v.ctypes.data for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
+    lib.ring_pair_rules(n, ptr(index), *(ptr(v) for v in (x, r, xu, ru, tgt, xt, rt, ddx, ddr, a, b, pair)),
+                        q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D),
+                        ptr(mask), ptr(psplit), ptr(tsplit))
+    return S, D
 
 
 # Series of (K(m) - E(m))/m = (pi/2) sum_n c_n^2 2n/(2n - 1) m^(n-1), c_n = (2n)!/(4^n n!^2)

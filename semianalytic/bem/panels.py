@@ -128,6 +128,10 @@ class PanelSet:
         u = np.asarray(u, dtype=float)
         if panel.shape != u.shape:
             panel, u = np.broadcast_arrays(panel, u)
+        if not second and u.size and self._compiled_curves is not None:
+            got = self._evaluate_compiled(panel, u, split)
+            if got is not None:
+                return got
         curves, group = self._curves
         if len(curves) == 1:
             return self._evaluate_segment(curves[0], panel, u, second, split)
@@ -135,6 +139,66 @@ class PanelSet:
         for seg, mask, pk in self._by_segment(panel):
             for o, v in zip(out, self._evaluate_segment(seg, pk, u[mask], second, split)):
                 o[mask] = v
+        return tuple(out)
+
+    @cached_property
+    def _compiled_curves(self):
+        """The per-panel arrays ``ring_panel_points`` and ``ring_panel_relative`` of ``_ring.c``
+        read (their addresses, kept alive here): the curve kind of each panel (0 line,
+        1 circular arc, 2 ellipse arc) and its two numbers (p1 - p0; the radius; the
+        semi-axes), the anchors, parameters, signs and corner substitutions; None when a
+        panel lies on another curve (a spline: the numpy path)."""
+        kinds = {Line: 0, Arc: 1, EllipseArc: 2}
+        rows = []
+        for seg in self.segments:
+            k = kinds.get(type(seg))
+            if k is None:
+                return None
+            rows.append((k, seg.p1[0] - seg.p0[0], seg.p1[1] - seg.p0[1]) if k == 0 else
+                        (k, seg.radius, 0.0) if k == 1 else (k, seg.a, seg.b))
+        keep = {name: np.ascontiguousarray(a, dtype=float) for name, a in (
+            ("base", self.base), ("da", self.da), ("db", self.db), ("half", self._half), ("sign", self.sign),
+            ("ax", self.anchor_x), ("ar", self.anchor_r))}
+        keep["kind"] = np.ascontiguousarray(np.array([r[0] for r in rows], dtype=np.intp)[self.segment_index])
+        for j, name in ((1, "c0"), (2, "c1")):
+            keep[name] = np.ascontiguousarray(np.array([r[j] for r in rows], dtype=float)[self.segment_index])
+        corner = self.cluster is not None and bool(self._clustered.any())
+        if corner:
+            keep["cluster"], keep["power"] = (np.ascontiguousarray(a, dtype=float) for a in (self.cluster, self.power))
+        addr = {name: a.ctypes.data for name, a in keep.items()}
+        if not corner:
+            addr["cluster"] = addr["power"] = None
+        return addr, keep
+
+    def _compiled_lib(self, panel):
+        """The compiled library and the panel indices as a flat intp array when the compiled
+        geometry applies (lines and arcs, indices in range), else None."""
+        if self._compiled_curves is None:
+            return None
+        from semianalytic.bem.kernels import compiled
+
+        lib = compiled()
+        if lib is None:
+            return None
+        pk = np.ascontiguousarray(panel, dtype=np.intp).reshape(-1)
+        if pk.min() < 0 or pk.max() >= self.n_panels:  # numpy's negative indices: its own path
+            return None
+        return lib, pk
+
+    def _evaluate_compiled(self, panel, u, split):
+        """:meth:`evaluate` (without second derivatives) by ``ring_panel_points`` of
+        ``_ring.c`` (the same formulas, this project's own speed-up), or None."""
+        got = self._compiled_lib(panel)
+        if got is None:
+            return None
+        lib, pk = got
+        c = self._compiled_curves[0]
+        uu = np.ascontiguousarray(u, dtype=float).reshape(-1)
+        out = [np.empty(u.shape) for _ in range(8 if split else 4)]
+        ptr = [a.ctypes.data for a in out] + [None] * (0 if split else 4)
+        lib.ring_panel_points(pk.size, pk.ctypes.data, uu.ctypes.data, c["base"], c["da"], c["db"], c["half"], c["sign"],
+                              c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
+                              *ptr)
         return tuple(out)
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):
@@ -219,6 +283,15 @@ class PanelSet:
         panel, u_from, u_to = np.broadcast_arrays(np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float))
         dx = np.empty(u_from.shape)
         dr = np.empty(u_from.shape)
+        got = self._compiled_lib(panel) if u_from.size else None
+        if got is not None:  # lines and arcs: ring_panel_relative of _ring.c, the same formulas
+            lib, pk = got
+            c = self._compiled_curves[0]
+            uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
+            lib.ring_panel_relative(pk.size, pk.ctypes.data, uf.ctypes.data, ut.ctypes.data, c["base"], c["da"], c["db"],
+                                    c["half"], c["sign"], c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
+                                    dx.ctypes.data, dr.ctypes.data)
+            return dx, dr
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
             uf, ut = u_from[mask], u_to[mask]

@@ -38,7 +38,10 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg
 
-from semianalytic.bem.kernels import gradient_kernels, single_double, single_double_dense, single_double_split
+from semianalytic.bem.kernels import (
+    gradient_kernels, pair_rules_compiled, single_double, single_double_dense, single_double_split,
+)
+from semianalytic.bem import kernels as _kernels
 from semianalytic.bem.panels import PanelSet
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -377,40 +380,80 @@ class PairQuadrature:
                 out[pairs] = np.matmul(wk[points].reshape(at, 1, Q), lag)[:, 0, :]
         return out
 
+    @cached_property
+    def _row_blocks(self) -> tuple:
+        """The Lagrange rows of the blocks as :func:`pair_rules_compiled` takes them: (first
+        points and past-the-last point, rows repeating every q points (0: one row per point),
+        the rows' addresses, p, the row arrays)."""
+        starts, q, keep = [], [], []
+        for pairs, points, Q, lag, rows, n in self._block_slices:
+            if points.start != (starts and stop or 0):  # the blocks' points follow each other
+                raise ValueError("PairQuadrature: blocks with gaps between their points")
+            starts.append(points.start)
+            stop = points.stop
+            if lag is None:
+                keep.append(np.ascontiguousarray(rows, dtype=float))
+                q.append(0)
+            elif lag.ndim == 2:  # one (Q, p) matrix shared by the block's pairs
+                keep.append(np.ascontiguousarray(lag, dtype=float))
+                q.append(Q)
+            else:  # one (Q, p) matrix per pair
+                keep.append(np.ascontiguousarray(lag, dtype=float))
+                q.append(0)
+        if (stop if starts else 0) != self.u.size:
+            raise ValueError("PairQuadrature: blocks that do not cover the points")
+        starts.append(self.u.size)
+        addresses = np.array([k.ctypes.data for k in keep], dtype=np.uintp)
+        return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
+
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
 
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
-        pairs when the rule carries logarithms (b != 0)."""
+        pairs when the rule carries logarithms (b != 0).  The single and double layer
+        (``_layers``, ``_layers_split``) run compiled after the geometry when the compiled
+        kernels are at hand (:func:`pair_rules_compiled`, the same sums to round-off; this
+        project's own speed-up)."""
         pan = self._point_panel
         sel = None
         if self.target_u is None and node_targets and ps.tiny_panels.any():
             # targets are nodes of ps: on panels graded far below their distance from the
             # origin, differences through the shared anchors (a corner) keep their digits
-            sel = np.nonzero(ps.tiny_panels[pan])[0]
+            on_tiny = ps.tiny_panels[pan]
+            sel = np.nonzero(on_tiny)[0]
         tiny = sel is not None and sel.size > 0
+        split = _COMPILED_LAYERS.get(kernels)
+        fast = split is not None and self.u.size > 0 and _kernels.compiled() is not None
+        index = None
         if self.distinct is not None:
             dpan, du, index = self.distinct
             x, r, xu, ru, *parts = ps.evaluate(dpan, du, split=tiny)
-            J = np.hypot(xu, ru)
-            x, r, J, nx, nr = x[index], r[index], J[index], (ru / J)[index], (-xu / J)[index]
             at = index[sel] if tiny else None
+            if not fast:
+                J = np.hypot(xu, ru)
+                x, r, J, nx, nr = x[index], r[index], J[index], (ru / J)[index], (-xu / J)[index]
         else:
             x, r, xu, ru, *parts = ps.evaluate(pan, self.u, split=tiny)
-            J = np.hypot(xu, ru)
-            nx, nr = ru / J, -xu / J
+            if not fast:
+                J = np.hypot(xu, ru)
+                nx, nr = ru / J, -xu / J
             at = sel
         t = self._point_target
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
             delta = ps.relative(pan, self.u, self.target_u[self.pair])
-        elif tiny:
+        elif tiny and not fast:
             ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
             tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
             dx, dr = xt[t] - x, rt[t] - r
             dx[sel] = (tax - ax) + (tex - ex)
             dr[sel] = (tar - ar) + (ter - er)
             delta = (dx, dr)
+        if fast:
+            # the differences of the points on tiny panels through the anchors, as below
+            through = (on_tiny, parts, ps.node_split) if tiny else None
+            return list(pair_rules_compiled(index, x, r, xu, ru, t, xt, rt, delta, self.a, self.b if split else None,
+                                            self.pair, self._row_blocks, len(self.target), through))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
@@ -654,6 +697,10 @@ def _layers_split(X, R, x, r, nx, nr, delta=None):
     with np.errstate(divide="ignore", invalid="ignore"):
         S, D, QS, QD = single_double_split(X, R, x, r, nx, nr, delta)
     return (S, QS), (D, QD)
+
+
+# the kernels PairQuadrature.integrate runs compiled after the geometry: split form or not
+_COMPILED_LAYERS = {_layers: False, _layers_split: True}
 
 
 def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCache | None = None) -> tuple[np.ndarray, np.ndarray]:
