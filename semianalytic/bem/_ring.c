@@ -262,7 +262,62 @@ typedef struct {
     const double *base, *da, *db, *half, *sign, *ax, *ar, *cluster, *power, *c0, *c1;
     const ptrdiff_t *kind;
     double offset;
+    /* kind 3: the cubic splines x(s), r(s) of a table nose (one per panel set): knots and the
+     * power-basis coefficients (4, nk - 1), highest power first, of scipy's CubicSpline */
+    ptrdiff_t nk;
+    const double *knots, *cx, *cr;
 } panels_t;
+
+/* scipy's PPoly evaluation of a cubic (scipy/interpolate/_ppoly.pyx: find_interval_ascending
+ * with extrapolation, evaluate_poly1), operation for operation so that the numbers are the
+ * same: the interval with knots[i] <= t < knots[i+1] (the last one closed; outside, the end
+ * intervals), s = t - knots[i], and the terms summed from the lowest power up as
+ * res + c z prefactor with z = s^k built by products.  nu = 0 or 1. */
+static inline void spline_eval(const panels_t *P, double t, int nu, double *x, double *r)
+{
+    ptrdiff_t nk = P->nk, m = nk - 1, i;
+    double a = P->knots[0], b = P->knots[nk - 1];
+    if (!(a <= t && t <= b)) {
+        if (t < a) i = 0;
+        else if (t > b) i = nk - 2;
+        else { *x = NAN; *r = NAN; return; }  /* NaN */
+    } else if (t == b) {
+        i = nk - 2;
+    } else {
+        ptrdiff_t lo = 0, hi = nk - 2;  /* the largest i with knots[i] <= t */
+        while (lo < hi) {
+            ptrdiff_t mid = (lo + hi + 1) / 2;
+            if (P->knots[mid] <= t) lo = mid; else hi = mid - 1;
+        }
+        i = lo;
+    }
+    double s = t - P->knots[i];
+    const double *cs[2] = {P->cx, P->cr};
+    double out[2];
+    for (int j = 0; j < 2; j++) {
+        const double *c = cs[j];
+        double c0 = c[i], c1 = c[m + i], c2 = c[2 * m + i], c3 = c[3 * m + i];
+        double res = 0.0, z = 1.0;
+        if (nu == 0) {
+            res = res + c3 * z * 1.0;
+            z *= s;
+            res = res + c2 * z * 1.0;
+            z *= s;
+            res = res + c1 * z * 1.0;
+            z *= s;
+            res = res + c0 * z * 1.0;
+        } else {
+            res = res + c2 * z * 1.0;
+            z *= s;
+            res = res + c1 * z * 2.0;
+            z *= s;
+            res = res + c0 * z * 3.0;
+        }
+        out[j] = res;
+    }
+    *x = out[0];
+    *r = out[1];
+}
 
 /* Offset dt of the segment parameter from the anchor at u, and d dt/du (PanelSet._param). */
 static inline double param(const panels_t *P, ptrdiff_t k, double uu, double *dtdu)
@@ -289,6 +344,12 @@ static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double
         double s2 = 2.0 * P->c0[k] * sin(0.5 * dt), mid = t + 0.5 * dt;
         *ex = -s2 * sin(mid);
         *er = s2 * cos(mid);
+    } else if (P->kind[k] == 3) {  /* SplineCurve.displacement: by difference */
+        double x0, r0, x1, r1;
+        spline_eval(P, t, 0, &x0, &r0);
+        spline_eval(P, t + dt, 0, &x1, &r1);
+        *ex = x1 - x0;
+        *er = r1 - r0;
     } else {
         double s2 = 2.0 * sin(0.5 * dt), mid = t + 0.5 * dt;
         *ex = -P->c0[k] * s2 * sin(mid);
@@ -302,10 +363,11 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
                        const double *da, const double *db, const double *half, const double *sign,
                        const double *ax, const double *ar, double offset, const double *cluster,
                        const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                       ptrdiff_t nk, const double *knots, const double *cx, const double *cr,
                        double *x, double *r, double *xu, double *ru,
                        double *sax, double *sar, double *sex, double *ser)
 {
-    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset};
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
     for (ptrdiff_t i = 0; i < n; i++) {
         ptrdiff_t k = panel[i];
         double dtdu, dt = param(&P, k, u[i], &dtdu), t = base[k], ex, er, dx, dr;
@@ -316,6 +378,8 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
         } else if (kind[k] == 1) {
             dx = -c0[k] * sin(t + dt);
             dr = c0[k] * cos(t + dt);
+        } else if (kind[k] == 3) {
+            spline_eval(&P, t + dt, 1, &dx, &dr);
         } else {
             dx = -c0[k] * sin(t + dt);
             dr = c1[k] * cos(t + dt);
@@ -338,9 +402,10 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
 void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_from, const double *u_to,
                          const double *base, const double *da, const double *db, const double *half,
                          const double *sign, const double *cluster, const double *power,
-                         const ptrdiff_t *kind, const double *c0, const double *c1, double *dx, double *dr)
+                         const ptrdiff_t *kind, const double *c0, const double *c1,
+                         ptrdiff_t nk, const double *knots, const double *cx, const double *cr, double *dx, double *dr)
 {
-    panels_t P = {base, da, db, half, sign, NULL, NULL, cluster, power, c0, c1, kind, 0.0};
+    panels_t P = {base, da, db, half, sign, NULL, NULL, cluster, power, c0, c1, kind, 0.0, nk, knots, cx, cr};
     for (ptrdiff_t i = 0; i < n; i++) {
         ptrdiff_t k = panel[i];
         double uf = u_from[i], ut = u_to[i], t_from, step, ex, er;

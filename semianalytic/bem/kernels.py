@@ -197,9 +197,9 @@ def compiled():
     lib.ring_dense.restype = None
     lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
     lib.ring_pair_rules.restype = None
-    lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 13
+    lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
     lib.ring_panel_points.restype = None
-    lib.ring_panel_relative.argtypes = [_N] + [_P] * 13 + [_P, _P]
+    lib.ring_panel_relative.argtypes = [_N] + [_P] * 13 + [_N] + [_P] * 3 + [_P, _P]
     lib.ring_panel_relative.restype = None
     if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
         raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")

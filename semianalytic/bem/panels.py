@@ -146,16 +146,22 @@ class PanelSet:
         """The per-panel arrays ``ring_panel_points`` and ``ring_panel_relative`` of ``_ring.c``
         read (their addresses, kept alive here): the curve kind of each panel (0 line,
         1 circular arc, 2 ellipse arc) and its two numbers (p1 - p0; the radius; the
-        semi-axes), the anchors, parameters, signs and corner substitutions; None when a
-        panel lies on another curve (a spline: the numpy path)."""
-        kinds = {Line: 0, Arc: 1, EllipseArc: 2}
+        semi-axes; 3 a table nose's cubic spline, whose knots and coefficients are passed once),
+        the anchors, parameters, signs and corner substitutions; None when a panel lies on
+        another curve (a power law, a Bezier nose, two different splines: the numpy path)."""
+        kinds = {Line: 0, Arc: 1, EllipseArc: 2, SplineCurve: 3}
         rows = []
+        splines = None
         for seg in self.segments:
             k = kinds.get(type(seg))
             if k is None:
                 return None
+            if k == 3:
+                if splines is not None and seg._splines is not splines:
+                    return None
+                splines = seg._splines
             rows.append((k, seg.p1[0] - seg.p0[0], seg.p1[1] - seg.p0[1]) if k == 0 else
-                        (k, seg.radius, 0.0) if k == 1 else (k, seg.a, seg.b))
+                        (k, seg.radius, 0.0) if k == 1 else (k, seg.a, seg.b) if k == 2 else (k, 0.0, 0.0))
         keep = {name: np.ascontiguousarray(a, dtype=float) for name, a in (
             ("base", self.base), ("da", self.da), ("db", self.db), ("half", self._half), ("sign", self.sign),
             ("ax", self.anchor_x), ("ar", self.anchor_r))}
@@ -165,9 +171,18 @@ class PanelSet:
         corner = self.cluster is not None and bool(self._clustered.any())
         if corner:
             keep["cluster"], keep["power"] = (np.ascontiguousarray(a, dtype=float) for a in (self.cluster, self.power))
+        if splines is not None:  # scipy CubicSpline's knots and (4, n - 1) coefficients, as its evaluation reads them
+            knots, sx, sr = splines
+            keep["knots"] = np.ascontiguousarray(sx.x, dtype=float)
+            keep["cx"], keep["cr"] = (np.ascontiguousarray(f.c, dtype=float) for f in (sx, sr))
+            if keep["cx"].shape != (4, keep["knots"].size - 1) or keep["cr"].shape != keep["cx"].shape:
+                return None
         addr = {name: a.ctypes.data for name, a in keep.items()}
         if not corner:
             addr["cluster"] = addr["power"] = None
+        addr["nk"] = 0 if splines is None else int(keep["knots"].size)
+        if splines is None:
+            addr["knots"] = addr["cx"] = addr["cr"] = None
         return addr, keep
 
     def _compiled_lib(self, panel):
@@ -198,7 +213,7 @@ class PanelSet:
         ptr = [a.ctypes.data for a in out] + [None] * (0 if split else 4)
         lib.ring_panel_points(pk.size, pk.ctypes.data, uu.ctypes.data, c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                              *ptr)
+                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
         return tuple(out)
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):
@@ -290,7 +305,7 @@ class PanelSet:
             uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
             lib.ring_panel_relative(pk.size, pk.ctypes.data, uf.ctypes.data, ut.ctypes.data, c["base"], c["da"], c["db"],
                                     c["half"], c["sign"], c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                                    dx.ctypes.data, dr.ctypes.data)
+                                    c["nk"], c["knots"], c["cx"], c["cr"], dx.ctypes.data, dr.ctypes.data)
             return dx, dr
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
