@@ -168,7 +168,8 @@ class SplineCurve:
         arrays: scipy's PPoly evaluation (its interval search and its sum of the terms from the
         lowest power up) in Python floats, the same numbers without the ~5 us of a PPoly call
         (this project's own shortcut: the layouts of a table nose and their root searches
-        evaluate the spline at single points hundreds of times per depth)."""
+        evaluate the spline at single points hundreds of times per depth; on arrays of panel points
+        the compiled geometry does the same in C, spline_eval of semianalytic/bem/_ring.c)."""
         knots, cx, cr = self._scalar_table
         i = min(max(bisect.bisect_right(knots, t) - 1, 0), len(knots) - 2)
         s = t - knots[i]

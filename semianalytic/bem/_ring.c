@@ -251,13 +251,13 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
     }
 }
 
-/* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs and
- * ellipse arcs, the same formulas in the same order as PanelSet._param, _evaluate_segment,
+/* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs,
+ * ellipse arcs and a table nose's cubic spline (kind 3, spline_eval above), the same formulas in the same order as PanelSet._param, _evaluate_segment,
  * relative and the segments' displacement and derivative (semianalytic/geometry.py).  Per
  * panel k: segment parameter of the anchor base, offsets da, db of the ends, half = (db - da)/2,
  * sign, anchor (ax, ar), the corner substitution (cluster -1, 0 or +1 and power; cluster NULL:
  * none), the curve kind (0 line with c0, c1 = p1 - p0; 1 arc with c0 = radius; 2 ellipse arc
- * with semi-axes c0, c1). */
+ * with semi-axes c0, c1; 3 the spline of P->knots, cx, cr). */
 typedef struct {
     const double *base, *da, *db, *half, *sign, *ax, *ar, *cluster, *power, *c0, *c1;
     const ptrdiff_t *kind;

@@ -28,7 +28,8 @@ here, and the same formulas; built on first use into the per-user cache by
 ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
 the two agree to a few units of 1e-16).  The same library, under the same dispatch, sums the
 near and self rules of the assembly after the panel geometry (:func:`pair_rules_compiled`) and
-evaluates the geometry of panels on lines and arcs (``PanelSet.evaluate``, ``relative``).
+evaluates the geometry of panels on lines, arcs and a table nose's cubic spline
+(``PanelSet.evaluate``, ``relative``).
 """
 
 from __future__ import annotations

@@ -66,12 +66,6 @@ class PanelSet:
     def n_panels(self) -> int:
         return len(self.da)
 
-    @cached_property
-    def mapped(self) -> np.ndarray:
-        """Indices of the panels with a corner substitution."""
-        if self.cluster is None:
-            return np.empty(0, dtype=int)
-        return np.nonzero(self.cluster != 0)[0]
 
     @cached_property
     def _half(self) -> np.ndarray:
@@ -187,7 +181,7 @@ class PanelSet:
 
     def _compiled_lib(self, panel):
         """The compiled library and the panel indices as a flat intp array when the compiled
-        geometry applies (lines and arcs, indices in range), else None."""
+        geometry applies (lines, arcs and a table's spline; indices in range), else None."""
         if self._compiled_curves is None:
             return None
         from semianalytic.bem.kernels import compiled
@@ -299,7 +293,7 @@ class PanelSet:
         dx = np.empty(u_from.shape)
         dr = np.empty(u_from.shape)
         got = self._compiled_lib(panel) if u_from.size else None
-        if got is not None:  # lines and arcs: ring_panel_relative of _ring.c, the same formulas
+        if got is not None:  # lines, arcs, a table's spline: ring_panel_relative of _ring.c, the same formulas
             lib, pk = got
             c = self._compiled_curves[0]
             uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
@@ -374,14 +368,16 @@ class PanelSet:
         """Arc length of each panel."""
         return self.nodes.w.sum(axis=1)
 
-    def mirror_node_index(self) -> np.ndarray:
-        """Flat index of the mirror image of each primary node (for folding columns)."""
-        p, n = self.order, self.n_primary
-        if self.n_panels == n:
-            return np.empty(0, dtype=int)
-        k = np.arange(n)
-        mirror_panel = 2 * n - 1 - k
-        return (mirror_panel[:, None] * p + (p - 1 - np.arange(p))[None, :]).ravel()
+    def fold_mirror(self, M: np.ndarray) -> np.ndarray:
+        """Columns of the mirror nodes added onto those of their primary nodes: (rows, N) from
+        (rows, 2N), N = n_primary * order; ``M`` itself without mirror panels.  The mirror
+        panels follow the primary ones in reverse order (panel 2n - 1 - k mirrors panel k, its
+        nodes reversed), so the mirror of primary node i is node 2N - 1 - i: a reversed view,
+        no gathered copy."""
+        if self.n_panels == self.n_primary:
+            return M
+        N = self.n_primary * self.order
+        return M[:, :N] + M[:, :N - 1:-1]
 
 
 @dataclass(frozen=True)

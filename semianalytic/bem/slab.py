@@ -338,10 +338,6 @@ def _matrices(src: PanelSet, xt, rt, rule, both: bool = True):
     return S, D
 
 
-def _fold(ps: PanelSet, M: np.ndarray) -> np.ndarray:
-    N = ps.n_primary * ps.order
-    mirror = ps.mirror_node_index()
-    return M[:, :N] + M[:, mirror]
 
 
 def assemble_slab(ps: PanelSet, thickness: float, plan: SlabPlan | None = None, cap_radius: float = 0.0,
@@ -367,12 +363,12 @@ def assemble_slab(ps: PanelSet, thickness: float, plan: SlabPlan | None = None, 
         for kk in (k, -k):
             Sk, Dk = _matrices(ps, xt - 2.0 * kk * H, rt, plan.copies[kk])
             sgn = (-1.0) ** k
-            S += sgn * _fold(ps, Sk)
-            D += sgn * _fold(ps, Dk)
+            S += sgn * ps.fold_mirror(Sk)
+            D += sgn * ps.fold_mirror(Dk)
     X, R, NX, NR, W = _flat_nodes(ps)
     St, Dt = _tail_kernels(xt[:, None] + P, rt[:, None], X[None, :] + P, R[None, :], NX[None, :], NR[None, :], H, K)
-    S += _fold(ps, St * W[None, :])
-    D += _fold(ps, Dt * W[None, :])
+    S += ps.fold_mirror(St * W[None, :])
+    D += ps.fold_mirror(Dt * W[None, :])
     return S, D
 
 

@@ -630,7 +630,7 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     if close.size:
         levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
         levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
-    mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels (ps.mapped)
+    mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels
     if mapped.size:
         # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
         # the node; keep the self rule's innermost pieces within half of that
@@ -754,9 +754,7 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     mirrored = ps.n_panels > ps.n_primary
     if cache is not None:
         cache.store(ps, S, D, copy=not mirrored)  # folding the mirror columns makes new matrices
-    if mirrored:  # the mirror node of primary node i is node 2N - 1 - i
-        S = S[:, :N] + S[:, :N - 1:-1]
-        D = D[:, :N] + D[:, :N - 1:-1]
+    S, D = ps.fold_mirror(S), ps.fold_mirror(D)
     # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
     # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
     # that near a corner the error follows the local variation of phi, not phi itself
