@@ -26,13 +26,32 @@ the same home folder (clusters).  ``-fno-math-errno`` only lets ``sqrt`` be one 
 
 from __future__ import annotations
 
+import ctypes
 import os
 from pathlib import Path
 
-__all__ = ["CACHE_ENV", "NATIVE_ENV", "cache_root", "native_dir", "load_library", "CFLAGS"]
+_char, _addressof = ctypes.c_char, ctypes.addressof
+
+__all__ = ["CACHE_ENV", "NATIVE_ENV", "cache_root", "native_dir", "load_library", "address", "CFLAGS"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
 CFLAGS = ("-O3", "-fPIC", "-shared", "-fno-fast-math", "-ffp-contract=off", "-fno-math-errno")
+
+
+def address(a) -> int | None:
+    """The address of the data of a C-contiguous numpy array ``a`` (None for None), for a
+    ctypes call; the caller keeps ``a`` alive during the call.
+
+    ``ctypes.c_char.from_buffer`` takes 0.7 microseconds where numpy's ``a.ctypes.data`` takes
+    2.2 (it builds a Python helper object each time); a table makes about 17000 such calls.
+    Read-only, empty or non-contiguous arrays, which the buffer route refuses, fall back to
+    ``a.ctypes.data``."""
+    if a is None:
+        return None
+    try:
+        return _addressof(_char.from_buffer(a))
+    except (TypeError, ValueError, BufferError):
+        return a.ctypes.data
 
 
 def _debug(msg: str, *args) -> None:

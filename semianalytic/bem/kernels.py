@@ -43,7 +43,7 @@ from pathlib import Path
 import numpy as np
 from scipy.special import ellipe, ellipk
 
-from semianalytic.native import load_library
+from semianalytic.native import address, load_library
 
 # Complete elliptic integrals as functions of the complementary parameter q = 1 - m,
 # K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q): the Cephes approximations
@@ -205,7 +205,7 @@ def compiled():
     if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
         raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")
     coefs = [np.ascontiguousarray(a, dtype=float) for a in (_PK, _QK, _PE, _QE, _K_SERIES, _KME_Q_SERIES)]
-    lib.ring_set_coefficients(*(a.ctypes.data for a in coefs))  # copied by the library
+    lib.ring_set_coefficients(*(address(a) for a in coefs))  # copied by the library
     return lib
 
 
@@ -221,7 +221,7 @@ def _flat_inputs(x, r, x1, r1, nx1, nr1, delta):
     arrays = np.broadcast_arrays(*(np.asarray(a, dtype=float) for a in args))
     shape = arrays[0].shape
     flat = [np.ascontiguousarray(a).reshape(-1) for a in arrays]
-    ptrs = [a.ctypes.data for a in flat] + ([None, None] if delta is None else [])
+    ptrs = [address(a) for a in flat] + ([None, None] if delta is None else [])
     return shape, flat, ptrs
 
 
@@ -233,7 +233,7 @@ def single_double(x, r, x1, r1, nx1, nr1, delta=None):
         return _single_double_numpy(x, r, x1, r1, nx1, nr1, delta)
     shape, keep, ptrs = _flat_inputs(x, r, x1, r1, nx1, nr1, delta)
     S, Dl = np.empty(shape), np.empty(shape)
-    lib.ring_single_double(S.size, *ptrs, S.ctypes.data, Dl.ctypes.data)
+    lib.ring_single_double(S.size, *ptrs, address(S), address(Dl))
     return S, Dl
 
 
@@ -245,7 +245,7 @@ def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
         return _single_double_split_numpy(x, r, x1, r1, nx1, nr1, delta)
     shape, keep, ptrs = _flat_inputs(x, r, x1, r1, nx1, nr1, delta)
     out = [np.empty(shape) for _ in range(4)]
-    lib.ring_single_double_split(out[0].size, *ptrs, *(a.ctypes.data for a in out))
+    lib.ring_single_double_split(out[0].size, *ptrs, *(address(a) for a in out))
     return tuple(out)
 
 
@@ -258,8 +258,8 @@ def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
     S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     lib = compiled()
     if lib is not None:
-        lib.ring_dense(xr.size, xr.ctypes.data, rr.ctypes.data, xc.size,
-                       *(a.ctypes.data for a in (xc, rc, nxc, nrc, wc)), S.ctypes.data, Dl.ctypes.data)
+        lib.ring_dense(xr.size, address(xr), address(rr), xc.size,
+                       *(address(a) for a in (xc, rc, nxc, nrc, wc)), address(S), address(Dl))
         return S, Dl
     step = max(1, chunk // max(xc.size, 1))
     for a in range(0, xr.size, step):
@@ -304,7 +304,7 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
     if any(v is not None and v.size != n for v in (a, b, pair, ddx, ddr, index)) or starts[-1] != n:
         raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
     S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
-    ptr = lambda v: None if v is None else v.ctypes.data  # noqa: E731
+    ptr = address
     mask = psplit = tsplit = None
     if tiny is not None:
         mask = _c_array(tiny[0], np.uint8)
@@ -312,7 +312,7 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
         if mask.size != n or len(ps_) != 4 or len(ts_) != 4 or any(v.size != x.size for v in ps_) \
                 or any(v.size < xt.size for v in ts_):
             raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
-        psplit, tsplit = (np.array([v.ctypes.data for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
+        psplit, tsplit = (np.array([address(v) for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
     lib.ring_pair_rules(n, ptr(index), *(ptr(v) for v in (x, r, xu, ru, tgt, xt, rt, ddx, ddr, a, b, pair)),
                         q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D),
                         ptr(mask), ptr(psplit), ptr(tsplit))

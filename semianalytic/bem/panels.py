@@ -25,6 +25,7 @@ from functools import cached_property
 import numpy as np
 
 from semianalytic.bem.quadrature import gauss_legendre
+from semianalytic.native import address
 from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc, segment_arc_length
 
 GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
@@ -171,7 +172,7 @@ class PanelSet:
             keep["cx"], keep["cr"] = (np.ascontiguousarray(f.c, dtype=float) for f in (sx, sr))
             if keep["cx"].shape != (4, keep["knots"].size - 1) or keep["cr"].shape != keep["cx"].shape:
                 return None
-        addr = {name: a.ctypes.data for name, a in keep.items()}
+        addr = {name: address(a) for name, a in keep.items()}
         if not corner:
             addr["cluster"] = addr["power"] = None
         addr["nk"] = 0 if splines is None else int(keep["knots"].size)
@@ -204,8 +205,8 @@ class PanelSet:
         c = self._compiled_curves[0]
         uu = np.ascontiguousarray(u, dtype=float).reshape(-1)
         out = [np.empty(u.shape) for _ in range(8 if split else 4)]
-        ptr = [a.ctypes.data for a in out] + [None] * (0 if split else 4)
-        lib.ring_panel_points(pk.size, pk.ctypes.data, uu.ctypes.data, c["base"], c["da"], c["db"], c["half"], c["sign"],
+        ptr = [address(a) for a in out] + [None] * (0 if split else 4)
+        lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
                               c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
         return tuple(out)
@@ -297,9 +298,9 @@ class PanelSet:
             lib, pk = got
             c = self._compiled_curves[0]
             uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
-            lib.ring_panel_relative(pk.size, pk.ctypes.data, uf.ctypes.data, ut.ctypes.data, c["base"], c["da"], c["db"],
+            lib.ring_panel_relative(pk.size, address(pk), address(uf), address(ut), c["base"], c["da"], c["db"],
                                     c["half"], c["sign"], c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                                    c["nk"], c["knots"], c["cx"], c["cr"], dx.ctypes.data, dr.ctypes.data)
+                                    c["nk"], c["knots"], c["cx"], c["cr"], address(dx), address(dr))
             return dx, dr
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])

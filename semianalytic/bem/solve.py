@@ -43,6 +43,7 @@ from semianalytic.bem.kernels import (
 )
 from semianalytic.bem import kernels as _kernels
 from semianalytic.bem.panels import PanelSet
+from semianalytic.native import address
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
     differentiation_matrix,
@@ -403,7 +404,7 @@ class PairQuadrature:
         if (stop if starts else 0) != self.u.size:
             raise ValueError("PairQuadrature: blocks that do not cover the points")
         starts.append(self.u.size)
-        addresses = np.array([k.ctypes.data for k in keep], dtype=np.uintp)
+        addresses = np.array([address(k) for k in keep], dtype=np.uintp)
         return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
 
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
