@@ -253,6 +253,12 @@ def test_baseline_only_rewrites_its_section_and_needs_a_baseline(tmp_path):
     row = next(line for line in text.splitlines() if line.startswith("| cone |"))
     assert row.split("|")[-2].strip() == "1.50"  # cone CPU after / ogive CPU after: 0.6 / 0.4
     assert "before/after 4.00 in wall time, 4.00 in CPU time" in text
+    # with the in-process times (the later tables of each process) a second table and ratio: 1.6 / 0.32 = 5
+    warm = {k: [v[0], v[1] * (0.8 if k[0] == "this" else 1.0), v[2]] for k, v in best.items()}
+    bench._append_interleaved(path, r | {"warm": warm})
+    text = path.read_text()
+    assert text.count(bench.INTERLEAVED_TITLE) == 1 and text.count("| ogive |") == 2
+    assert "4.00 in CPU time in fresh processes; 4.00 in wall time, 5.00 in CPU time in process" in text
     env = {"SEMIANALYTIC_CACHE_DIR": str(tmp_path / "c"), "PATH": "/usr/bin:/bin"}
     out = subprocess.run([sys.executable, "-m", "semianalytic", "bench-bem", "--out", str(tmp_path), "--baseline-only"],
                          capture_output=True, text=True, env=env, timeout=120)
