@@ -39,7 +39,7 @@ import numpy as np
 import scipy.linalg
 
 from semianalytic.bem.kernels import (
-    gradient_kernels, pair_rules_compiled, single_double, single_double_dense, single_double_split,
+    gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_dense, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
 from semianalytic.bem.panels import PanelSet
@@ -407,6 +407,16 @@ class PairQuadrature:
         addresses = np.array([address(k) for k in keep], dtype=np.uintp)
         return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
 
+    def _compiled_rule(self, split: bool):
+        """This rule's arguments of :func:`pair_rules_compiled`, converted and checked once
+        (:func:`pair_rules_prepare`; the two assemblies of a difference in P share the rule)."""
+        got = self.__dict__.setdefault("_prepared", {})
+        if split not in got:
+            index = None if self.distinct is None else self.distinct[2]
+            got[split] = pair_rules_prepare(index, self._point_target, self.a, self.b if split else None, self.pair,
+                                            self._row_blocks, len(self.target))
+        return got[split]
+
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
 
@@ -453,8 +463,7 @@ class PairQuadrature:
         if fast:
             # the differences of the points on tiny panels through the anchors, as below
             through = (on_tiny, parts, ps.node_split) if tiny else None
-            return list(pair_rules_compiled(index, x, r, xu, ru, t, xt, rt, delta, self.a, self.b if split else None,
-                                            self.pair, self._row_blocks, len(self.target), through))
+            return list(pair_rules_run(self._compiled_rule(split), x, r, xu, ru, xt, rt, delta, through))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
