@@ -667,28 +667,36 @@ class AssemblyCache:
     round-off of the coordinates (1e-13 relative), and the two solves of a difference in P
     read the same copy, so the error cancels in phi'_P."""
 
-    nodes: np.ndarray | None = None  # (n_primary, p, 3): x, r and weight of the cached panels' nodes
+    nodes: tuple | None = None  # x, r (n_primary, p) and the largest weight of each panel of the cached nodes
     S: np.ndarray | None = None  # (N, N) raw blocks (weights applied, before folding and the diagonal rule)
     D: np.ndarray | None = None
 
     @staticmethod
-    def _signature(ps: PanelSet) -> np.ndarray:
-        g = ps.nodes
-        n = ps.n_primary
-        return np.stack([g.x[:n], g.r[:n], g.w[:n]], axis=-1)
+    def _signature(ps: PanelSet) -> tuple:
+        """(x, r, w of the primary nodes (n_primary, p), max |x|, |r| over them, max |w| per panel),
+        kept on the panel set: matched up to three times and stored once per depth."""
+        got = ps.__dict__.get("_assembly_signature")
+        if got is None:
+            g = ps.nodes
+            n = ps.n_primary
+            x, r, w = g.x[:n], g.r[:n], g.w[:n]
+            scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(r).max(initial=0.0)), 1e-300)
+            got = (x, r, w, scale, np.abs(w).max(axis=1, initial=0.0))
+            ps.__dict__["_assembly_signature"] = got
+        return got
 
     def match(self, ps: PanelSet) -> np.ndarray:
         """Mask over the primary panels of ``ps``: True where the panel of the same index in
         the cache has the same nodes (to 1e-13 of the body's size)."""
         out = np.zeros(ps.n_primary, bool)
-        if self.nodes is None or self.nodes.shape[1] != ps.order:
+        if self.nodes is None or self.nodes[0].shape[1] != ps.order:
             return out
-        new = self._signature(ps)
-        n = min(len(new), len(self.nodes))
-        scale = max(float(np.max(np.abs(new[..., :2]))), 1e-300)
-        close = np.abs(new[:n, :, :2] - self.nodes[:n, :, :2]).max(axis=(1, 2)) <= 1e-13 * scale
-        wclose = np.abs(new[:n, :, 2] - self.nodes[:n, :, 2]).max(axis=1) <= 1e-13 * np.abs(new[:n, :, 2]).max(axis=1)
-        out[:n] = close & wclose
+        x, r, w, scale, wmax = self._signature(ps)
+        ox, or_, ow = self.nodes[:3]
+        n = min(len(x), len(ox))
+        close = np.maximum(np.abs(x[:n] - ox[:n]).max(axis=1), np.abs(r[:n] - or_[:n]).max(axis=1)) <= 1e-13 * scale
+        wclose = np.abs(w[:n] - ow[:n]).max(axis=1) <= 1e-13 * wmax[:n]
+        np.logical_and(close, wclose, out=out[:n])
         return out
 
     def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray, copy: bool = True) -> None:
