@@ -144,9 +144,11 @@ void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, con
 /* The dense block of assemble(): S[i, j], D[i, j] (row-major, nrow x ncol) of the targets
  * (xr[i], rr[i]) against the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the
  * column weight wc[j]. */
-void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
-                const double *xc, const double *rc, const double *nxc, const double *nrc,
-                const double *wc, double *S, double *D)
+/* ring_dense into rows ld doubles apart (a block of a larger C-ordered matrix: row i of the
+ * block at S + i * ld), the same numbers. */
+void ring_dense_ld(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                   const double *xc, const double *rc, const double *nxc, const double *nrc,
+                   const double *wc, ptrdiff_t ld, double *S, double *D)
 {
     double dx[BLK], dr[BLK], s[BLK];
     for (ptrdiff_t i = 0; i < nrow; i++) {
@@ -158,10 +160,17 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
                 dr[j] = r - rc[a + j];
                 s[j] = r + rc[a + j];
             }
-            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
+            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ld + a, D + i * ld + a,
                   NULL, NULL);
         }
     }
+}
+
+void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                const double *xc, const double *rc, const double *nxc, const double *nrc,
+                const double *wc, double *S, double *D)
+{
+    ring_dense_ld(nrow, xr, rr, ncol, xc, rc, nxc, nrc, wc, ncol, S, D);
 }
 
 /* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:

@@ -196,6 +196,8 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
+    lib.ring_dense_ld.argtypes = [_N, _P, _P, _N] + [_P] * 5 + [_N, _P, _P]
+    lib.ring_dense_ld.restype = None
     lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
@@ -249,14 +251,29 @@ def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     return tuple(out)
 
 
-def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
+def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288, out=None):
     """S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` for the targets (xr, rr)[i] against
     the source rings (xc, rc, normal (nxc, nrc), weight wc)[j]: the dense block of the assembly
     (Part I, eqs. (20)-(22)).  Compiled: one fused pass writing the two (rows, cols) arrays;
-    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small."""
+    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small.
+
+    ``out``: two (rows, cols) float64 arrays, blocks of larger C-ordered matrices (rows at a
+    common stride, each row contiguous), written in place (no temporaries) and returned."""
     xr, rr, xc, rc, nxc, nrc, wc = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (xr, rr, xc, rc, nxc, nrc, wc))
-    S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     lib = compiled()
+    if out is not None:
+        S, Dl = out
+        if S.shape != (xr.size, xc.size) or Dl.shape != S.shape or S.dtype != float or Dl.dtype != float \
+                or S.strides != Dl.strides or S.strides[1] != S.itemsize:
+            raise ValueError("single_double_dense: out must be two (rows, cols) float64 blocks with contiguous rows")
+        if lib is not None and xr.size and xc.size:
+            ld = S.strides[0] // S.itemsize
+            lib.ring_dense_ld(xr.size, address(xr), address(rr), xc.size, *(address(a) for a in (xc, rc, nxc, nrc, wc)),
+                              ld, S.ctypes.data, Dl.ctypes.data)
+            return S, Dl
+        S[...], Dl[...] = single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk)
+        return S, Dl
+    S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     if lib is not None:
         lib.ring_dense(xr.size, address(xr), address(rr), xc.size,
                        *(address(a) for a in (xc, rc, nxc, nrc, wc)), address(S), address(Dl))
