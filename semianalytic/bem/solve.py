@@ -249,6 +249,10 @@ class PairQuadrature:
     def _point_target(self) -> np.ndarray:
         return self.target[self.pair]
 
+    @cached_property
+    def _point_target_u(self) -> np.ndarray:
+        return self.target_u[self.pair]
+
     def entries(self, order: int, columns: int) -> np.ndarray:
         """Flat indices, in a C-ordered matrix of ``columns`` columns, of the (target, node)
         entries of each pair's block (n_pairs, order): row target, columns panel * order + j
@@ -452,7 +456,7 @@ class PairQuadrature:
         t = self._point_target
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
-            delta = ps.relative(pan, self.u, self.target_u[self.pair])
+            delta = ps.relative(pan, self.u, self._point_target_u)
         elif tiny and not fast:
             ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
             tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
@@ -1013,15 +1017,17 @@ def solve_panels(
     of a panel set of the same topology.
     """
     S, D = assemble(ps, plan, cache)
-    phi, g = solve_assembled(ps, S, D, neumann, depth)
+    phi, g = solve_assembled(ps, S, D, neumann, depth, overwrite=True)  # D: a fresh matrix of assemble's
     return SurfaceSolution(ps, phi, g, kind, depth=depth, volume=volume)
 
 
-def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, depth: float | None = None):
+def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, depth: float | None = None,
+                    overwrite: bool = False):
     """The boundary-integral equation (1/2 - D) phi = -S g of Part I, eq. (21) on assembled
     single- and double-layer matrices (the half-space's and the plate's, bem/slab.py): the Neumann
     data g at the primary nodes (default g = -n_x, unit motion in +x, Part I eq. (7)) and the
-    solution, both shaped (n_primary, order).  A non-finite solution raises ModelError."""
+    solution, both shaped (n_primary, order).  A non-finite solution raises ModelError.
+    ``overwrite``: D (C-ordered) may be overwritten (no (N, N) temporary)."""
     geo = ps.nodes
     n = ps.n_primary
     if neumann is None:
@@ -1029,10 +1035,10 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    A = -D
+    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
     A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
     with _single_threaded_blas():
-        phi = _dense_solve(A, -S @ g)
+        phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
     if phi is None or not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
