@@ -198,7 +198,7 @@ def compiled():
     lib.ring_dense.restype = None
     lib.ring_dense_ld.argtypes = [_N, _P, _P, _N] + [_P] * 5 + [_N, _P, _P]
     lib.ring_dense_ld.restype = None
-    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
     lib.ring_panel_points.restype = None
@@ -347,7 +347,9 @@ def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
     ddx, ddr = (None, None) if delta is None else (_c_array(v) for v in delta)
     if ddx is not None and (ddx.size != n or ddr.size != n):
         raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
-    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
+    # with an index: the Jacobians and normals of the x.size distinct points once (3 x.size more)
+    ngeo = min(xu.size, ru.size) if p_index is not None else 0
+    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n + 3 * ngeo)
     ptr = address
     mask = psplit = tsplit = None
     if tiny is not None:
@@ -359,7 +361,7 @@ def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
         psplit, tsplit = (np.array([address(v) for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
     lib.ring_pair_rules(n, p_index, ptr(x), ptr(r), ptr(xu), ptr(ru), p_tgt, ptr(xt), ptr(rt), ptr(ddx), ptr(ddr),
                         p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, p, ptr(work), ptr(S), ptr(D),
-                        ptr(mask), ptr(psplit), ptr(tsplit))
+                        ptr(mask), ptr(psplit), ptr(tsplit), ngeo, address(work[2 * n:]) if ngeo else None)
     return S, D
 
 
