@@ -144,9 +144,11 @@ void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, con
 /* The dense block of assemble(): S[i, j], D[i, j] (row-major, nrow x ncol) of the targets
  * (xr[i], rr[i]) against the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the
  * column weight wc[j]. */
-void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
-                const double *xc, const double *rc, const double *nxc, const double *nrc,
-                const double *wc, double *S, double *D)
+/* ring_dense into rows ld doubles apart (a block of a larger C-ordered matrix: row i of the
+ * block at S + i * ld), the same numbers. */
+void ring_dense_ld(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                   const double *xc, const double *rc, const double *nxc, const double *nrc,
+                   const double *wc, ptrdiff_t ld, double *S, double *D)
 {
     double dx[BLK], dr[BLK], s[BLK];
     for (ptrdiff_t i = 0; i < nrow; i++) {
@@ -158,10 +160,17 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
                 dr[j] = r - rc[a + j];
                 s[j] = r + rc[a + j];
             }
-            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
+            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ld + a, D + i * ld + a,
                   NULL, NULL);
         }
     }
+}
+
+void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                const double *xc, const double *rc, const double *nxc, const double *nrc,
+                const double *wc, double *S, double *D)
+{
+    ring_dense_ld(nrow, xr, rr, ncol, xc, rc, nxc, nrc, wc, ncol, S, D);
 }
 
 /* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:
@@ -204,20 +213,40 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
                      const double *b, const ptrdiff_t *pair, ptrdiff_t nblk, const ptrdiff_t *bstart,
                      const ptrdiff_t *bq, const double *const *brows, ptrdiff_t p, double *work,
                      double *outS, double *outD, const unsigned char *tiny,
-                     const double *const *psplit, const double *const *tsplit)
+                     const double *const *psplit, const double *const *tsplit, ptrdiff_t nsrc,
+                     double *geo)
 {
     double dx[BLK], dr[BLK], s[BLK], r1[BLK], nx1[BLK], nr1[BLK], J[BLK];
     double S[BLK], Dl[BLK], QS[BLK], QD[BLK];
     double *ws = work, *wd = work + n;
+    /* with index and geo (3 nsrc doubles): the Jacobian and normal of each of the nsrc source
+     * points once, shared by the points that index it (the same numbers) */
+    double *gJ = NULL, *gnx = NULL, *gnr = NULL;
+    if (index && geo) {
+        gJ = geo, gnx = geo + nsrc, gnr = geo + 2 * nsrc;
+        for (ptrdiff_t j = 0; j < nsrc; j++) {
+            double Jk = hypot(xu[j], ru[j]);
+            gJ[j] = Jk;
+            gnx[j] = ru[j] / Jk;
+            gnr[j] = -xu[j] / Jk;
+        }
+    }
     for (ptrdiff_t a0 = 0; a0 < n; a0 += BLK) {
         int m = n - a0 < BLK ? (int)(n - a0) : BLK;
         for (int i = 0; i < m; i++) {
             ptrdiff_t k = a0 + i, j = index ? index[k] : k, t = tgt[k];
-            double xs = x[j], rs = r[j], xus = xu[j], rus = ru[j];
-            double Jk = hypot(xus, rus);
-            J[i] = Jk;
-            nx1[i] = rus / Jk;
-            nr1[i] = -xus / Jk;
+            double xs = x[j], rs = r[j];
+            if (gJ) {
+                J[i] = gJ[j];
+                nx1[i] = gnx[j];
+                nr1[i] = gnr[j];
+            } else {
+                double xus = xu[j], rus = ru[j];
+                double Jk = hypot(xus, rus);
+                J[i] = Jk;
+                nx1[i] = rus / Jk;
+                nr1[i] = -xus / Jk;
+            }
             r1[i] = rs;
             if (tiny && tiny[k]) {
                 dx[i] = (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]);

@@ -196,7 +196,9 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
-    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P]
+    lib.ring_dense_ld.argtypes = [_N, _P, _P, _N] + [_P] * 5 + [_N, _P, _P]
+    lib.ring_dense_ld.restype = None
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
     lib.ring_panel_points.restype = None
@@ -249,14 +251,29 @@ def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     return tuple(out)
 
 
-def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
+def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288, out=None):
     """S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` for the targets (xr, rr)[i] against
     the source rings (xc, rc, normal (nxc, nrc), weight wc)[j]: the dense block of the assembly
     (Part I, eqs. (20)-(22)).  Compiled: one fused pass writing the two (rows, cols) arrays;
-    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small."""
+    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small.
+
+    ``out``: two (rows, cols) float64 arrays, blocks of larger C-ordered matrices (rows at a
+    common stride, each row contiguous), written in place (no temporaries) and returned."""
     xr, rr, xc, rc, nxc, nrc, wc = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (xr, rr, xc, rc, nxc, nrc, wc))
-    S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     lib = compiled()
+    if out is not None:
+        S, Dl = out
+        if S.shape != (xr.size, xc.size) or Dl.shape != S.shape or S.dtype != float or Dl.dtype != float \
+                or S.strides != Dl.strides or S.strides[1] != S.itemsize:
+            raise ValueError("single_double_dense: out must be two (rows, cols) float64 blocks with contiguous rows")
+        if lib is not None and xr.size and xc.size:
+            ld = S.strides[0] // S.itemsize
+            lib.ring_dense_ld(xr.size, address(xr), address(rr), xc.size, *(address(a) for a in (xc, rc, nxc, nrc, wc)),
+                              ld, S.ctypes.data, Dl.ctypes.data)
+            return S, Dl
+        S[...], Dl[...] = single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk)
+        return S, Dl
+    S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     if lib is not None:
         lib.ring_dense(xr.size, address(xr), address(rr), xc.size,
                        *(address(a) for a in (xc, rc, nxc, nrc, wc)), address(S), address(Dl))
@@ -290,20 +307,49 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
     points, the points' split (anchor x, anchor r, offset x, offset r) indexed like x, the
     targets' split indexed like xt): the masked points take their differences as
     (anchor - anchor) + (offset - offset) (the numpy path:
-    :meth:`semianalytic.bem.solve.PairQuadrature.integrate`)."""
-    lib = compiled()
-    if lib is None:
+    :meth:`semianalytic.bem.solve.PairQuadrature.integrate`).
+
+    :func:`pair_rules_prepare` and :func:`pair_rules_run` are its two halves: a rule that runs
+    many times converts and checks its own arrays once (this project's own speed-up)."""
+    rule = pair_rules_prepare(index, tgt, a, b, pair, blocks, npairs)
+    return None if rule is None else pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny)
+
+
+def pair_rules_prepare(index, tgt, a, b, pair, blocks, npairs: int):
+    """The per-rule arguments of :func:`pair_rules_compiled` (everything but the geometry, the
+    targets and ``tiny``) converted, checked and their addresses taken, for
+    :func:`pair_rules_run`; None without the compiled kernels."""
+    if compiled() is None:
         return None
-    starts, q, addresses, p, _ = blocks
-    x, r, xu, ru, xt, rt, a = (_c_array(v) for v in (x, r, xu, ru, xt, rt, a))
+    starts, q, addresses, p, keep_rows = blocks
+    a = _c_array(a)
     tgt, pair = (_c_array(v, np.intp) for v in (tgt, pair))
     index = None if index is None else _c_array(index, np.intp)
-    ddx, ddr = (None, None) if delta is None else (_c_array(v) for v in delta)
     b = None if b is None else _c_array(b)
+    starts, q, addresses = _c_array(starts, np.intp), _c_array(q, np.intp), _c_array(addresses, np.uintp)
     n = tgt.size
-    if any(v is not None and v.size != n for v in (a, b, pair, ddx, ddr, index)) or starts[-1] != n:
+    if any(v is not None and v.size != n for v in (a, b, pair, index)) or starts[-1] != n:
         raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
-    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n)
+    keep = (a, b, tgt, pair, index, starts, q, addresses, keep_rows)
+    need = (int(index.max()) + 1 if index is not None and n else n, int(tgt.max()) + 1 if n else 0)
+    ptrs = (address(index), address(tgt), address(a), address(b), address(pair), q.size, address(starts),
+            address(q), address(addresses), p)
+    return n, npairs, p, need, ptrs, keep
+
+
+def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
+    """:func:`pair_rules_compiled` with the per-rule arguments from :func:`pair_rules_prepare`."""
+    lib = compiled()
+    n, npairs, p, (nsrc, ntgt), (p_index, p_tgt, p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, _), _ = rule
+    x, r, xu, ru, xt, rt = (_c_array(v) for v in (x, r, xu, ru, xt, rt))
+    if x.size < nsrc or r.size < nsrc or xu.size < nsrc or ru.size < nsrc or xt.size < ntgt or rt.size < ntgt:
+        raise ValueError("pair_rules_compiled: geometry arrays shorter than the rule's indices")
+    ddx, ddr = (None, None) if delta is None else (_c_array(v) for v in delta)
+    if ddx is not None and (ddx.size != n or ddr.size != n):
+        raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
+    # with an index: the Jacobians and normals of the x.size distinct points once (3 x.size more)
+    ngeo = min(xu.size, ru.size) if p_index is not None else 0
+    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n + 3 * ngeo)
     ptr = address
     mask = psplit = tsplit = None
     if tiny is not None:
@@ -313,9 +359,9 @@ def pair_rules_compiled(index, x, r, xu, ru, tgt, xt, rt, delta, a, b, pair, blo
                 or any(v.size < xt.size for v in ts_):
             raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
         psplit, tsplit = (np.array([address(v) for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
-    lib.ring_pair_rules(n, ptr(index), *(ptr(v) for v in (x, r, xu, ru, tgt, xt, rt, ddx, ddr, a, b, pair)),
-                        q.size, ptr(starts), ptr(q), ptr(addresses), p, ptr(work), ptr(S), ptr(D),
-                        ptr(mask), ptr(psplit), ptr(tsplit))
+    lib.ring_pair_rules(n, p_index, ptr(x), ptr(r), ptr(xu), ptr(ru), p_tgt, ptr(xt), ptr(rt), ptr(ddx), ptr(ddr),
+                        p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, p, ptr(work), ptr(S), ptr(D),
+                        ptr(mask), ptr(psplit), ptr(tsplit), ngeo, address(work[2 * n:]) if ngeo else None)
     return S, D
 
 

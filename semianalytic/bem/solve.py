@@ -39,7 +39,7 @@ import numpy as np
 import scipy.linalg
 
 from semianalytic.bem.kernels import (
-    gradient_kernels, pair_rules_compiled, single_double, single_double_dense, single_double_split,
+    gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_dense, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
 from semianalytic.bem.panels import PanelSet
@@ -249,6 +249,10 @@ class PairQuadrature:
     def _point_target(self) -> np.ndarray:
         return self.target[self.pair]
 
+    @cached_property
+    def _point_target_u(self) -> np.ndarray:
+        return self.target_u[self.pair]
+
     def entries(self, order: int, columns: int) -> np.ndarray:
         """Flat indices, in a C-ordered matrix of ``columns`` columns, of the (target, node)
         entries of each pair's block (n_pairs, order): row target, columns panel * order + j
@@ -407,6 +411,16 @@ class PairQuadrature:
         addresses = np.array([address(k) for k in keep], dtype=np.uintp)
         return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
 
+    def _compiled_rule(self, split: bool):
+        """This rule's arguments of :func:`pair_rules_compiled`, converted and checked once
+        (:func:`pair_rules_prepare`; the two assemblies of a difference in P share the rule)."""
+        got = self.__dict__.setdefault("_prepared", {})
+        if split not in got:
+            index = None if self.distinct is None else self.distinct[2]
+            got[split] = pair_rules_prepare(index, self._point_target, self.a, self.b if split else None, self.pair,
+                                            self._row_blocks, len(self.target))
+        return got[split]
+
     def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
 
@@ -442,7 +456,7 @@ class PairQuadrature:
         t = self._point_target
         delta = None
         if self.target_u is not None:  # target and source on one panel: exact differences
-            delta = ps.relative(pan, self.u, self.target_u[self.pair])
+            delta = ps.relative(pan, self.u, self._point_target_u)
         elif tiny and not fast:
             ax, ar, ex, er = (a[at] for a in parts)  # the points' split (anchor + offset)
             tax, tar, tex, ter = (a[t[sel]] for a in ps.node_split)
@@ -453,8 +467,7 @@ class PairQuadrature:
         if fast:
             # the differences of the points on tiny panels through the anchors, as below
             through = (on_tiny, parts, ps.node_split) if tiny else None
-            return list(pair_rules_compiled(index, x, r, xu, ru, t, xt, rt, delta, self.a, self.b if split else None,
-                                            self.pair, self._row_blocks, len(self.target), through))
+            return list(pair_rules_run(self._compiled_rule(split), x, r, xu, ru, xt, rt, delta, through))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
@@ -658,28 +671,36 @@ class AssemblyCache:
     round-off of the coordinates (1e-13 relative), and the two solves of a difference in P
     read the same copy, so the error cancels in phi'_P."""
 
-    nodes: np.ndarray | None = None  # (n_primary, p, 3): x, r and weight of the cached panels' nodes
+    nodes: tuple | None = None  # x, r (n_primary, p) and the largest weight of each panel of the cached nodes
     S: np.ndarray | None = None  # (N, N) raw blocks (weights applied, before folding and the diagonal rule)
     D: np.ndarray | None = None
 
     @staticmethod
-    def _signature(ps: PanelSet) -> np.ndarray:
-        g = ps.nodes
-        n = ps.n_primary
-        return np.stack([g.x[:n], g.r[:n], g.w[:n]], axis=-1)
+    def _signature(ps: PanelSet) -> tuple:
+        """(x, r, w of the primary nodes (n_primary, p), max |x|, |r| over them, max |w| per panel),
+        kept on the panel set: matched up to three times and stored once per depth."""
+        got = ps.__dict__.get("_assembly_signature")
+        if got is None:
+            g = ps.nodes
+            n = ps.n_primary
+            x, r, w = g.x[:n], g.r[:n], g.w[:n]
+            scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(r).max(initial=0.0)), 1e-300)
+            got = (x, r, w, scale, np.abs(w).max(axis=1, initial=0.0))
+            ps.__dict__["_assembly_signature"] = got
+        return got
 
     def match(self, ps: PanelSet) -> np.ndarray:
         """Mask over the primary panels of ``ps``: True where the panel of the same index in
         the cache has the same nodes (to 1e-13 of the body's size)."""
         out = np.zeros(ps.n_primary, bool)
-        if self.nodes is None or self.nodes.shape[1] != ps.order:
+        if self.nodes is None or self.nodes[0].shape[1] != ps.order:
             return out
-        new = self._signature(ps)
-        n = min(len(new), len(self.nodes))
-        scale = max(float(np.max(np.abs(new[..., :2]))), 1e-300)
-        close = np.abs(new[:n, :, :2] - self.nodes[:n, :, :2]).max(axis=(1, 2)) <= 1e-13 * scale
-        wclose = np.abs(new[:n, :, 2] - self.nodes[:n, :, 2]).max(axis=1) <= 1e-13 * np.abs(new[:n, :, 2]).max(axis=1)
-        out[:n] = close & wclose
+        x, r, w, scale, wmax = self._signature(ps)
+        ox, or_, ow = self.nodes[:3]
+        n = min(len(x), len(ox))
+        close = np.maximum(np.abs(x[:n] - ox[:n]).max(axis=1), np.abs(r[:n] - or_[:n]).max(axis=1)) <= 1e-13 * scale
+        wclose = np.abs(w[:n] - ow[:n]).max(axis=1) <= 1e-13 * wmax[:n]
+        np.logical_and(close, wclose, out=out[:n])
         return out
 
     def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray, copy: bool = True) -> None:
@@ -719,9 +740,10 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     N = ps.n_primary * p
     xt, rt = X[:N], R[:N]
 
-    def dense(rows, cols):
-        # compiled: one fused pass; numpy: row blocks, so that temporaries stay small (DENSE_CHUNK)
-        return single_double_dense(xt[rows], rt[rows], X[cols], R[cols], NX[cols], NR[cols], W[cols], DENSE_CHUNK)
+    def dense(rows, cols, out=None):
+        # compiled: one fused pass (into ``out``, blocks of S and D, when given); numpy: row
+        # blocks, so that temporaries stay small (DENSE_CHUNK)
+        return single_double_dense(xt[rows], rt[rows], X[cols], R[cols], NX[cols], NR[cols], W[cols], DENSE_CHUNK, out)
 
     if plan.fixed is None:
         S, D = dense(slice(None), slice(None))
@@ -733,9 +755,9 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
         k = int(np.count_nonzero(fix))
         if fix[:k].all():  # the fixed panels lead (the nose before the moving ones): blocks by slices
             fi, fr, other = slice(0, k), slice(k, N), slice(k, None)
-            S[:, other], D[:, other] = dense(slice(None), other)
+            dense(slice(None), other, (S[:, other], D[:, other]))  # written in place
             if k < N:
-                S[fr, fi], D[fr, fi] = dense(fr, fi)
+                dense(fr, fi, (S[fr, fi], D[fr, fi]))
             S[fi, fi] = cache.S[fi, fi]
             D[fi, fi] = cache.D[fi, fi]
         else:
@@ -760,7 +782,7 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
     # that near a corner the error follows the local variation of phi, not phi itself
     # (without it, B drifts as graded panels shrink: |grad phi| ~ s^(lambda - 1))
-    D[np.arange(N), np.arange(N)] -= D.sum(axis=1) + 0.5
+    D.flat[:: N + 1] -= D.sum(axis=1) + 0.5  # the diagonal (D is (N, N), C-ordered)
     return S, D
 
 
@@ -995,15 +1017,17 @@ def solve_panels(
     of a panel set of the same topology.
     """
     S, D = assemble(ps, plan, cache)
-    phi, g = solve_assembled(ps, S, D, neumann, depth)
+    phi, g = solve_assembled(ps, S, D, neumann, depth, overwrite=True)  # D: a fresh matrix of assemble's
     return SurfaceSolution(ps, phi, g, kind, depth=depth, volume=volume)
 
 
-def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, depth: float | None = None):
+def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, depth: float | None = None,
+                    overwrite: bool = False):
     """The boundary-integral equation (1/2 - D) phi = -S g of Part I, eq. (21) on assembled
     single- and double-layer matrices (the half-space's and the plate's, bem/slab.py): the Neumann
     data g at the primary nodes (default g = -n_x, unit motion in +x, Part I eq. (7)) and the
-    solution, both shaped (n_primary, order).  A non-finite solution raises ModelError."""
+    solution, both shaped (n_primary, order).  A non-finite solution raises ModelError.
+    ``overwrite``: D (C-ordered) may be overwritten (no (N, N) temporary)."""
     geo = ps.nodes
     n = ps.n_primary
     if neumann is None:
@@ -1011,10 +1035,10 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    A = -D
+    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
     A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
     with _single_threaded_blas():
-        phi = _dense_solve(A, -S @ g)
+        phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
     if phi is None or not np.all(np.isfinite(phi)):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
