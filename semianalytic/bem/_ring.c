@@ -173,6 +173,93 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
     ring_dense_ld(nrow, xr, rr, ncol, xc, rc, nxc, nrc, wc, ncol, S, D);
 }
 
+/* The block of ring_dense() whose targets are its own source nodes (the primary nodes against the primary
+ * panels): the modulus of the elliptic integrals is symmetric in target and source (the differences only
+ * change sign, the sum r + r1 commutes), so q, ln q, K, E and 1/(pi sqrt D) are computed once per pair
+ * {i, j} and give both S[i, j] and S[j, i] (this project's own shortcut).  Each entry is the same
+ * arithmetic, in the same order, as ring_dense's: the same numbers.  Nodes (x, r), normals (nx, nr),
+ * weights w; rows of S and D ld apart; with skip != NULL the pairs with skip[i] and skip[j] both nonzero
+ * are left as they are (their block is copied from a cache). */
+#define TILE 32
+
+/* One tile of ring_dense_sym: rows i0 .. i1-1 against columns j0 .. j1-1 (j0 >= i0), the pairs with j >= i;
+ * the entries (i, j) written along the rows, then their mirror entries (j, i) along the rows too; pairs
+ * of two skipped nodes are computed (in a tile that also holds others) but not written. */
+static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, const double *x, const double *r,
+                     const double *nx, const double *nr, const double *w, ptrdiff_t ld, const unsigned char *skip,
+                     double *restrict S, double *restrict D)
+{
+    double dx[TILE][TILE], dr[TILE][TILE], d2[TILE][TILE], K[TILE][TILE], E[TILE][TILE], inv[TILE][TILE];
+    double Dd[TILE], q[TILE], lnq[TILE];
+    for (ptrdiff_t i = i0; i < i1; i++) {
+        ptrdiff_t a = i - i0, first = j0 > i ? j0 : i;
+        int m = (int)(j1 - first);
+        if (m <= 0)
+            continue;
+        const double xi = x[i], ri = r[i];
+        double *tdx = dx[a] + (first - j0), *tdr = dr[a] + (first - j0), *td2 = d2[a] + (first - j0);
+        double *tK = K[a] + (first - j0), *tE = E[a] + (first - j0), *tinv = inv[a] + (first - j0);
+        for (int k = 0; k < m; k++) {
+            double s = ri + r[first + k];
+            tdx[k] = xi - x[first + k];
+            tdr[k] = ri - r[first + k];
+            td2[k] = tdx[k] * tdx[k] + tdr[k] * tdr[k];
+            Dd[k] = tdx[k] * tdx[k] + s * s;
+            q[k] = td2[k] / Dd[k];
+        }
+        for (int k = 0; k < m; k++)
+            lnq[k] = log(q[k]);
+        for (int k = 0; k < m; k++) {
+            tK[k] = horner(q[k], PK, 11) - lnq[k] * horner(q[k], QK, 11);
+            tE[k] = horner(q[k], PE, 11) - lnq[k] * q[k] * horner(q[k], QE, 10);
+            tinv[k] = 1.0 / (PI * sqrt(Dd[k]));
+        }
+        double *Si = S + i * ld + first, *Di = D + i * ld + first;
+        for (int k = 0; k < m; k++) {  /* target i, source j = first + k */
+            ptrdiff_t j = first + k;
+            if (skip && skip[i] && skip[j])
+                continue;
+            double bracket = r[j] * (tdx[k] * nx[j] + tdr[k] * nr[j]) + 0.5 * nr[j] * td2[k];
+            Si[k] = r[j] * tK[k] * tinv[k] * w[j];
+            Di[k] = (tE[k] * bracket / td2[k] - 0.5 * nr[j] * tK[k]) * tinv[k] * w[j];
+        }
+    }
+    for (ptrdiff_t j = j0; j < j1; j++) {  /* target j, source i < j: the differences are -dx, -dr */
+        ptrdiff_t b = j - j0, last = j < i1 ? j : i1;
+        double *Sj = S + j * ld, *Dj = D + j * ld;
+        for (ptrdiff_t i = i0; i < last; i++) {
+            ptrdiff_t a = i - i0;
+            if (skip && skip[i] && skip[j])
+                continue;
+            double mdx = -dx[a][b], mdr = -dr[a][b];
+            double bracket = r[i] * (mdx * nx[i] + mdr * nr[i]) + 0.5 * nr[i] * d2[a][b];
+            Sj[i] = r[i] * K[a][b] * inv[a][b] * w[i];
+            Dj[i] = (E[a][b] * bracket / d2[a][b] - 0.5 * nr[i] * K[a][b]) * inv[a][b] * w[i];
+        }
+    }
+}
+
+void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
+                    const double *w, ptrdiff_t ld, const unsigned char *skip, double *S, double *D)
+{
+    for (ptrdiff_t i0 = 0; i0 < n; i0 += TILE) {
+        ptrdiff_t i1 = i0 + TILE < n ? i0 + TILE : n;
+        for (ptrdiff_t j0 = i0; j0 < n; j0 += TILE) {
+            ptrdiff_t j1 = j0 + TILE < n ? j0 + TILE : n;
+            if (skip) {  /* a tile of skipped pairs only: nothing to do */
+                int all = 1;
+                for (ptrdiff_t i = i0; i < i1 && all; i++)
+                    all = skip[i] != 0;
+                for (ptrdiff_t j = j0; j < j1 && all; j++)
+                    all = skip[j] != 0;
+                if (all)
+                    continue;
+            }
+            sym_tile(i0, i1, j0, j1, x, r, nx, nr, w, ld, skip, S, D);
+        }
+    }
+}
+
 /* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:
  * the rows of a block are consecutive in `rows` (Q == 0) or repeat every Q points (Q > 0, one
  * matrix shared by the block's pairs).  P is a constant where inlined (the compiler unrolls). */

@@ -198,6 +198,8 @@ def compiled():
     lib.ring_dense.restype = None
     lib.ring_dense_ld.argtypes = [_N, _P, _P, _N] + [_P] * 5 + [_N, _P, _P]
     lib.ring_dense_ld.restype = None
+    lib.ring_dense_sym.argtypes = [_N] + [_P] * 5 + [_N, _P, _P, _P]
+    lib.ring_dense_sym.restype = None
     lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
@@ -285,6 +287,29 @@ def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288, out=No
     S *= wc
     Dl *= wc
     return S, Dl
+
+
+def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None) -> bool:
+    """The dense block of the nodes (x, r) (normals (nx, nr), weights w) against themselves, written into
+    the first n columns of the C-contiguous (n, ld) arrays S and D: S[i, j] w[j] and Dl[i, j] w[j] of
+    :func:`single_double` (Part I, eqs. (20)-(22)), the same numbers as :func:`single_double_dense`, with the
+    elliptic integrals evaluated once per pair {i, j} (their modulus is symmetric: this project's own
+    shortcut).  ``skip`` (a mask over the nodes, or None): pairs of two masked nodes are left unwritten.
+    Returns False, writing nothing, without the compiled kernels (the caller then uses
+    :func:`single_double_dense`)."""
+    lib = compiled()
+    if lib is None:
+        return False
+    x, r, nx, nr, w = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (x, r, nx, nr, w))
+    n = x.size
+    if not (S.flags.c_contiguous and D.flags.c_contiguous and S.shape == D.shape and S.shape[0] == n
+            and S.shape[1] >= n and S.dtype == D.dtype == np.float64) or any(a.size != n for a in (r, nx, nr, w)):
+        raise ValueError("single_double_dense_sym: arrays of inconsistent shapes")
+    mask = None if skip is None else np.ascontiguousarray(skip, dtype=np.uint8)
+    if mask is not None and mask.size != n:
+        raise ValueError("single_double_dense_sym: skip must have one entry per node")
+    lib.ring_dense_sym(n, *(address(a) for a in (x, r, nx, nr, w)), S.shape[1], address(mask), address(S), address(D))
+    return True
 
 
 def _c_array(a, dtype=float):

@@ -745,13 +745,22 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
         # blocks, so that temporaries stay small (DENSE_CHUNK)
         return single_double_dense(xt[rows], rt[rows], X[cols], R[cols], NX[cols], NR[cols], W[cols], DENSE_CHUNK, out)
 
-    if plan.fixed is None:
+    if plan.fixed is not None and cache is None:
+        raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
+    fix = None if plan.fixed is None else np.repeat(plan.fixed, p)
+    S, D = np.empty((N, X.size)), np.empty((N, X.size))
+    if _kernels.single_double_dense_sym(xt, rt, NX[:N], NR[:N], W[:N], S, D, fix):
+        # compiled: the primary nodes against themselves once per pair (the same numbers), then the mirror
+        # columns; the fixed panels' block from the cache
+        if X.size > N:
+            dense(slice(None), slice(N, None), (S[:, N:], D[:, N:]))  # written in place
+        if fix is not None:
+            k = int(np.count_nonzero(fix))
+            block = (slice(0, k),) * 2 if fix[:k].all() else np.ix_(*(np.nonzero(fix)[0],) * 2)  # slices when they lead
+            S[block], D[block] = cache.S[block], cache.D[block]
+    elif plan.fixed is None:
         S, D = dense(slice(None), slice(None))
     else:  # the block of the fixed panels from the cache, the rest computed
-        if cache is None:
-            raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
-        fix = np.repeat(plan.fixed, p)
-        S, D = np.empty((N, X.size)), np.empty((N, X.size))
         k = int(np.count_nonzero(fix))
         if fix[:k].all():  # the fixed panels lead (the nose before the moving ones): blocks by slices
             fi, fr, other = slice(0, k), slice(k, N), slice(k, None)
