@@ -272,7 +272,7 @@ typedef struct {
  * with extrapolation, evaluate_poly1), operation for operation so that the numbers are the
  * same: the interval with knots[i] <= t < knots[i+1] (the last one closed; outside, the end
  * intervals), s = t - knots[i], and the terms summed from the lowest power up as
- * res + c z prefactor with z = s^k built by products.  nu = 0 or 1. */
+ * res + c z prefactor with z = s^k built by products.  nu = 0, 1 or 2. */
 static inline void spline_eval(const panels_t *P, double t, int nu, double *x, double *r)
 {
     ptrdiff_t nk = P->nk, m = nk - 1, i;
@@ -306,12 +306,16 @@ static inline void spline_eval(const panels_t *P, double t, int nu, double *x, d
             res = res + c1 * z * 1.0;
             z *= s;
             res = res + c0 * z * 1.0;
-        } else {
+        } else if (nu == 1) {
             res = res + c2 * z * 1.0;
             z *= s;
             res = res + c1 * z * 2.0;
             z *= s;
             res = res + c0 * z * 3.0;
+        } else {  /* nu = 2: the prefactors 2 * 1 and 3 * 2 */
+            res = res + c1 * z * 2.0;
+            z *= s;
+            res = res + c0 * z * 6.0;
         }
         out[j] = res;
     }
@@ -357,6 +361,31 @@ static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double
     }
 }
 
+/* PanelSet.evaluate at one point: x, r, x_u, r_u (out[0..3]) at u on panel k, and the
+ * displacement (ex, er) from the anchor. */
+static inline void point_first(const panels_t *P, ptrdiff_t k, double uu, double *out, double *ex, double *er)
+{
+    double dtdu, dt = param(P, k, uu, &dtdu), t = P->base[k], dx, dr, c0 = P->c0[k], c1 = P->c1[k];
+    displacement(P, k, t, dt, ex, er);
+    if (P->kind[k] == 0) {  /* the derivative at t + dt */
+        dx = c0;
+        dr = c1;
+    } else if (P->kind[k] == 1) {
+        dx = -c0 * sin(t + dt);
+        dr = c0 * cos(t + dt);
+    } else if (P->kind[k] == 3) {
+        spline_eval(P, t + dt, 1, &dx, &dr);
+    } else {
+        dx = -c0 * sin(t + dt);
+        dr = c1 * cos(t + dt);
+    }
+    double sg = P->sign[k];
+    out[0] = sg * (P->ax[k] + *ex) + (sg - 1.0) * P->offset;
+    out[1] = P->ar[k] + *er;
+    out[2] = sg * dx * dtdu;
+    out[3] = dr * dtdu;
+}
+
 /* PanelSet.evaluate: point i on panel k = panel[i] at the reference coordinate u[i]; writes x,
  * r, x_u, r_u and, with sax != NULL, the split (anchor, offset) of PanelSet.split. */
 void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
@@ -368,28 +397,17 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
                        double *sax, double *sar, double *sex, double *ser)
 {
     panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    double o[4];
     for (ptrdiff_t i = 0; i < n; i++) {
         ptrdiff_t k = panel[i];
-        double dtdu, dt = param(&P, k, u[i], &dtdu), t = base[k], ex, er, dx, dr;
-        displacement(&P, k, t, dt, &ex, &er);
-        if (kind[k] == 0) {  /* the derivative at t + dt */
-            dx = c0[k];
-            dr = c1[k];
-        } else if (kind[k] == 1) {
-            dx = -c0[k] * sin(t + dt);
-            dr = c0[k] * cos(t + dt);
-        } else if (kind[k] == 3) {
-            spline_eval(&P, t + dt, 1, &dx, &dr);
-        } else {
-            dx = -c0[k] * sin(t + dt);
-            dr = c1[k] * cos(t + dt);
-        }
-        double sg = sign[k];
-        x[i] = sg * (ax[k] + ex) + (sg - 1.0) * offset;
-        r[i] = ar[k] + er;
-        xu[i] = sg * dx * dtdu;
-        ru[i] = dr * dtdu;
+        double ex, er;
+        point_first(&P, k, u[i], o, &ex, &er);
+        x[i] = o[0];
+        r[i] = o[1];
+        xu[i] = o[2];
+        ru[i] = o[3];
         if (sax) {
+            double sg = sign[k];
             sax[i] = sg * ax[k] + (sg - 1.0) * offset;
             sar[i] = ar[k];
             sex[i] = sg * ex;
@@ -420,5 +438,74 @@ void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_fr
         displacement(&P, k, t_from, step, &ex, &er);
         dx[i] = sign[k] * ex;
         dr[i] = er;
+    }
+}
+
+/* PanelSet.evaluate(..., second=True) at one point: x, r, x_u, r_u, x_uu, r_uu (out[0..5]) at u
+ * on panel k, the formulas of PanelSet._param (with its d2t) and _evaluate_segment's second
+ * branch in numpy's order, the segments' second_derivative (line 0, arc -R (cos, sin), ellipse
+ * (-a cos, -b sin), spline_eval with nu = 2).  On a corner panel w[0..2] are numpy's lo^q,
+ * lo^(q - 1) and lo^max(q - 2, 0) at the point (numpy's power differs from libm's pow by an
+ * ulp at times, and this replicates the numpy path; w is read on corner panels only). */
+static inline void point_second(const panels_t *P, ptrdiff_t k, double uu, const double *w, double *out)
+{
+    double dt = P->da[k] + P->half[k] * (uu + 1.0), dtdu = P->half[k], d2t = 0.0;
+    if (P->cluster && P->cluster[k] != 0.0) {
+        double c = P->cluster[k], q = P->power[k], span = P->db[k] - P->da[k];
+        double sw = span * w[0];
+        dt = c > 0 ? P->db[k] - sw : P->da[k] + sw;
+        dtdu = 0.5 * span * q * w[1];
+        double d2w = 0.25 * q * (q - 1.0) * w[2];
+        d2t = c > 0 ? -span * d2w : span * d2w;
+    }
+    double t = P->base[k], ex, er, dx, dr, ddx, ddr, c0 = P->c0[k], c1 = P->c1[k];
+    displacement(P, k, t, dt, &ex, &er);
+    if (P->kind[k] == 0) {
+        dx = c0;
+        dr = c1;
+        ddx = 0.0;
+        ddr = 0.0;
+    } else if (P->kind[k] == 1) {
+        dx = -c0 * sin(t + dt);
+        dr = c0 * cos(t + dt);
+        ddx = -c0 * cos(t + dt);
+        ddr = -c0 * sin(t + dt);
+    } else if (P->kind[k] == 3) {
+        spline_eval(P, t + dt, 1, &dx, &dr);
+        spline_eval(P, t + dt, 2, &ddx, &ddr);
+    } else {
+        dx = -c0 * sin(t + dt);
+        dr = c1 * cos(t + dt);
+        ddx = -c0 * cos(t + dt);
+        ddr = -c1 * sin(t + dt);
+    }
+    double sg = P->sign[k];
+    out[0] = sg * (P->ax[k] + ex) + (sg - 1.0) * P->offset;
+    out[1] = P->ar[k] + er;
+    out[2] = sg * dx * dtdu;
+    out[3] = dr * dtdu;
+    out[4] = sg * (ddx * dtdu * dtdu + dx * d2t);
+    out[5] = ddr * dtdu * dtdu + dr * d2t;
+}
+
+/* PanelSet.evaluate(..., second=True) (point_second) at point i on panel[i]; pw: (n, 3), rows
+ * of point_second's w (NULL without corner points). */
+void ring_panel_second(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
+                       const double *da, const double *db, const double *half, const double *sign,
+                       const double *ax, const double *ar, double offset, const double *cluster,
+                       const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                       ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw,
+                       double *x, double *r, double *xu, double *ru, double *xuu, double *ruu)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    double o[6];
+    for (ptrdiff_t i = 0; i < n; i++) {
+        point_second(&P, panel[i], u[i], pw ? pw + 3 * i : NULL, o);
+        x[i] = o[0];
+        r[i] = o[1];
+        xu[i] = o[2];
+        ru[i] = o[3];
+        xuu[i] = o[4];
+        ruu[i] = o[5];
     }
 }

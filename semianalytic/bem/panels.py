@@ -123,8 +123,8 @@ class PanelSet:
         u = np.asarray(u, dtype=float)
         if panel.shape != u.shape:
             panel, u = np.broadcast_arrays(panel, u)
-        if not second and u.size and self._compiled_curves is not None:
-            got = self._evaluate_compiled(panel, u, split)
+        if u.size and not (second and split) and self._compiled_curves is not None:
+            got = self._evaluate_compiled(panel, u, split, second)
             if got is not None:
                 return got
         curves, group = self._curves
@@ -195,21 +195,55 @@ class PanelSet:
             return None
         return lib, pk
 
-    def _evaluate_compiled(self, panel, u, split):
-        """:meth:`evaluate` (without second derivatives) by ``ring_panel_points`` of
-        ``_ring.c`` (the same formulas, this project's own speed-up), or None."""
+    def _evaluate_compiled(self, panel, u, split, second=False):
+        """:meth:`evaluate` by ``ring_panel_points`` of ``_ring.c`` (with ``second``:
+        ``ring_panel_second``, without ``split``) (the same formulas, this project's own
+        speed-up), or None."""
         got = self._compiled_lib(panel)
         if got is None:
             return None
         lib, pk = got
         c = self._compiled_curves[0]
         uu = np.ascontiguousarray(u, dtype=float).reshape(-1)
+        if second:
+            fn = lib.ring_panel_second
+            if fn.argtypes is None:  # declared here, beside its only caller
+                import ctypes
+
+                p, n = ctypes.c_void_p, ctypes.c_ssize_t
+                fn.argtypes = [n] + [p] * 9 + [ctypes.c_double] + [p] * 5 + [n] + [p] * 10
+                fn.restype = None
+            out = [np.empty(u.shape) for _ in range(6)]
+            pw = self._numpy_powers(pk, uu)
+            fn(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"],
+               c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"], c["nk"],
+               c["knots"], c["cx"], c["cr"], None if pw is None else address(pw), *(address(a) for a in out))
+            return tuple(out)
         out = [np.empty(u.shape) for _ in range(8 if split else 4)]
         ptr = [address(a) for a in out] + [None] * (0 if split else 4)
         lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
                               c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
         return tuple(out)
+
+    def _numpy_powers(self, pk, u):
+        """numpy's lo^q, lo^(q - 1), lo^max(q - 2, 0) of :meth:`_param` at the
+        points on corner panels, (n, 3) (other rows unset), for ``ring_panel_second``; None
+        without corner points.  numpy's power differs from the C library's pow by an ulp at
+        times: these keep the compiled second derivatives equal to numpy's bit for bit."""
+        if self.cluster is None:
+            return None
+        on = np.nonzero(self._clustered[pk])[0]
+        if on.size == 0:
+            return None
+        pko = pk[on]
+        q = self.power[pko]
+        lo = 0.5 * (1.0 - self.cluster[pko] * u[on])
+        pw = np.empty((pk.size, 3))
+        pw[on, 0] = lo**q
+        pw[on, 1] = lo ** (q - 1.0)
+        pw[on, 2] = lo ** np.maximum(q - 2.0, 0.0)
+        return pw
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):
         base, sg = self.base[pk], self.sign[pk]
