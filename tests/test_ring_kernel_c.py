@@ -344,3 +344,44 @@ def test_compiled_second_derivatives(monkeypatch):
     for ps, pan, u, g in got:
         for a, b in zip(g, ps.evaluate(pan, u, second=True), strict=True):
             assert np.array_equal(a, b)
+
+
+@needs_c
+def test_compiled_closest_points(monkeypatch):
+    """solve.closest_points compiled (ring_closest_points and ring_newton_step of _ring.c):
+    against the exact nearest point on a sphere (a target on the normal through a panel point
+    y0, inside the circle and within 1e-2 of the radius: the nearest point is y0 itself; two
+    Newton steps from the nearest of 17 samples converge to round-off there: measured 1e-15,
+    bounded at 1e-12 of the radius), and against the numpy path (kernels.compiled() None: the
+    same operations; the final points differ from numpy's geometry by the ulps of libm's pow
+    against numpy's on corner panels: 1e-12 relative in u* and du) on the study noses'
+    layouts with corner panels, near and far targets, images across the axis."""
+    from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
+    from semianalytic.bem.solve import closest_points
+    from semianalytic.coefficients.study import study_nose
+
+    rng = np.random.default_rng(11)
+    ps = body_panels(sphere_body(2.0))
+    pan = rng.integers(0, ps.n_panels, 400)
+    x0, r0, _, _ = ps.evaluate(pan, rng.uniform(-1, 1, 400))
+    shrink = 1.0 - rng.uniform(1e-6, 1e-2, 400)
+    u, du = closest_points(ps, pan, (x0 + ps.offset) * shrink - ps.offset, r0 * shrink)
+    x, r, _, _ = ps.evaluate(pan, u)
+    assert np.max(np.hypot(x - x0, r - r0)) <= 1e-12
+    got = []
+    for kind, f in (("ogive", 0.4), ("ogive", 2.5), ("cone", 0.3), ("cone", 2.0), ("table", 0.5), ("flat", 0.7)):
+        nose = study_nose(kind)
+        ps = halfspace_layout(nose, f * nose.depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+        assert ps._compiled_curves is not None
+        pan = rng.integers(0, ps.n_panels, 400)
+        x, r, _, _ = ps.evaluate(pan, rng.uniform(-1, 1, 400))
+        scale = np.where(rng.random(400) < 0.5, 1e-3, 0.3) * ps.lengths[pan]
+        xq, rq = x + scale * rng.standard_normal(400), r + scale * rng.standard_normal(400)
+        rq[:40] *= -1.0  # images across the axis
+        got.append((ps, pan, xq, rq, *closest_points(ps, pan, xq, rq)))
+    assert any(ps._clustered.any() for ps, *_ in got)
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    for ps, pan, xq, rq, u, du in got:
+        u0, du0 = closest_points(ps, pan, xq, rq)
+        assert np.max(np.abs(u - u0)) <= 1e-12
+        assert np.max(np.abs(du - du0) / np.maximum(du0, 1e-300)) <= 1e-12

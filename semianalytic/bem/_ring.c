@@ -509,3 +509,90 @@ void ring_panel_second(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
         ruu[i] = o[5];
     }
 }
+
+/* One Newton step of closest_points (semianalytic/bem/solve.py, _newton) on
+ * (y(u) - x) . y'(u) = 0 from u on panel k towards the point (X, R), projected onto [-1, 1] as
+ * numpy's clip does (NaN stays); w as in point_second. */
+static inline double newton_step(const panels_t *P, ptrdiff_t k, double uu, double X, double R, const double *w)
+{
+    double o[6];
+    point_second(P, k, uu, w, o);
+    double ex = o[0] - X, er = o[1] - R;
+    double fn = ex * o[2] + er * o[3];
+    double fp = o[2] * o[2] + o[3] * o[3] + ex * o[4] + er * o[5];
+    double step = fp > 0 ? fn / fp : 0.0;
+    double v = uu - step;
+    if (!(v != v)) v = v < -1.0 ? -1.0 : (v > 1.0 ? 1.0 : v);
+    return v;
+}
+
+/* newton_step at each pair i (u updated in place); pw as in ring_panel_second. */
+void ring_newton_step(ptrdiff_t n, const ptrdiff_t *pan, double *u, const double *xq, const double *rq,
+                      const double *base, const double *da, const double *db, const double *half, const double *sign,
+                      const double *ax, const double *ar, double offset, const double *cluster,
+                      const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                      ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    for (ptrdiff_t i = 0; i < n; i++)
+        u[i] = newton_step(&P, pan[i], u[i], xq[i], rq[i], pw ? pw + 3 * i : NULL);
+}
+
+/* closest_points (semianalytic/bem/solve.py) on the panels without a corner substitution, the
+ * same operations in the same order: the nearest of the ns samples of the panel's table
+ * (stx, str, stxu, stru: x, r, x_u, r_u, each (n_panels, ns); numpy's argmin, the first NaN or
+ * else the first minimum), the end test, two Newton steps on (y(u) - x) . y'(u) = 0 projected
+ * onto [-1, 1] (numpy's clip: NaN stays), the point at the result.  Writes u, ex = x - xq,
+ * er = r - rq, x_u, r_u; a pair that needs Newton steps on a corner panel gets todo[i] = 1 and
+ * its sample's values (the caller steps it with numpy's power, which pow here would miss by
+ * an ulp at times), the others todo[i] = 0. */
+void ring_closest_points(ptrdiff_t n, const ptrdiff_t *pan, const double *xq, const double *rq,
+                         ptrdiff_t ns, const double *samples, const double *stx, const double *str,
+                         const double *stxu, const double *stru, const double *base,
+                         const double *da, const double *db, const double *half, const double *sign,
+                         const double *ax, const double *ar, double offset, const double *cluster,
+                         const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                         ptrdiff_t nk, const double *knots, const double *cx, const double *cr,
+                         double *u, double *ex, double *er, double *xu, double *ru, signed char *todo)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = pan[i], row = k * ns, j = 0;
+        double X = xq[i], R = rq[i], best = 0.0;
+        for (ptrdiff_t m = 0; m < ns; m++) {
+            double a = stx[row + m] - X, b = str[row + m] - R;
+            double d2 = a * a + b * b;
+            if (d2 != d2) {  /* numpy's argmin: the first NaN */
+                j = m;
+                break;
+            }
+            if (m == 0 || d2 < best) {
+                best = d2;
+                j = m;
+            }
+        }
+        double uu = samples[j], x = stx[row + j], r = str[row + j], dx = stxu[row + j], dr = stru[row + j];
+        double f = (x - X) * dx + (r - R) * dr;
+        int settled = (j == 0 && f >= 0) || (j == ns - 1 && f <= 0);
+        todo[i] = 0;
+        if (!settled) {
+            if (cluster && cluster[k] != 0.0) {
+                todo[i] = 1;
+            } else {
+                double o[4], e1, e2;
+                for (int it = 0; it < 2; it++)
+                    uu = newton_step(&P, k, uu, X, R, NULL);
+                point_first(&P, k, uu, o, &e1, &e2);
+                x = o[0];
+                r = o[1];
+                dx = o[2];
+                dr = o[3];
+            }
+        }
+        u[i] = uu;
+        ex[i] = x - X;
+        er[i] = r - R;
+        xu[i] = dx;
+        ru[i] = dr;
+    }
+}

@@ -120,35 +120,97 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     Sampled, then refined by Newton's method (projected onto [-1, 1]): the minimum may lie
     between an end sample and its neighbour.  A pair whose nearest sample is an end of the
     panel where the distance grows inwards ((y - x) . y' >= 0 at u = -1, <= 0 at u = +1) keeps
-    that end: every Newton step from there points out of the panel and is projected back."""
-    samples = _samples(ps.order)
-    sx, sr, sxu, sru = _sample_table(ps)
-    x, r = sx[pan], sr[pan]
-    d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
-    j = np.argmin(d2, axis=1)
-    rows = np.arange(len(pan))
-    u = samples[j]
-    x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
-    f = (x - xq) * xu + (r - rq) * ru
-    last = samples.size - 1
-    settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
-    inner = np.nonzero(~settled)[0]
-    if inner.size:
-        ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
-        for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
-            xn, rn, xun, run, xuu, ruu = ps.evaluate(pi, ui, second=True)
-            ex, er = xn - xi, rn - ri
-            fn = ex * xun + er * run
-            fp = xun * xun + run * run + ex * xuu + er * ruu
-            step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
-            ui = np.clip(ui - step, -1.0, 1.0)
-        x[inner], r[inner], xu[inner], ru[inner] = ps.evaluate(pi, ui)
-        u[inner] = ui
-    dist = np.hypot(x - xq, r - rq)
+    that end: every Newton step from there points out of the panel and is projected back.
+    Compiled (``ring_closest_points`` of ``_ring.c``, the same operations: this project's own
+    speed-up) where the panel geometry is; Newton steps on corner panels always by
+    :func:`_newton` (numpy's power)."""
+    got = _closest_compiled(ps, pan, xq, rq)
+    if got is not None:
+        u, ex, er, xu, ru, todo = got
+    else:
+        samples = _samples(ps.order)
+        sx, sr, sxu, sru = _sample_table(ps)
+        x, r = sx[pan], sr[pan]
+        d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
+        j = np.argmin(d2, axis=1)
+        rows = np.arange(len(pan))
+        u = samples[j]
+        x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
+        ex, er = x - xq, r - rq
+        f = ex * xu + er * ru
+        last = samples.size - 1
+        settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
+        todo = np.nonzero(~settled)[0]
+    if todo.size:
+        u[todo], ex[todo], er[todo], xu[todo], ru[todo] = _newton(ps, pan[todo], u[todo], xq[todo], rq[todo])
+    dist = np.hypot(ex, er)
     with np.errstate(divide="ignore", invalid="ignore"):
         du = dist / np.hypot(xu, ru)
     du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
     return u, du
+
+
+def _newton(ps: PanelSet, pan, u, xq, rq):
+    """Two Newton steps of :func:`closest_points` from u: u, x - xq, r - rq, x_u, r_u there
+    (compiled: ``ring_newton_step`` of ``_ring.c``, given numpy's powers on corner panels)."""
+    got = ps._compiled_lib(pan)
+    if got is not None:
+        lib, pk = got
+        fn = _declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p")
+        c = ps._compiled_curves[0]
+        u = np.array(u, dtype=float)
+        xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
+        for _ in range(2):
+            pw = ps._numpy_powers(pk, u)
+            fn(pk.size, address(pk), address(u), address(xq), address(rq), c["base"], c["da"], c["db"], c["half"],
+               c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
+               c["nk"], c["knots"], c["cx"], c["cr"], None if pw is None else address(pw))
+        x, r, xu, ru = ps.evaluate(pan, u)
+        return u, x - xq, r - rq, xu, ru
+    for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
+        xn, rn, xun, run, xuu, ruu = ps.evaluate(pan, u, second=True)
+        ex, er = xn - xq, rn - rq
+        fn = ex * xun + er * run
+        fp = xun * xun + run * run + ex * xuu + er * ruu
+        step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
+        u = np.clip(u - step, -1.0, 1.0)
+    x, r, xu, ru = ps.evaluate(pan, u)
+    return u, x - xq, r - rq, xu, ru
+
+
+def _declare(fn, types: str):
+    """A function of the compiled library with its argument types (n: ptrdiff_t, p: address,
+    d: double) declared, once; declared here beside its callers."""
+    if fn.argtypes is None:
+        import ctypes
+
+        kinds = {"n": ctypes.c_ssize_t, "p": ctypes.c_void_p, "d": ctypes.c_double}
+        fn.argtypes = [kinds[t] for t in types.split()]
+        fn.restype = None
+    return fn
+
+
+def _closest_compiled(ps: PanelSet, pan, xq, rq):
+    """:func:`closest_points`' search by ``ring_closest_points``: u, x - xq, r - rq, x_u, r_u
+    and the pairs left to :func:`_newton` (on corner panels); None without compiled geometry."""
+    got = ps._compiled_lib(pan) if len(pan) else None
+    if got is None:
+        return None
+    lib, pk = got
+    fn = _declare(lib.ring_closest_points, "n p p p n" + " p" * 12 + " d p p p p p n" + " p" * 9)
+    c = ps._compiled_curves[0]
+    table = ps.__dict__.get("_closest_table")
+    if table is None:
+        table = ps.__dict__["_closest_table"] = [np.ascontiguousarray(a, dtype=float) for a in _sample_table(ps)]
+    samples = _samples(ps.order)
+    xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
+    out = [np.empty(pk.size) for _ in range(5)]
+    todo = np.empty(pk.size, dtype=np.int8)
+    fn(pk.size, address(pk), address(xq), address(rq), samples.size, address(samples), *(address(a) for a in table),
+       c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"],
+       c["power"], c["kind"], c["c0"], c["c1"], c["nk"], c["knots"], c["cx"], c["cr"],
+       *(address(a) for a in out), address(todo))
+    return (*out, np.nonzero(todo)[0])
 
 
 def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.ndarray | None = None,
