@@ -564,40 +564,63 @@ def _end_rule(order: int, end: float, n: int):
     return u, w, lag
 
 
+@functools.lru_cache(maxsize=256)
+def _end_rules(order: int, keys: bytes):
+    """The end rules of ``keys`` (int64, each the signed number of pieces of :func:`_end_rule`):
+    their Lagrange matrices, numbers of points and first points in the concatenation of their
+    points and weights (kept per set of keys: the neighbouring depths of a table share them)."""
+    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in np.frombuffer(keys, dtype=np.int64).tolist()]
+    size = np.array([r[0].size for r in rules], dtype=np.int64)
+    cat = [np.concatenate([r[j] for r in rules]) if rules else np.empty(0) for j in (0, 1)]
+    return tuple(r[2] for r in rules), size, np.cumsum(size) - size, cat[0], cat[1]
+
+
 def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     """Dyadic rules on [-1, 1] split at u* (the panel point nearest each target), with
     pieces no longer than their distance from the target (``du`` in the panel parameter).
 
     Pairs whose u* is an end of the panel (neighbouring panels: most pairs) take a rule
-    built once per level (:func:`_end_rule`); the others are built together."""
+    built once per level (:func:`_end_rule`); the others are built together.  The rule's
+    :attr:`PairQuadrature.distinct` points are those of :meth:`PairQuadrature.with_distinct_points`,
+    found from the rules' structure (one set per end rule and panel, in the order of their
+    keys; then each other pair's points)."""
     target, panel = np.asarray(target), np.asarray(panel)
     if target.size == 0:
         return PairQuadrature.build(target, panel, order, [])
-    left, right = 1.0 + ustar, 1.0 - ustar
-    # pieces per side; 0: the side is empty (u* at that end of the panel)
-    n_l = np.where(left > 0, _levels(left, du) + 1, 0)
-    n_r = np.where(right > 0, _levels(right, du) + 1, 0)
+    npairs = ustar.size
+    # pieces per side, left (1 + u*) and right (1 - u*) in one call; 0: the side is empty
+    sides = np.concatenate([1.0 + ustar, 1.0 - ustar])
+    n_lr = np.where(sides > 0, _levels(sides, np.concatenate([du, du])) + 1, 0)
+    n_l, n_r = n_lr[:npairs], n_lr[npairs:]
     at_end = (n_l == 0) | (n_r == 0)
     key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
     # point's u and w gathered from the rules' concatenated points; then the other pairs
     ends = np.nonzero(at_end)[0]
     ends = ends[np.argsort(key[ends], kind="stable")]
-    keys, first, per_key = np.unique(key[ends], return_index=True, return_counts=True)
-    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in keys.tolist()]
-    size = np.array([r[0].size for r in rules], dtype=np.int64)
-    blocks = tuple((int(f), int(c), int(q), r[2]) for f, c, q, r in zip(first, per_key, size, rules))
+    sk = key[ends]
+    first = np.flatnonzero(np.concatenate([[True], sk[1:] != sk[:-1]])) if sk.size else np.empty(0, np.int64)
+    per_key = np.diff(np.append(first, sk.size))
+    lags, size, rule_first, u_cat, w_cat = _end_rules(order, np.ascontiguousarray(sk[first], dtype=np.int64).tobytes())
+    blocks = tuple(zip(first.tolist(), per_key.tolist(), size.tolist(), lags))
     counts = np.repeat(size, per_key)  # points of each end pair
-    inner = np.nonzero(~at_end)[0]
-    if rules:
-        rule_at = np.repeat(np.cumsum(size) - size, per_key)  # each pair's rule in the concatenation
-        pair_at = np.cumsum(counts) - counts
-        src = np.repeat(rule_at - pair_at, counts) + np.arange(int(counts.sum()))
-        u_end = np.concatenate([r[0] for r in rules])[src]
-        w_end = np.concatenate([r[1] for r in rules])[src]
-    else:
-        u_end = w_end = np.empty(0)
+    pair_at = np.cumsum(counts) - counts
+    src = np.repeat(np.repeat(rule_first, per_key) - pair_at, counts) + np.arange(int(pair_at[-1] + counts[-1]) if counts.size else 0)
+    u_end, w_end = u_cat[src], w_cat[src]
+    # distinct points: one set per (end rule, panel), in ascending rule * span + panel
+    span = int(panel.max()) + 1
+    gkey = np.repeat(np.arange(size.size), per_key) * span + panel[ends]
+    present = np.zeros(size.size * span, bool)
+    present[gkey] = True
+    groups = np.flatnonzero(present)
+    group_of = (np.cumsum(present) - 1)[gkey]  # each end pair's set
+    g_rule, g_size = groups // span, size[groups // span]
+    g_at = np.cumsum(g_size) - g_size
+    d_src = np.repeat(rule_first[g_rule] - g_at, g_size) + np.arange(int(g_size.sum()))
+    d_panel, d_u = np.repeat(groups % span, g_size), u_cat[d_src]
+    d_index = np.repeat(g_at[group_of] - pair_at, counts) + np.arange(u_end.size)
     flat = np.empty((0, order))
+    inner = np.nonzero(~at_end)[0]
     if inner.size:
         pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
@@ -605,11 +628,15 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
         flat = lagrange_matrix(gauss_legendre(order)[0], u)
         blocks += ((ends.size, inner.size, 0, None),)
         counts = np.concatenate([counts, np.bincount(pair, minlength=inner.size)])
+        # each inner pair's points are a set of their own, after the end rules' sets
+        d_index = np.concatenate([d_index, int(g_size.sum()) + np.arange(u.size)])
+        d_panel = np.concatenate([d_panel, panel[inner][pair[pts]]])
+        d_u = np.concatenate([d_u, u])
         u_end, w_end = np.concatenate([u_end, u]), np.concatenate([w_end, w])
     order_idx = np.concatenate([ends, inner])
-    rule = PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
-                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks)
-    return rule.with_distinct_points()
+    return PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
+                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks,
+                          (d_panel, d_u, d_index))
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
