@@ -233,8 +233,9 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     :func:`closest_points` (the same numbers as separate calls, a third of the calls)."""
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
-    near = np.hypot(xt[:, None] - cx[None, :], rt[:, None] - cr[None, :]) < reach
-    near_img = np.hypot(xt[:, None] - cx[None, :], rt[:, None] + cr[None, :]) < reach
+    dx = xt[:, None] - cx[None, :]
+    near = np.hypot(dx, rt[:, None] - cr[None, :]) < reach
+    near_img = np.hypot(dx, rt[:, None] + cr[None, :]) < reach
     if exclude_panel is not None:
         rows = np.arange(len(xt))
         near[rows, exclude_panel] = False
@@ -717,17 +718,23 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     # the near pairs and the self pairs' axis images: one search of the nearest points
     tgt, pan, ustar, du, _, du_img = _near_pairs_with(ps, xt, rt, own_panel, block,
                                                       (own_panel[close], xt[close], -rt[close]))
-    if close.size:
-        levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
-        levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
     mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels
-    if mapped.size:
+    # the levels of both sides of the close nodes and of the mapped ones, in one call
+    m, n = close.size, mapped.size
+    if m or n:
+        c = ps.cluster[own_panel[mapped]] if n else np.empty(0)
+        uc, um = uq[close], uq[mapped]
         # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
         # the node; keep the self rule's innermost pieces within half of that
-        c = ps.cluster[own_panel[mapped]]
-        gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
-        levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
-        levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
+        gap = 0.5 * np.where(c < 0, 1.0 + um, 1.0 - um)
+        d = du_img / IMAGE_MARGIN
+        lev = _levels(np.concatenate([1.0 - uc, 1.0 + uc, 1.0 - um, 1.0 + um]), np.concatenate([d, d, gap, gap]))
+        if m:
+            levels[close, 0] = lev[:m]
+            levels[close, 1] = lev[m:2 * m]
+        if n:
+            levels[mapped, 0] = np.maximum(levels[mapped, 0], lev[2 * m:2 * m + n])
+            levels[mapped, 1] = np.maximum(levels[mapped, 1], lev[2 * m + n:])
     self_rule = self_quadrature(levels, p)
     if fixed is not None:
         self_rule = self_rule.subset(free_node[self_rule.target])
