@@ -526,16 +526,28 @@ static inline double newton_step(const panels_t *P, ptrdiff_t k, double uu, doub
     return v;
 }
 
-/* newton_step at each pair i (u updated in place); pw as in ring_panel_second. */
+/* newton_step at each pair i (u updated in place); pw as in ring_panel_second.  With ex != NULL,
+ * also the point at the new u (point_first, as PanelSet.evaluate computes it): x - xq, r - rq,
+ * x_u, r_u. */
 void ring_newton_step(ptrdiff_t n, const ptrdiff_t *pan, double *u, const double *xq, const double *rq,
                       const double *base, const double *da, const double *db, const double *half, const double *sign,
                       const double *ax, const double *ar, double offset, const double *cluster,
                       const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
-                      ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw)
+                      ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw,
+                      double *ex, double *er, double *xu, double *ru)
 {
     panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
-    for (ptrdiff_t i = 0; i < n; i++)
+    for (ptrdiff_t i = 0; i < n; i++) {
         u[i] = newton_step(&P, pan[i], u[i], xq[i], rq[i], pw ? pw + 3 * i : NULL);
+        if (ex) {
+            double o[4], e1, e2;
+            point_first(&P, pan[i], u[i], o, &e1, &e2);
+            ex[i] = o[0] - xq[i];
+            er[i] = o[1] - rq[i];
+            xu[i] = o[2];
+            ru[i] = o[3];
+        }
+    }
 }
 
 /* closest_points (semianalytic/bem/solve.py) on the panels without a corner substitution, the

@@ -360,20 +360,22 @@ class PanelSet:
         |dy/du| -> 0 at the corner, the u-step that covers ``dist`` along the curve."""
         if self.cluster is None:
             return du
-        on = np.nonzero(self.cluster[panel] != 0)[0]
+        on = np.nonzero(self._clustered[panel])[0]
         if on.size == 0:
             return du
         du = np.array(du, dtype=float, copy=True)
         pk, uk, dk = panel[on], u[on], dist[on]
         c, q = self.cluster[pk], self.power[pk]
-        span = np.abs(self.db[pk] - self.da[pk])
+        so = self._span[pk]
+        span = np.abs(so)
+        lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
+        w = lo**q  # fraction of the panel's parameter span from the corner
+        sw = so * w  # the parameter offset of _param on corner panels, from the same power
+        dt = np.where(c > 0, self.db[pk] - sw, self.da[pk] + sw)
         speed = np.empty(on.size)
-        dt = self._param(pk, uk)[0]
         for seg, m, pkm in self._by_segment(pk):
             dx, dr = seg.derivative(self.base[pkm] + dt[m])
             speed[m] = np.hypot(dx, dr)
-        lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
-        w = lo**q  # fraction of the panel's parameter span from the corner
         dw = dk / np.maximum(speed * span, 1e-300)
         up = np.minimum(w + dw, 1.0) ** (1.0 / q) - lo
         down = lo - np.maximum(w - dw, 0.0) ** (1.0 / q)

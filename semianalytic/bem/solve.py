@@ -156,17 +156,18 @@ def _newton(ps: PanelSet, pan, u, xq, rq):
     got = ps._compiled_lib(pan)
     if got is not None:
         lib, pk = got
-        fn = _declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p")
+        fn = _declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p p p p p")
         c = ps._compiled_curves[0]
         u = np.array(u, dtype=float)
         xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
-        for _ in range(2):
+        out = [np.empty(u.size) for _ in range(4)]  # the point at the last step: ex, er, x_u, r_u
+        for last in (False, True):
             pw = ps._numpy_powers(pk, u)
             fn(pk.size, address(pk), address(u), address(xq), address(rq), c["base"], c["da"], c["db"], c["half"],
                c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-               c["nk"], c["knots"], c["cx"], c["cr"], None if pw is None else address(pw))
-        x, r, xu, ru = ps.evaluate(pan, u)
-        return u, x - xq, r - rq, xu, ru
+               c["nk"], c["knots"], c["cx"], c["cr"], None if pw is None else address(pw),
+               *((address(a) for a in out) if last else (None,) * 4))
+        return (u, *out)
     for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
         xn, rn, xun, run, xuu, ruu = ps.evaluate(pan, u, second=True)
         ex, er = xn - xq, rn - rq
