@@ -35,3 +35,21 @@ def test_near_quadrature_distinct_points(kind, f):
         # every point's distinct point is the point itself
         panel_of, u_of, index = rule.distinct
         assert np.array_equal(panel_of[index], rule.panel[rule.pair]) and np.array_equal(u_of[index], rule.u)
+
+
+def test_closer_is_hypot_below_reach():
+    """solve._closer (squared distances, hypot only at the margin) against numpy's hypot(a, b)
+    < reach, the test it replaces, element for element: random points, points on the circle of
+    radius reach (the 3-4-5 triangle, exact) and an ulp either side, scales from 1e-200 to 1e200
+    (the fallback where squares would under- or overflow)."""
+    from semianalytic.bem.solve import _closer
+
+    rng = np.random.default_rng(4)
+    for scale in (1e-200, 1e-9, 1.0, 1e200):
+        a = rng.standard_normal((60, 30)) * scale
+        b = rng.standard_normal((60, 30)) * scale
+        reach = np.abs(rng.standard_normal(30)) * scale * 1.5
+        a[:5], b[:5] = 0.6 * reach, 0.8 * reach  # on the circle
+        a[5:10] = np.nextafter(0.6 * reach, np.inf)
+        a[10:15] = np.nextafter(0.6 * reach, -np.inf)
+        assert np.array_equal(_closer(a, b, reach[None, :]), np.hypot(a, b) < reach[None, :])

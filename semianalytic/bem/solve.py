@@ -235,8 +235,8 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
     dx = xt[:, None] - cx[None, :]
-    near = np.hypot(dx, rt[:, None] - cr[None, :]) < reach
-    near_img = np.hypot(dx, rt[:, None] + cr[None, :]) < reach
+    near = _closer(dx, rt[:, None] - cr[None, :], reach)
+    near_img = _closer(dx, rt[:, None] + cr[None, :], reach)
     if exclude_panel is not None:
         rows = np.arange(len(xt))
         near[rows, exclude_panel] = False
@@ -263,6 +263,23 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
         u[img[use]] = u_img[use]
         du[img[use]] = du_img[use]
     return tgt, pan, u, du, uq[n + m:], duq[n + m:]
+
+
+def _closer(a, b, reach):
+    """hypot(a, b) < reach elementwise (a, b of one shape, reach broadcasting to it), numpy's
+    hypot deciding only where a^2 + b^2 lies within 1e-12 of reach^2 (this project's own
+    shortcut, the same booleans at a quarter of the cost: a^2 + b^2 and hypot^2 differ by a
+    few ulps, 1e-15; squares near under- or overflow take hypot everywhere)."""
+    if not 1e-140 < float(np.min(reach)) <= float(np.max(reach)) < 1e140:
+        return np.hypot(a, b) < reach
+    r2 = reach * reach
+    with np.errstate(over="ignore"):  # a^2 = inf: far, as hypot says
+        s = a * a + b * b
+    out = s < r2 * (1.0 - 1e-12)
+    edge = np.nonzero(~out & (s <= r2 * (1.0 + 1e-12)))
+    if edge[0].size:
+        out[edge] = np.hypot(a[edge], b[edge]) < np.broadcast_to(reach, s.shape)[edge]
+    return out
 
 
 def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
