@@ -42,7 +42,7 @@ from semianalytic.bem.kernels import (
     gradient_kernels, pair_rules_compiled, single_double, single_double_dense, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
-from semianalytic.bem.panels import PanelSet
+from semianalytic.bem.panels import PanelSet, declare
 from semianalytic.native import address
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -156,7 +156,7 @@ def _newton(ps: PanelSet, pan, u, xq, rq):
     got = ps._compiled_lib(pan)
     if got is not None:
         lib, pk = got
-        fn = _declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p p p p p")
+        fn = declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p p p p p")
         c = ps._compiled_curves[0]
         u = np.array(u, dtype=float)
         xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
@@ -179,18 +179,6 @@ def _newton(ps: PanelSet, pan, u, xq, rq):
     return u, x - xq, r - rq, xu, ru
 
 
-def _declare(fn, types: str):
-    """A function of the compiled library with its argument types (n: ptrdiff_t, p: address,
-    d: double) declared, once; declared here beside its callers."""
-    if fn.argtypes is None:
-        import ctypes
-
-        kinds = {"n": ctypes.c_ssize_t, "p": ctypes.c_void_p, "d": ctypes.c_double}
-        fn.argtypes = [kinds[t] for t in types.split()]
-        fn.restype = None
-    return fn
-
-
 def _closest_compiled(ps: PanelSet, pan, xq, rq):
     """:func:`closest_points`' search by ``ring_closest_points``: u, x - xq, r - rq, x_u, r_u
     and the pairs left to :func:`_newton` (on corner panels); None without compiled geometry."""
@@ -198,7 +186,7 @@ def _closest_compiled(ps: PanelSet, pan, xq, rq):
     if got is None:
         return None
     lib, pk = got
-    fn = _declare(lib.ring_closest_points, "n p p p n" + " p" * 12 + " d p p p p p n" + " p" * 9)
+    fn = declare(lib.ring_closest_points, "n p p p n" + " p" * 12 + " d p p p p p n" + " p" * 9)
     c = ps._compiled_curves[0]
     table = ps.__dict__.get("_closest_table")
     if table is None:
