@@ -389,9 +389,21 @@ class PairQuadrature:
         )
 
     def subset(self, keep: np.ndarray) -> "PairQuadrature":
-        """The rules of the pairs where ``keep`` (a mask over pairs) is true."""
+        """The rules of the pairs where ``keep`` (a mask over pairs) is true (kept per mask, up
+        to 64 masks: the self rules, shared by the depths of a table, are cut by the same masks
+        of reused blocks at many depths; this project's own shortcut, the same rules)."""
         if keep.all():
             return self
+        memo = self.__dict__.setdefault("_subsets", {})
+        key = np.ascontiguousarray(keep, dtype=bool).tobytes()
+        got = memo.get(key)
+        if got is None:
+            got = self._subset(keep)
+            if len(memo) < 64:
+                memo[key] = got
+        return got
+
+    def _subset(self, keep: np.ndarray) -> "PairQuadrature":
         points = keep[self.pair]
         renumber = np.cumsum(keep) - 1
         pair = renumber[self.pair[points]]
