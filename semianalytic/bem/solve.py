@@ -616,7 +616,8 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
     # point's u and w gathered from the rules' concatenated points; then the other pairs
     ends = np.nonzero(at_end)[0]
-    ends = ends[np.argsort(key[ends], kind="stable")]
+    # keys within +-2 (MAX_LEVELS + 1): sorted as int16 (numpy's radix sort; the same stable order)
+    ends = ends[np.argsort(key[ends].astype(np.int16), kind="stable")]
     sk = key[ends]
     first = np.flatnonzero(np.concatenate([[True], sk[1:] != sk[:-1]])) if sk.size else np.empty(0, np.int64)
     per_key = np.diff(np.append(first, sk.size))
