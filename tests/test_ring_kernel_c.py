@@ -293,3 +293,95 @@ def test_compiled_panel_geometry(monkeypatch):
         for a, b in zip(g, e):
             assert a.shape == b.shape
             assert np.max(np.abs(a - b)) <= 4e-15 * max(np.max(np.abs(b)), 1e-300)
+
+
+@needs_c
+def test_compiled_second_derivatives(monkeypatch):
+    """PanelSet.evaluate(..., second=True) compiled (ring_panel_second of _ring.c): against an
+    exact property, the curvature |x_u r_uu - r_u x_uu| / |y_u|^3, which does not depend on
+    the parametrisation (so it holds on corner panels, whose substituted parameter brings in
+    d2t, and on mirror images): 1/R on the ogive's arc (R = crh d) and on a sphere, ab / (a^2
+    sin^2 t + b^2 cos^2 t)^(3/2) on a spheroid's ellipse (round-off in a few products and a cube,
+    1e-9; on corner panels x_uu is dominated by y' d2t, parallel to y_u, which cancels in the
+    cross product: measured 4e-8 on the ogive's tip panels, bounded at 1e-6, far below the O(1)
+    error a wrong or missing term causes); and bit for bit against the numpy path (the same operations in the
+    same order, numpy's power passed in on corner panels) on lines, arcs, ellipse arcs and a
+    table's spline, plain and corner panels, primary and mirrored."""
+    from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
+    from semianalytic.coefficients.study import study_nose
+    from semianalytic.geometry import spheroid_body
+
+    rng = np.random.default_rng(5)
+    ogive = study_nose("ogive")
+    cases = [(halfspace_layout(ogive, 0.7 * ogive.length, LayoutOptions(8, 0.3, 6)).panels(), 3.0 * 7.11e-3),
+             (body_panels(sphere_body(2.0)), 1.0)]
+    for ps, R in cases:
+        assert ps._compiled_curves is not None
+        pan = rng.integers(0, ps.n_panels, 3000)
+        u = rng.uniform(-1, 1, 3000)
+        x, r, xu, ru, xuu, ruu = ps.evaluate(pan, u, second=True)
+        kappa = np.abs(xu * ruu - ru * xuu) / np.hypot(xu, ru) ** 3
+        assert np.max(np.abs(kappa * R - 1.0)) <= 1e-6
+    a, b = 1.5, 0.5  # the semi-axes of spheroid_body(3, 1)
+    ps = body_panels(spheroid_body(2 * a, 2 * b))
+    pan = rng.integers(0, ps.n_panels, 3000)
+    u = rng.uniform(-1, 1, 3000)
+    x, r, xu, ru, xuu, ruu = ps.evaluate(pan, u, second=True)
+    t = np.arctan2(r / b, (x + ps.offset - ps.segments[0].xc) / a)
+    exact = a * b / (a**2 * np.sin(t) ** 2 + b**2 * np.cos(t) ** 2) ** 1.5
+    assert np.max(np.abs(np.abs(xu * ruu - ru * xuu) / np.hypot(xu, ru) ** 3 / exact - 1.0)) <= 1e-9
+    layouts = [halfspace_layout(study_nose(k), f * study_nose(k).depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+               for k, f in (("ogive", 3.5), ("ogive", 0.3), ("cone", 2.0), ("cone", 0.2), ("table", 0.4), ("table", 1.5),
+                            ("flat", 0.5))] + [body_panels(spheroid_body(3.0, 1.0))]
+    got = []
+    for ps in layouts:
+        assert ps._compiled_curves is not None
+        pan = rng.integers(0, ps.n_panels, 3000)
+        u = np.concatenate([rng.uniform(-1, 1, 2900), -np.ones(50), np.ones(50)])
+        got.append((ps, pan, u, ps.evaluate(pan, u, second=True)))
+    assert any(ps._clustered.any() for ps in layouts)
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    for ps, pan, u, g in got:
+        for a, b in zip(g, ps.evaluate(pan, u, second=True), strict=True):
+            assert np.array_equal(a, b)
+
+
+@needs_c
+def test_compiled_closest_points(monkeypatch):
+    """solve.closest_points compiled (ring_closest_points and ring_newton_step of _ring.c):
+    against the exact nearest point on a sphere (a target on the normal through a panel point
+    y0, inside the circle and within 1e-2 of the radius: the nearest point is y0 itself; two
+    Newton steps from the nearest of 17 samples converge to round-off there: measured 1e-15,
+    bounded at 1e-12 of the radius), and against the numpy path (kernels.compiled() None: the
+    same operations; the final points differ from numpy's geometry by the ulps of libm's pow
+    against numpy's on corner panels: 1e-12 relative in u* and du) on the study noses'
+    layouts with corner panels, near and far targets, images across the axis."""
+    from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
+    from semianalytic.bem.solve import closest_points
+    from semianalytic.coefficients.study import study_nose
+
+    rng = np.random.default_rng(11)
+    ps = body_panels(sphere_body(2.0))
+    pan = rng.integers(0, ps.n_panels, 400)
+    x0, r0, _, _ = ps.evaluate(pan, rng.uniform(-1, 1, 400))
+    shrink = 1.0 - rng.uniform(1e-6, 1e-2, 400)
+    u, du = closest_points(ps, pan, (x0 + ps.offset) * shrink - ps.offset, r0 * shrink)
+    x, r, _, _ = ps.evaluate(pan, u)
+    assert np.max(np.hypot(x - x0, r - r0)) <= 1e-12
+    got = []
+    for kind, f in (("ogive", 0.4), ("ogive", 2.5), ("cone", 0.3), ("cone", 2.0), ("table", 0.5), ("flat", 0.7)):
+        nose = study_nose(kind)
+        ps = halfspace_layout(nose, f * nose.depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+        assert ps._compiled_curves is not None
+        pan = rng.integers(0, ps.n_panels, 400)
+        x, r, _, _ = ps.evaluate(pan, rng.uniform(-1, 1, 400))
+        scale = np.where(rng.random(400) < 0.5, 1e-3, 0.3) * ps.lengths[pan]
+        xq, rq = x + scale * rng.standard_normal(400), r + scale * rng.standard_normal(400)
+        rq[:40] *= -1.0  # images across the axis
+        got.append((ps, pan, xq, rq, *closest_points(ps, pan, xq, rq)))
+    assert any(ps._clustered.any() for ps, *_ in got)
+    monkeypatch.setattr(kernels, "compiled", lambda: None)
+    for ps, pan, xq, rq, u, du in got:
+        u0, du0 = closest_points(ps, pan, xq, rq)
+        assert np.max(np.abs(u - u0)) <= 1e-12
+        assert np.max(np.abs(du - du0) / np.maximum(du0, 1e-300)) <= 1e-12

@@ -388,7 +388,7 @@ typedef struct {
  * with extrapolation, evaluate_poly1), operation for operation so that the numbers are the
  * same: the interval with knots[i] <= t < knots[i+1] (the last one closed; outside, the end
  * intervals), s = t - knots[i], and the terms summed from the lowest power up as
- * res + c z prefactor with z = s^k built by products.  nu = 0 or 1. */
+ * res + c z prefactor with z = s^k built by products.  nu = 0, 1 or 2. */
 static inline void spline_eval(const panels_t *P, double t, int nu, double *x, double *r)
 {
     ptrdiff_t nk = P->nk, m = nk - 1, i;
@@ -422,12 +422,16 @@ static inline void spline_eval(const panels_t *P, double t, int nu, double *x, d
             res = res + c1 * z * 1.0;
             z *= s;
             res = res + c0 * z * 1.0;
-        } else {
+        } else if (nu == 1) {
             res = res + c2 * z * 1.0;
             z *= s;
             res = res + c1 * z * 2.0;
             z *= s;
             res = res + c0 * z * 3.0;
+        } else {  /* nu = 2: the prefactors 2 * 1 and 3 * 2 */
+            res = res + c1 * z * 2.0;
+            z *= s;
+            res = res + c0 * z * 6.0;
         }
         out[j] = res;
     }
@@ -473,6 +477,31 @@ static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double
     }
 }
 
+/* PanelSet.evaluate at one point: x, r, x_u, r_u (out[0..3]) at u on panel k, and the
+ * displacement (ex, er) from the anchor. */
+static inline void point_first(const panels_t *P, ptrdiff_t k, double uu, double *out, double *ex, double *er)
+{
+    double dtdu, dt = param(P, k, uu, &dtdu), t = P->base[k], dx, dr, c0 = P->c0[k], c1 = P->c1[k];
+    displacement(P, k, t, dt, ex, er);
+    if (P->kind[k] == 0) {  /* the derivative at t + dt */
+        dx = c0;
+        dr = c1;
+    } else if (P->kind[k] == 1) {
+        dx = -c0 * sin(t + dt);
+        dr = c0 * cos(t + dt);
+    } else if (P->kind[k] == 3) {
+        spline_eval(P, t + dt, 1, &dx, &dr);
+    } else {
+        dx = -c0 * sin(t + dt);
+        dr = c1 * cos(t + dt);
+    }
+    double sg = P->sign[k];
+    out[0] = sg * (P->ax[k] + *ex) + (sg - 1.0) * P->offset;
+    out[1] = P->ar[k] + *er;
+    out[2] = sg * dx * dtdu;
+    out[3] = dr * dtdu;
+}
+
 /* PanelSet.evaluate: point i on panel k = panel[i] at the reference coordinate u[i]; writes x,
  * r, x_u, r_u and, with sax != NULL, the split (anchor, offset) of PanelSet.split. */
 void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
@@ -484,28 +513,17 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
                        double *sax, double *sar, double *sex, double *ser)
 {
     panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    double o[4];
     for (ptrdiff_t i = 0; i < n; i++) {
         ptrdiff_t k = panel[i];
-        double dtdu, dt = param(&P, k, u[i], &dtdu), t = base[k], ex, er, dx, dr;
-        displacement(&P, k, t, dt, &ex, &er);
-        if (kind[k] == 0) {  /* the derivative at t + dt */
-            dx = c0[k];
-            dr = c1[k];
-        } else if (kind[k] == 1) {
-            dx = -c0[k] * sin(t + dt);
-            dr = c0[k] * cos(t + dt);
-        } else if (kind[k] == 3) {
-            spline_eval(&P, t + dt, 1, &dx, &dr);
-        } else {
-            dx = -c0[k] * sin(t + dt);
-            dr = c1[k] * cos(t + dt);
-        }
-        double sg = sign[k];
-        x[i] = sg * (ax[k] + ex) + (sg - 1.0) * offset;
-        r[i] = ar[k] + er;
-        xu[i] = sg * dx * dtdu;
-        ru[i] = dr * dtdu;
+        double ex, er;
+        point_first(&P, k, u[i], o, &ex, &er);
+        x[i] = o[0];
+        r[i] = o[1];
+        xu[i] = o[2];
+        ru[i] = o[3];
         if (sax) {
+            double sg = sign[k];
             sax[i] = sg * ax[k] + (sg - 1.0) * offset;
             sar[i] = ar[k];
             sex[i] = sg * ex;
@@ -536,5 +554,173 @@ void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_fr
         displacement(&P, k, t_from, step, &ex, &er);
         dx[i] = sign[k] * ex;
         dr[i] = er;
+    }
+}
+
+/* PanelSet.evaluate(..., second=True) at one point: x, r, x_u, r_u, x_uu, r_uu (out[0..5]) at u
+ * on panel k, the formulas of PanelSet._param (with its d2t) and _evaluate_segment's second
+ * branch in numpy's order, the segments' second_derivative (line 0, arc -R (cos, sin), ellipse
+ * (-a cos, -b sin), spline_eval with nu = 2).  On a corner panel w[0..2] are numpy's lo^q,
+ * lo^(q - 1) and lo^max(q - 2, 0) at the point (numpy's power differs from libm's pow by an
+ * ulp at times, and this replicates the numpy path; w is read on corner panels only). */
+static inline void point_second(const panels_t *P, ptrdiff_t k, double uu, const double *w, double *out)
+{
+    double dt = P->da[k] + P->half[k] * (uu + 1.0), dtdu = P->half[k], d2t = 0.0;
+    if (P->cluster && P->cluster[k] != 0.0) {
+        double c = P->cluster[k], q = P->power[k], span = P->db[k] - P->da[k];
+        double sw = span * w[0];
+        dt = c > 0 ? P->db[k] - sw : P->da[k] + sw;
+        dtdu = 0.5 * span * q * w[1];
+        double d2w = 0.25 * q * (q - 1.0) * w[2];
+        d2t = c > 0 ? -span * d2w : span * d2w;
+    }
+    double t = P->base[k], ex, er, dx, dr, ddx, ddr, c0 = P->c0[k], c1 = P->c1[k];
+    displacement(P, k, t, dt, &ex, &er);
+    if (P->kind[k] == 0) {
+        dx = c0;
+        dr = c1;
+        ddx = 0.0;
+        ddr = 0.0;
+    } else if (P->kind[k] == 1) {
+        dx = -c0 * sin(t + dt);
+        dr = c0 * cos(t + dt);
+        ddx = -c0 * cos(t + dt);
+        ddr = -c0 * sin(t + dt);
+    } else if (P->kind[k] == 3) {
+        spline_eval(P, t + dt, 1, &dx, &dr);
+        spline_eval(P, t + dt, 2, &ddx, &ddr);
+    } else {
+        dx = -c0 * sin(t + dt);
+        dr = c1 * cos(t + dt);
+        ddx = -c0 * cos(t + dt);
+        ddr = -c1 * sin(t + dt);
+    }
+    double sg = P->sign[k];
+    out[0] = sg * (P->ax[k] + ex) + (sg - 1.0) * P->offset;
+    out[1] = P->ar[k] + er;
+    out[2] = sg * dx * dtdu;
+    out[3] = dr * dtdu;
+    out[4] = sg * (ddx * dtdu * dtdu + dx * d2t);
+    out[5] = ddr * dtdu * dtdu + dr * d2t;
+}
+
+/* PanelSet.evaluate(..., second=True) (point_second) at point i on panel[i]; pw: (n, 3), rows
+ * of point_second's w (NULL without corner points). */
+void ring_panel_second(ptrdiff_t n, const ptrdiff_t *panel, const double *u, const double *base,
+                       const double *da, const double *db, const double *half, const double *sign,
+                       const double *ax, const double *ar, double offset, const double *cluster,
+                       const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                       ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw,
+                       double *x, double *r, double *xu, double *ru, double *xuu, double *ruu)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    double o[6];
+    for (ptrdiff_t i = 0; i < n; i++) {
+        point_second(&P, panel[i], u[i], pw ? pw + 3 * i : NULL, o);
+        x[i] = o[0];
+        r[i] = o[1];
+        xu[i] = o[2];
+        ru[i] = o[3];
+        xuu[i] = o[4];
+        ruu[i] = o[5];
+    }
+}
+
+/* One Newton step of closest_points (semianalytic/bem/solve.py, _newton) on
+ * (y(u) - x) . y'(u) = 0 from u on panel k towards the point (X, R), projected onto [-1, 1] as
+ * numpy's clip does (NaN stays); w as in point_second. */
+static inline double newton_step(const panels_t *P, ptrdiff_t k, double uu, double X, double R, const double *w)
+{
+    double o[6];
+    point_second(P, k, uu, w, o);
+    double ex = o[0] - X, er = o[1] - R;
+    double fn = ex * o[2] + er * o[3];
+    double fp = o[2] * o[2] + o[3] * o[3] + ex * o[4] + er * o[5];
+    double step = fp > 0 ? fn / fp : 0.0;
+    double v = uu - step;
+    if (!(v != v)) v = v < -1.0 ? -1.0 : (v > 1.0 ? 1.0 : v);
+    return v;
+}
+
+/* newton_step at each pair i (u updated in place); pw as in ring_panel_second.  With ex != NULL,
+ * also the point at the new u (point_first, as PanelSet.evaluate computes it): x - xq, r - rq,
+ * x_u, r_u. */
+void ring_newton_step(ptrdiff_t n, const ptrdiff_t *pan, double *u, const double *xq, const double *rq,
+                      const double *base, const double *da, const double *db, const double *half, const double *sign,
+                      const double *ax, const double *ar, double offset, const double *cluster,
+                      const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                      ptrdiff_t nk, const double *knots, const double *cx, const double *cr, const double *pw,
+                      double *ex, double *er, double *xu, double *ru)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        u[i] = newton_step(&P, pan[i], u[i], xq[i], rq[i], pw ? pw + 3 * i : NULL);
+        if (ex) {
+            double o[4], e1, e2;
+            point_first(&P, pan[i], u[i], o, &e1, &e2);
+            ex[i] = o[0] - xq[i];
+            er[i] = o[1] - rq[i];
+            xu[i] = o[2];
+            ru[i] = o[3];
+        }
+    }
+}
+
+/* closest_points (semianalytic/bem/solve.py) on the panels without a corner substitution, the
+ * same operations in the same order: the nearest of the ns samples of the panel's table
+ * (stx, str, stxu, stru: x, r, x_u, r_u, each (n_panels, ns); numpy's argmin, the first NaN or
+ * else the first minimum), the end test, two Newton steps on (y(u) - x) . y'(u) = 0 projected
+ * onto [-1, 1] (numpy's clip: NaN stays), the point at the result.  Writes u, ex = x - xq,
+ * er = r - rq, x_u, r_u; a pair that needs Newton steps on a corner panel gets todo[i] = 1 and
+ * its sample's values (the caller steps it with numpy's power, which pow here would miss by
+ * an ulp at times), the others todo[i] = 0. */
+void ring_closest_points(ptrdiff_t n, const ptrdiff_t *pan, const double *xq, const double *rq,
+                         ptrdiff_t ns, const double *samples, const double *stx, const double *str,
+                         const double *stxu, const double *stru, const double *base,
+                         const double *da, const double *db, const double *half, const double *sign,
+                         const double *ax, const double *ar, double offset, const double *cluster,
+                         const double *power, const ptrdiff_t *kind, const double *c0, const double *c1,
+                         ptrdiff_t nk, const double *knots, const double *cx, const double *cr,
+                         double *u, double *ex, double *er, double *xu, double *ru, signed char *todo)
+{
+    panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
+    for (ptrdiff_t i = 0; i < n; i++) {
+        ptrdiff_t k = pan[i], row = k * ns, j = 0;
+        double X = xq[i], R = rq[i], best = 0.0;
+        for (ptrdiff_t m = 0; m < ns; m++) {
+            double a = stx[row + m] - X, b = str[row + m] - R;
+            double d2 = a * a + b * b;
+            if (d2 != d2) {  /* numpy's argmin: the first NaN */
+                j = m;
+                break;
+            }
+            if (m == 0 || d2 < best) {
+                best = d2;
+                j = m;
+            }
+        }
+        double uu = samples[j], x = stx[row + j], r = str[row + j], dx = stxu[row + j], dr = stru[row + j];
+        double f = (x - X) * dx + (r - R) * dr;
+        int settled = (j == 0 && f >= 0) || (j == ns - 1 && f <= 0);
+        todo[i] = 0;
+        if (!settled) {
+            if (cluster && cluster[k] != 0.0) {
+                todo[i] = 1;
+            } else {
+                double o[4], e1, e2;
+                for (int it = 0; it < 2; it++)
+                    uu = newton_step(&P, k, uu, X, R, NULL);
+                point_first(&P, k, uu, o, &e1, &e2);
+                x = o[0];
+                r = o[1];
+                dx = o[2];
+                dr = o[3];
+            }
+        }
+        u[i] = uu;
+        ex[i] = x - X;
+        er[i] = r - R;
+        xu[i] = dx;
+        ru[i] = dr;
     }
 }

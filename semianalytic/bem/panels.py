@@ -32,6 +32,19 @@ GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type gra
 
 
 
+def declare(fn, types: str):
+    """A function of the compiled library (``_ring.c``) with its argument types declared, once
+    (n: ptrdiff_t, p: an address, d: a double): the functions of the panel geometry and the
+    closest-point search, declared beside their callers."""
+    if fn.argtypes is None:
+        import ctypes
+
+        kinds = {"n": ctypes.c_ssize_t, "p": ctypes.c_void_p, "d": ctypes.c_double}
+        fn.argtypes = [kinds[t] for t in types.split()]
+        fn.restype = None
+    return fn
+
+
 @dataclass(frozen=True)
 class PanelSet:
     """Panels over one or more segments.
@@ -123,8 +136,8 @@ class PanelSet:
         u = np.asarray(u, dtype=float)
         if panel.shape != u.shape:
             panel, u = np.broadcast_arrays(panel, u)
-        if not second and u.size and self._compiled_curves is not None:
-            got = self._evaluate_compiled(panel, u, split)
+        if u.size and not (second and split) and self._compiled_curves is not None:
+            got = self._evaluate_compiled(panel, u, split, second)
             if got is not None:
                 return got
         curves, group = self._curves
@@ -196,21 +209,49 @@ class PanelSet:
             return None
         return lib, pk
 
-    def _evaluate_compiled(self, panel, u, split):
-        """:meth:`evaluate` (without second derivatives) by ``ring_panel_points`` of
-        ``_ring.c`` (the same formulas, this project's own speed-up), or None."""
+    def _evaluate_compiled(self, panel, u, split, second=False):
+        """:meth:`evaluate` by ``ring_panel_points`` of ``_ring.c`` (with ``second``:
+        ``ring_panel_second``, without ``split``) (the same formulas, this project's own
+        speed-up), or None."""
         got = self._compiled_lib(panel)
         if got is None:
             return None
         lib, pk = got
         c = self._compiled_curves[0]
         uu = np.ascontiguousarray(u, dtype=float).reshape(-1)
+        if second:
+            fn = declare(lib.ring_panel_second, "n" + " p" * 9 + " d" + " p" * 5 + " n" + " p" * 10)
+            out = [np.empty(u.shape) for _ in range(6)]
+            pw = self._numpy_powers(pk, uu)
+            fn(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"],
+               c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"], c["nk"],
+               c["knots"], c["cx"], c["cr"], None if pw is None else address(pw), *(address(a) for a in out))
+            return tuple(out)
         out = [np.empty(u.shape) for _ in range(8 if split else 4)]
         ptr = [address(a) for a in out] + [None] * (0 if split else 4)
         lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
                               c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
         return tuple(out)
+
+    def _numpy_powers(self, pk, u):
+        """numpy's lo^q, lo^(q - 1), lo^max(q - 2, 0) of :meth:`_param` at the
+        points on corner panels, (n, 3) (other rows unset), for ``ring_panel_second``; None
+        without corner points.  numpy's power differs from the C library's pow by an ulp at
+        times: these keep the compiled second derivatives equal to numpy's bit for bit."""
+        if self.cluster is None:
+            return None
+        on = np.nonzero(self._clustered[pk])[0]
+        if on.size == 0:
+            return None
+        pko = pk[on]
+        q = self.power[pko]
+        lo = 0.5 * (1.0 - self.cluster[pko] * u[on])
+        pw = np.empty((pk.size, 3))
+        pw[on, 0] = lo**q
+        pw[on, 1] = lo ** (q - 1.0)
+        pw[on, 2] = lo ** np.maximum(q - 2.0, 0.0)
+        return pw
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):
         base, sg = self.base[pk], self.sign[pk]
@@ -327,20 +368,22 @@ class PanelSet:
         |dy/du| -> 0 at the corner, the u-step that covers ``dist`` along the curve."""
         if self.cluster is None:
             return du
-        on = np.nonzero(self.cluster[panel] != 0)[0]
+        on = np.nonzero(self._clustered[panel])[0]
         if on.size == 0:
             return du
         du = np.array(du, dtype=float, copy=True)
         pk, uk, dk = panel[on], u[on], dist[on]
         c, q = self.cluster[pk], self.power[pk]
-        span = np.abs(self.db[pk] - self.da[pk])
+        so = self._span[pk]
+        span = np.abs(so)
+        lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
+        w = lo**q  # fraction of the panel's parameter span from the corner
+        sw = so * w  # the parameter offset of _param on corner panels, from the same power
+        dt = np.where(c > 0, self.db[pk] - sw, self.da[pk] + sw)
         speed = np.empty(on.size)
-        dt = self._param(pk, uk)[0]
         for seg, m, pkm in self._by_segment(pk):
             dx, dr = seg.derivative(self.base[pkm] + dt[m])
             speed[m] = np.hypot(dx, dr)
-        lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
-        w = lo**q  # fraction of the panel's parameter span from the corner
         dw = dk / np.maximum(speed * span, 1e-300)
         up = np.minimum(w + dw, 1.0) ** (1.0 / q) - lo
         down = lo - np.maximum(w - dw, 0.0) ** (1.0 / q)

@@ -42,7 +42,7 @@ from semianalytic.bem.kernels import (
     gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_dense, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
-from semianalytic.bem.panels import PanelSet
+from semianalytic.bem.panels import PanelSet, declare
 from semianalytic.native import address
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -120,35 +120,86 @@ def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray
     Sampled, then refined by Newton's method (projected onto [-1, 1]): the minimum may lie
     between an end sample and its neighbour.  A pair whose nearest sample is an end of the
     panel where the distance grows inwards ((y - x) . y' >= 0 at u = -1, <= 0 at u = +1) keeps
-    that end: every Newton step from there points out of the panel and is projected back."""
-    samples = _samples(ps.order)
-    sx, sr, sxu, sru = _sample_table(ps)
-    x, r = sx[pan], sr[pan]
-    d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
-    j = np.argmin(d2, axis=1)
-    rows = np.arange(len(pan))
-    u = samples[j]
-    x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
-    f = (x - xq) * xu + (r - rq) * ru
-    last = samples.size - 1
-    settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
-    inner = np.nonzero(~settled)[0]
-    if inner.size:
-        ui, pi, xi, ri = u[inner], pan[inner], xq[inner], rq[inner]
-        for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
-            xn, rn, xun, run, xuu, ruu = ps.evaluate(pi, ui, second=True)
-            ex, er = xn - xi, rn - ri
-            fn = ex * xun + er * run
-            fp = xun * xun + run * run + ex * xuu + er * ruu
-            step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
-            ui = np.clip(ui - step, -1.0, 1.0)
-        x[inner], r[inner], xu[inner], ru[inner] = ps.evaluate(pi, ui)
-        u[inner] = ui
-    dist = np.hypot(x - xq, r - rq)
+    that end: every Newton step from there points out of the panel and is projected back.
+    Compiled (``ring_closest_points`` of ``_ring.c``, the same operations: this project's own
+    speed-up) where the panel geometry is; Newton steps on corner panels always by
+    :func:`_newton` (numpy's power)."""
+    got = _closest_compiled(ps, pan, xq, rq)
+    if got is not None:
+        u, ex, er, xu, ru, todo = got
+    else:
+        samples = _samples(ps.order)
+        sx, sr, sxu, sru = _sample_table(ps)
+        x, r = sx[pan], sr[pan]
+        d2 = (x - xq[:, None]) ** 2 + (r - rq[:, None]) ** 2
+        j = np.argmin(d2, axis=1)
+        rows = np.arange(len(pan))
+        u = samples[j]
+        x, r, xu, ru = x[rows, j], r[rows, j], sxu[pan, j], sru[pan, j]
+        ex, er = x - xq, r - rq
+        f = ex * xu + er * ru
+        last = samples.size - 1
+        settled = ((j == 0) & (f >= 0)) | ((j == last) & (f <= 0))
+        todo = np.nonzero(~settled)[0]
+    if todo.size:
+        u[todo], ex[todo], er[todo], xu[todo], ru[todo] = _newton(ps, pan[todo], u[todo], xq[todo], rq[todo])
+    dist = np.hypot(ex, er)
     with np.errstate(divide="ignore", invalid="ignore"):
         du = dist / np.hypot(xu, ru)
     du = ps.param_distance(pan, u, dist, np.where(np.isfinite(du), du, np.inf))
     return u, du
+
+
+def _newton(ps: PanelSet, pan, u, xq, rq):
+    """Two Newton steps of :func:`closest_points` from u: u, x - xq, r - rq, x_u, r_u there
+    (compiled: ``ring_newton_step`` of ``_ring.c``, given numpy's powers on corner panels)."""
+    got = ps._compiled_lib(pan)
+    if got is not None:
+        lib, pk = got
+        fn = declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p p p p p")
+        c = ps._compiled_curves[0]
+        u = np.array(u, dtype=float)
+        xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
+        out = [np.empty(u.size) for _ in range(4)]  # the point at the last step: ex, er, x_u, r_u
+        for last in (False, True):
+            pw = ps._numpy_powers(pk, u)
+            fn(pk.size, address(pk), address(u), address(xq), address(rq), c["base"], c["da"], c["db"], c["half"],
+               c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
+               c["nk"], c["knots"], c["cx"], c["cr"], None if pw is None else address(pw),
+               *((address(a) for a in out) if last else (None,) * 4))
+        return (u, *out)
+    for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
+        xn, rn, xun, run, xuu, ruu = ps.evaluate(pan, u, second=True)
+        ex, er = xn - xq, rn - rq
+        fn = ex * xun + er * run
+        fp = xun * xun + run * run + ex * xuu + er * ruu
+        step = np.where(fp > 0, fn / np.where(fp > 0, fp, 1.0), 0.0)
+        u = np.clip(u - step, -1.0, 1.0)
+    x, r, xu, ru = ps.evaluate(pan, u)
+    return u, x - xq, r - rq, xu, ru
+
+
+def _closest_compiled(ps: PanelSet, pan, xq, rq):
+    """:func:`closest_points`' search by ``ring_closest_points``: u, x - xq, r - rq, x_u, r_u
+    and the pairs left to :func:`_newton` (on corner panels); None without compiled geometry."""
+    got = ps._compiled_lib(pan) if len(pan) else None
+    if got is None:
+        return None
+    lib, pk = got
+    fn = declare(lib.ring_closest_points, "n p p p n" + " p" * 12 + " d p p p p p n" + " p" * 9)
+    c = ps._compiled_curves[0]
+    table = ps.__dict__.get("_closest_table")
+    if table is None:
+        table = ps.__dict__["_closest_table"] = [np.ascontiguousarray(a, dtype=float) for a in _sample_table(ps)]
+    samples = _samples(ps.order)
+    xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
+    out = [np.empty(pk.size) for _ in range(5)]
+    todo = np.empty(pk.size, dtype=np.int8)
+    fn(pk.size, address(pk), address(xq), address(rq), samples.size, address(samples), *(address(a) for a in table),
+       c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"],
+       c["power"], c["kind"], c["c0"], c["c1"], c["nk"], c["knots"], c["cx"], c["cr"],
+       *(address(a) for a in out), address(todo))
+    return (*out, np.nonzero(todo)[0])
 
 
 def near_pairs(ps: PanelSet, xt: np.ndarray, rt: np.ndarray, exclude_panel: np.ndarray | None = None,
@@ -171,8 +222,9 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     :func:`closest_points` (the same numbers as separate calls, a third of the calls)."""
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
-    near = np.hypot(xt[:, None] - cx[None, :], rt[:, None] - cr[None, :]) < reach
-    near_img = np.hypot(xt[:, None] - cx[None, :], rt[:, None] + cr[None, :]) < reach
+    dx = xt[:, None] - cx[None, :]
+    near = _closer(dx, rt[:, None] - cr[None, :], reach)
+    near_img = _closer(dx, rt[:, None] + cr[None, :], reach)
     if exclude_panel is not None:
         rows = np.arange(len(xt))
         near[rows, exclude_panel] = False
@@ -199,6 +251,23 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
         u[img[use]] = u_img[use]
         du[img[use]] = du_img[use]
     return tgt, pan, u, du, uq[n + m:], duq[n + m:]
+
+
+def _closer(a, b, reach):
+    """hypot(a, b) < reach elementwise (a, b of one shape, reach broadcasting to it), numpy's
+    hypot deciding only where a^2 + b^2 lies within 1e-12 of reach^2 (this project's own
+    shortcut, the same booleans at a quarter of the cost: a^2 + b^2 and hypot^2 differ by a
+    few ulps, 1e-15; squares near under- or overflow take hypot everywhere)."""
+    if not 1e-140 < float(np.min(reach)) <= float(np.max(reach)) < 1e140:
+        return np.hypot(a, b) < reach
+    r2 = reach * reach
+    with np.errstate(over="ignore"):  # a^2 = inf: far, as hypot says
+        s = a * a + b * b
+    out = s < r2 * (1.0 - 1e-12)
+    edge = np.nonzero(~out & (s <= r2 * (1.0 + 1e-12)))
+    if edge[0].size:
+        out[edge] = np.hypot(a[edge], b[edge]) < np.broadcast_to(reach, s.shape)[edge]
+    return out
 
 
 def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
@@ -324,9 +393,21 @@ class PairQuadrature:
         )
 
     def subset(self, keep: np.ndarray) -> "PairQuadrature":
-        """The rules of the pairs where ``keep`` (a mask over pairs) is true."""
+        """The rules of the pairs where ``keep`` (a mask over pairs) is true (kept per mask, up
+        to 64 masks: the self rules, shared by the depths of a table, are cut by the same masks
+        of reused blocks at many depths; this project's own shortcut, the same rules)."""
         if keep.all():
             return self
+        memo = self.__dict__.setdefault("_subsets", {})
+        key = np.ascontiguousarray(keep, dtype=bool).tobytes()
+        got = memo.get(key)
+        if got is None:
+            got = self._subset(keep)
+            if len(memo) < 64:
+                memo[key] = got
+        return got
+
+    def _subset(self, keep: np.ndarray) -> "PairQuadrature":
         points = keep[self.pair]
         renumber = np.cumsum(keep) - 1
         pair = renumber[self.pair[points]]
@@ -515,40 +596,64 @@ def _end_rule(order: int, end: float, n: int):
     return u, w, lag
 
 
+@functools.lru_cache(maxsize=256)
+def _end_rules(order: int, keys: bytes):
+    """The end rules of ``keys`` (int64, each the signed number of pieces of :func:`_end_rule`):
+    their Lagrange matrices, numbers of points and first points in the concatenation of their
+    points and weights (kept per set of keys: the neighbouring depths of a table share them)."""
+    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in np.frombuffer(keys, dtype=np.int64).tolist()]
+    size = np.array([r[0].size for r in rules], dtype=np.int64)
+    cat = [np.concatenate([r[j] for r in rules]) if rules else np.empty(0) for j in (0, 1)]
+    return tuple(r[2] for r in rules), size, np.cumsum(size) - size, cat[0], cat[1]
+
+
 def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     """Dyadic rules on [-1, 1] split at u* (the panel point nearest each target), with
     pieces no longer than their distance from the target (``du`` in the panel parameter).
 
     Pairs whose u* is an end of the panel (neighbouring panels: most pairs) take a rule
-    built once per level (:func:`_end_rule`); the others are built together."""
+    built once per level (:func:`_end_rule`); the others are built together.  The rule's
+    :attr:`PairQuadrature.distinct` points are those of :meth:`PairQuadrature.with_distinct_points`,
+    found from the rules' structure (one set per end rule and panel, in the order of their
+    keys; then each other pair's points)."""
     target, panel = np.asarray(target), np.asarray(panel)
     if target.size == 0:
         return PairQuadrature.build(target, panel, order, [])
-    left, right = 1.0 + ustar, 1.0 - ustar
-    # pieces per side; 0: the side is empty (u* at that end of the panel)
-    n_l = np.where(left > 0, _levels(left, du) + 1, 0)
-    n_r = np.where(right > 0, _levels(right, du) + 1, 0)
+    npairs = ustar.size
+    # pieces per side, left (1 + u*) and right (1 - u*) in one call; 0: the side is empty
+    sides = np.concatenate([1.0 + ustar, 1.0 - ustar])
+    n_lr = np.where(sides > 0, _levels(sides, np.concatenate([du, du])) + 1, 0)
+    n_l, n_r = n_lr[:npairs], n_lr[npairs:]
     at_end = (n_l == 0) | (n_r == 0)
     key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
     # point's u and w gathered from the rules' concatenated points; then the other pairs
     ends = np.nonzero(at_end)[0]
-    ends = ends[np.argsort(key[ends], kind="stable")]
-    keys, first, per_key = np.unique(key[ends], return_index=True, return_counts=True)
-    rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in keys.tolist()]
-    size = np.array([r[0].size for r in rules], dtype=np.int64)
-    blocks = tuple((int(f), int(c), int(q), r[2]) for f, c, q, r in zip(first, per_key, size, rules))
+    # keys within +-2 (MAX_LEVELS + 1): sorted as int16 (numpy's radix sort; the same stable order)
+    ends = ends[np.argsort(key[ends].astype(np.int16), kind="stable")]
+    sk = key[ends]
+    first = np.flatnonzero(np.concatenate([[True], sk[1:] != sk[:-1]])) if sk.size else np.empty(0, np.int64)
+    per_key = np.diff(np.append(first, sk.size))
+    lags, size, rule_first, u_cat, w_cat = _end_rules(order, np.ascontiguousarray(sk[first], dtype=np.int64).tobytes())
+    blocks = tuple(zip(first.tolist(), per_key.tolist(), size.tolist(), lags))
     counts = np.repeat(size, per_key)  # points of each end pair
-    inner = np.nonzero(~at_end)[0]
-    if rules:
-        rule_at = np.repeat(np.cumsum(size) - size, per_key)  # each pair's rule in the concatenation
-        pair_at = np.cumsum(counts) - counts
-        src = np.repeat(rule_at - pair_at, counts) + np.arange(int(counts.sum()))
-        u_end = np.concatenate([r[0] for r in rules])[src]
-        w_end = np.concatenate([r[1] for r in rules])[src]
-    else:
-        u_end = w_end = np.empty(0)
+    pair_at = np.cumsum(counts) - counts
+    src = np.repeat(np.repeat(rule_first, per_key) - pair_at, counts) + np.arange(int(pair_at[-1] + counts[-1]) if counts.size else 0)
+    u_end, w_end = u_cat[src], w_cat[src]
+    # distinct points: one set per (end rule, panel), in ascending rule * span + panel
+    span = int(panel.max()) + 1
+    gkey = np.repeat(np.arange(size.size), per_key) * span + panel[ends]
+    present = np.zeros(size.size * span, bool)
+    present[gkey] = True
+    groups = np.flatnonzero(present)
+    group_of = (np.cumsum(present) - 1)[gkey]  # each end pair's set
+    g_rule, g_size = groups // span, size[groups // span]
+    g_at = np.cumsum(g_size) - g_size
+    d_src = np.repeat(rule_first[g_rule] - g_at, g_size) + np.arange(int(g_size.sum()))
+    d_panel, d_u = np.repeat(groups % span, g_size), u_cat[d_src]
+    d_index = np.repeat(g_at[group_of] - pair_at, counts) + np.arange(u_end.size)
     flat = np.empty((0, order))
+    inner = np.nonzero(~at_end)[0]
     if inner.size:
         pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
@@ -556,11 +661,15 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
         flat = lagrange_matrix(gauss_legendre(order)[0], u)
         blocks += ((ends.size, inner.size, 0, None),)
         counts = np.concatenate([counts, np.bincount(pair, minlength=inner.size)])
+        # each inner pair's points are a set of their own, after the end rules' sets
+        d_index = np.concatenate([d_index, int(g_size.sum()) + np.arange(u.size)])
+        d_panel = np.concatenate([d_panel, panel[inner][pair[pts]]])
+        d_u = np.concatenate([d_u, u])
         u_end, w_end = np.concatenate([u_end, u]), np.concatenate([w_end, w])
     order_idx = np.concatenate([ends, inner])
-    rule = PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
-                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks)
-    return rule.with_distinct_points()
+    return PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
+                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks,
+                          (d_panel, d_u, d_index))
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
@@ -641,17 +750,23 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     # the near pairs and the self pairs' axis images: one search of the nearest points
     tgt, pan, ustar, du, _, du_img = _near_pairs_with(ps, xt, rt, own_panel, block,
                                                       (own_panel[close], xt[close], -rt[close]))
-    if close.size:
-        levels[close, 0] = _levels(1.0 - uq[close], du_img / IMAGE_MARGIN)
-        levels[close, 1] = _levels(1.0 + uq[close], du_img / IMAGE_MARGIN)
     mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels
-    if mapped.size:
+    # the levels of both sides of the close nodes and of the mapped ones, in one call
+    m, n = close.size, mapped.size
+    if m or n:
+        c = ps.cluster[own_panel[mapped]] if n else np.empty(0)
+        uc, um = uq[close], uq[mapped]
         # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
         # the node; keep the self rule's innermost pieces within half of that
-        c = ps.cluster[own_panel[mapped]]
-        gap = 0.5 * np.where(c < 0, 1.0 + uq[mapped], 1.0 - uq[mapped])
-        levels[mapped, 0] = np.maximum(levels[mapped, 0], _levels(1.0 - uq[mapped], gap))
-        levels[mapped, 1] = np.maximum(levels[mapped, 1], _levels(1.0 + uq[mapped], gap))
+        gap = 0.5 * np.where(c < 0, 1.0 + um, 1.0 - um)
+        d = du_img / IMAGE_MARGIN
+        lev = _levels(np.concatenate([1.0 - uc, 1.0 + uc, 1.0 - um, 1.0 + um]), np.concatenate([d, d, gap, gap]))
+        if m:
+            levels[close, 0] = lev[:m]
+            levels[close, 1] = lev[m:2 * m]
+        if n:
+            levels[mapped, 0] = np.maximum(levels[mapped, 0], lev[2 * m:2 * m + n])
+            levels[mapped, 1] = np.maximum(levels[mapped, 1], lev[2 * m + n:])
     self_rule = self_quadrature(levels, p)
     if fixed is not None:
         self_rule = self_rule.subset(free_node[self_rule.target])
