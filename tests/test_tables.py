@@ -291,3 +291,29 @@ def test_short_blunt_nose_reaches_its_deep_limit_with_the_defaults(capsys, tmp_p
     out = _json(capsys, ["coefficients", str(case), "--json"])
     assert out["deep_limit"]["C_bar"] == pytest.approx(1.0, abs=1e-5)
     assert max(out["depth_m"]) > 84 * 3.555e-3  # beyond where the L_h-counted range stopped
+
+
+def test_quintic_hermite_is_scipys_from_derivatives():
+    """The table's quintic Hermite pieces (values, first and second derivatives at the knots) built for all
+    intervals at once are scipy's BPoly.from_derivatives, coefficient for coefficient (bit for bit: the
+    same operations in the same order), on knots spanning eight decades and data of mixed magnitudes, and
+    the interpolant meets a smooth function's data at the knots (an independent check of the construction:
+    see the tolerances below)."""
+    from scipy.interpolate import BPoly
+
+    from semianalytic.coefficients.table import _quintic_bernstein, _spline
+
+    rng = np.random.default_rng(11)
+    for n in (2, 3, 7, 40):
+        x = np.sort(rng.uniform(0.0, 1.0, n)) * 10.0 ** rng.uniform(-6, 2)
+        Y = rng.normal(size=(n, 3)) * 10.0 ** rng.uniform(-5, 5, 3)
+        assert np.array_equal(_quintic_bernstein(x, Y), BPoly.from_derivatives(x, Y).c)
+        # a smooth function's data (f = sin(x/L) + 2): the interpolant meets them at the knots
+        L = x[-1] + 1e-300
+        F = np.column_stack([np.sin(x / L) + 2.0, np.cos(x / L) / L, -np.sin(x / L) / L**2])
+        pp = _spline(x, F[:, 0], (F[:, 1], F[:, 2]))
+        # the power basis of a short interval cancels digits in each derivative order: values to 1e-12,
+        # first and second derivatives to 1e-7 and 1e-4 (knots down to 1e-3 L apart here)
+        for k, tol in ((0, 1e-12), (1, 1e-7), (2, 1e-4)):
+            got = pp.derivative(k)(x) if k else pp(x)
+            assert np.allclose(got, F[:, k], rtol=tol, atol=tol * np.max(np.abs(F[:, k])))

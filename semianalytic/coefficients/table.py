@@ -339,8 +339,31 @@ def _spline(v: np.ndarray, y: np.ndarray, derivs=None):
         return None
     if derivs is not None:
         dy, d2y = derivs
-        return PPoly.from_bernstein_basis(BPoly.from_derivatives(v, np.column_stack([y, dy, d2y])))
+        return PPoly.from_bernstein_basis(BPoly(_quintic_bernstein(np.asarray(v, float), np.column_stack([y, dy, d2y])), v))
     return make_interp_spline(v, y, k=_degree(n))
+
+
+def _quintic_bernstein(x: np.ndarray, Y: np.ndarray) -> np.ndarray:
+    """Bernstein coefficients (6, n - 1) of the quintic Hermite interpolant through the values, first and
+    second derivatives ``Y`` (n, 3) at the knots ``x``: scipy's ``BPoly.from_derivatives`` (its
+    ``_construct_from_derivatives``), the same operations in the same order, on all the intervals at
+    once instead of one Python call per interval (the same numbers; this project's own speed-up)."""
+    from scipy.special import comb, poch
+
+    ya, yb = Y[:-1], Y[1:]
+    # (xb - xa)**q as scipy takes it: a float64 scalar power per interval (numpy's array power may round
+    # differently from the C library's pow)
+    dxq = [np.array([d**q for d in x[1:] - x[:-1]]) for q in range(3)]
+    c = np.empty((6, len(x) - 1))
+    for q in range(3):  # from the left end
+        c[q] = ya[:, q] / poch(6 - q, q) * dxq[q]
+        for j in range(q):
+            c[q] -= (-1) ** (j + q) * comb(q, j) * c[j]
+    for q in range(3):  # from the right end
+        c[-q - 1] = yb[:, q] / poch(6 - q, q) * (-1) ** q * dxq[q]
+        for j in range(q):
+            c[-q - 1] -= (-1) ** (j + 1) * comb(q, j + 1) * c[-q + j]
+    return c
 
 
 def _degree(n: int) -> int:
