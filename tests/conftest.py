@@ -83,6 +83,8 @@ LONG = {
     "tests/test_tables.py::test_depth_error_estimate_bounds_a_tighter_table",
     "tests/test_tables.py::test_short_blunt_nose_reaches_its_deep_limit_with_the_defaults",
     "tests/test_tables.py::test_table_against_direct_solves_at_random_depths",
+    "tests/test_tables_speed_and_reach.py::test_block_sums_of_the_rules_match_adaptive_quadrature",
+    "tests/test_force_reports.py::test_force_refuses_a_users_file_and_replaces_its_own",
 }
 
 
