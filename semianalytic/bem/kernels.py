@@ -206,6 +206,12 @@ def compiled():
     lib.ring_panel_points.restype = None
     lib.ring_panel_relative.argtypes = [_N] + [_P] * 13 + [_N] + [_P] * 3 + [_P, _P]
     lib.ring_panel_relative.restype = None
+    lib.ring_panel_second.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 10
+    lib.ring_panel_second.restype = None
+    lib.ring_newton_step.argtypes = [_N] + [_P] * 11 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 8
+    lib.ring_newton_step.restype = None
+    lib.ring_closest_points.argtypes = [_N, _P, _P, _P, _N] + [_P] * 12 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 9
+    lib.ring_closest_points.restype = None
     if len(_K_SERIES) != 10 or len(_PK) != 11 or len(_QE) != 10:  # the sizes _ring.c is written for
         raise AssertionError("kernels.py and _ring.c disagree on the polynomials' sizes")
     coefs = [np.ascontiguousarray(a, dtype=float) for a in (_PK, _QK, _PE, _QE, _K_SERIES, _KME_Q_SERIES)]

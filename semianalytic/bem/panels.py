@@ -32,19 +32,6 @@ GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type gra
 
 
 
-def declare(fn, types: str):
-    """A function of the compiled library (``_ring.c``) with its argument types declared, once
-    (n: ptrdiff_t, p: an address, d: a double): the functions of the panel geometry and the
-    closest-point search, declared beside their callers."""
-    if fn.argtypes is None:
-        import ctypes
-
-        kinds = {"n": ctypes.c_ssize_t, "p": ctypes.c_void_p, "d": ctypes.c_double}
-        fn.argtypes = [kinds[t] for t in types.split()]
-        fn.restype = None
-    return fn
-
-
 @dataclass(frozen=True)
 class PanelSet:
     """Panels over one or more segments.
@@ -220,7 +207,7 @@ class PanelSet:
         c = self._compiled_curves[0]
         uu = np.ascontiguousarray(u, dtype=float).reshape(-1)
         if second:
-            fn = declare(lib.ring_panel_second, "n" + " p" * 9 + " d" + " p" * 5 + " n" + " p" * 10)
+            fn = lib.ring_panel_second
             out = [np.empty(u.shape) for _ in range(6)]
             pw = self._numpy_powers(pk, uu)
             fn(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"],

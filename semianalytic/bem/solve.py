@@ -42,7 +42,7 @@ from semianalytic.bem.kernels import (
     gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_dense, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
-from semianalytic.bem.panels import PanelSet, declare
+from semianalytic.bem.panels import PanelSet
 from semianalytic.native import address
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -156,7 +156,7 @@ def _newton(ps: PanelSet, pan, u, xq, rq):
     got = ps._compiled_lib(pan)
     if got is not None:
         lib, pk = got
-        fn = declare(lib.ring_newton_step, "n p p p p p p p p p p p d p p p p p n p p p p p p p p")
+        fn = lib.ring_newton_step
         c = ps._compiled_curves[0]
         u = np.array(u, dtype=float)
         xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
@@ -186,7 +186,7 @@ def _closest_compiled(ps: PanelSet, pan, xq, rq):
     if got is None:
         return None
     lib, pk = got
-    fn = declare(lib.ring_closest_points, "n p p p n" + " p" * 12 + " d p p p p p n" + " p" * 9)
+    fn = lib.ring_closest_points
     c = ps._compiled_curves[0]
     table = ps.__dict__.get("_closest_table")
     if table is None:
