@@ -35,7 +35,7 @@ def test_symmetric_dense_block_equals_the_plain_one(n, skip):
             "leading": np.arange(n) < 2 * n // 3, "all": np.ones(n, bool)}[skip]
     ld = n + 5
     S, D = np.full((n, ld), 7.0), np.full((n, ld), 7.0)
-    assert kernels.single_double_dense_sym(x, r, nx, nr, w, S, D, mask)
+    kernels.single_double_dense_sym(x, r, nx, nr, w, S, D, mask)
     S0, D0 = kernels.single_double_dense(x, r, x, r, nx, nr, w)
     both = np.zeros((n, n), bool) if mask is None else mask[:, None] & mask[None, :]
     for got, ref in ((S, S0), (D, D0)):
@@ -60,15 +60,23 @@ def test_symmetric_dense_block_against_the_numpy_kernels():
         assert np.max(np.abs(got[off] - ref[off]) / (np.abs(ref[off]) + 1e-300)) < 1e-9
 
 
-def test_symmetric_dense_block_declines_without_the_compiled_kernels(monkeypatch):
-    """Without the compiled kernels it writes nothing and says so (the assembly then takes the plain block)."""
+@pytest.mark.parametrize("skip", [None, "random"])
+def test_symmetric_dense_block_on_the_numpy_path(skip, monkeypatch):
+    """Without the compiled kernels the block is the numpy dense block's, entry for entry, the pairs of
+    two skipped nodes left untouched (the assembly's fallback)."""
     monkeypatch.setattr(kernels, "compiled", lambda: None)
-    S = np.full((3, 3), 7.0)
-    assert not kernels.single_double_dense_sym(*_nodes(3, 0), S, S.copy())
-    assert np.all(S == 7.0)
+    n = 40
+    x, r, nx, nr, w = _nodes(n, 4)
+    mask = None if skip is None else np.random.default_rng(2).random(n) < 0.5
+    S, D = np.full((n, n + 3), 7.0), np.full((n, n + 3), 7.0)
+    kernels.single_double_dense_sym(x, r, nx, nr, w, S, D, mask, chunk=100)
+    S0, D0 = kernels.single_double_dense(x, r, x, r, nx, nr, w)
+    both = np.zeros((n, n), bool) if mask is None else mask[:, None] & mask[None, :]
+    for got, ref in ((S, S0), (D, D0)):
+        assert np.all(got[:, n:] == 7.0) and np.all(got[:, :n][both] == 7.0)
+        assert np.array_equal(got[:, :n][~both], ref[~both], equal_nan=True)
 
 
-@needs_c
 def test_symmetric_dense_block_refuses_inconsistent_shapes():
     x, r, nx, nr, w = _nodes(10, 0)
     with pytest.raises(ValueError):

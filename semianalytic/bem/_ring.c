@@ -64,6 +64,24 @@ static inline double series(double q, const double *c)
 /* S, Dl (and, with QS != NULL, the coefficients QS, QD of L = -ln(1 - m)/2) of n <= BLK points:
  * differences dx = x - x1, dr = r - r1, sums s = r + r1, source radius r1 and normal (nx1, nr1);
  * with w != NULL, S and Dl are multiplied by w. */
+/* K(m) and E(m) from q = 1 - m and ln q (Cephes' approximations: kernels.py's _PK, _QK, _PE, _QE). */
+static inline void ellip_ke(double q, double lnq, double *K, double *E)
+{
+    *K = horner(q, PK, 11) - lnq * horner(q, QK, 11);
+    *E = horner(q, PE, 11) - lnq * q * horner(q, QE, 10);
+}
+
+/* The single and double layer of one ring (Part I, eqs. (20)-(22); errata items 1, 1a) from K, E,
+ * inv = 1/(pi sqrt D), d2 = dx^2 + dr^2, the differences dx, dr, the source radius r1 and normal
+ * (nx1, nr1); the split form (block() with QS) groups bracket/d2 differently and stays there. */
+static inline void ring_layers(double K, double E, double inv, double d2, double dx, double dr, double r1,
+                               double nx1, double nr1, double *S, double *Dl)
+{
+    double bracket = r1 * (dx * nx1 + dr * nr1) + 0.5 * nr1 * d2;
+    *S = r1 * K * inv;
+    *Dl = (E * bracket / d2 - 0.5 * nr1 * K) * inv;
+}
+
 static void block(int n, const double *dx, const double *dr, const double *s, const double *r1,
                   const double *nx1, const double *nr1, const double *w,
                   double *restrict S, double *restrict Dl, double *restrict QS, double *restrict QD)
@@ -79,12 +97,9 @@ static void block(int n, const double *dx, const double *dr, const double *s, co
         lnq[i] = log(q[i]);
     if (QS == NULL) {
         for (int i = 0; i < n; i++) {
-            double K = horner(q[i], PK, 11) - lnq[i] * horner(q[i], QK, 11);
-            double E = horner(q[i], PE, 11) - lnq[i] * q[i] * horner(q[i], QE, 10);
-            double inv = 1.0 / (PI * sqrt(D[i]));
-            double bracket = r1[i] * (dx[i] * nx1[i] + dr[i] * nr1[i]) + 0.5 * nr1[i] * d2[i];
-            S[i] = r1[i] * K * inv;
-            Dl[i] = (E * bracket / d2[i] - 0.5 * nr1[i] * K) * inv;
+            double K, E;
+            ellip_ke(q[i], lnq[i], &K, &E);
+            ring_layers(K, E, 1.0 / (PI * sqrt(D[i])), d2[i], dx[i], dr[i], r1[i], nx1[i], nr1[i], S + i, Dl + i);
         }
         if (w)
             for (int i = 0; i < n; i++) {
@@ -94,8 +109,8 @@ static void block(int n, const double *dx, const double *dr, const double *s, co
         return;
     }
     for (int i = 0; i < n; i++) {
-        double K = horner(q[i], PK, 11) - lnq[i] * horner(q[i], QK, 11);
-        double E = horner(q[i], PE, 11) - lnq[i] * q[i] * horner(q[i], QE, 10);
+        double K, E;
+        ellip_ke(q[i], lnq[i], &K, &E);
         double Kc = series(q[i], KSER);
         double KcmEc = series(q[i], KMESER);
         double inv = 1.0 / (PI * sqrt(D[i]));
@@ -210,8 +225,7 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
         for (int k = 0; k < m; k++)
             lnq[k] = log(q[k]);
         for (int k = 0; k < m; k++) {
-            tK[k] = horner(q[k], PK, 11) - lnq[k] * horner(q[k], QK, 11);
-            tE[k] = horner(q[k], PE, 11) - lnq[k] * q[k] * horner(q[k], QE, 10);
+            ellip_ke(q[k], lnq[k], tK + k, tE + k);
             tinv[k] = 1.0 / (PI * sqrt(Dd[k]));
         }
         double *Si = S + i * ld + first, *Di = D + i * ld + first;
@@ -219,9 +233,10 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
             ptrdiff_t j = first + k;
             if (skip && skip[i] && skip[j])
                 continue;
-            double bracket = r[j] * (tdx[k] * nx[j] + tdr[k] * nr[j]) + 0.5 * nr[j] * td2[k];
-            Si[k] = r[j] * tK[k] * tinv[k] * w[j];
-            Di[k] = (tE[k] * bracket / td2[k] - 0.5 * nr[j] * tK[k]) * tinv[k] * w[j];
+            double sv, dv;
+            ring_layers(tK[k], tE[k], tinv[k], td2[k], tdx[k], tdr[k], r[j], nx[j], nr[j], &sv, &dv);
+            Si[k] = sv * w[j];
+            Di[k] = dv * w[j];
         }
     }
     for (ptrdiff_t j = j0; j < j1; j++) {  /* target j, source i < j: the differences are -dx, -dr */
@@ -231,10 +246,10 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
             ptrdiff_t a = i - i0;
             if (skip && skip[i] && skip[j])
                 continue;
-            double mdx = -dx[a][b], mdr = -dr[a][b];
-            double bracket = r[i] * (mdx * nx[i] + mdr * nr[i]) + 0.5 * nr[i] * d2[a][b];
-            Sj[i] = r[i] * K[a][b] * inv[a][b] * w[i];
-            Dj[i] = (E[a][b] * bracket / d2[a][b] - 0.5 * nr[i] * K[a][b]) * inv[a][b] * w[i];
+            double sv, dv;
+            ring_layers(K[a][b], E[a][b], inv[a][b], d2[a][b], -dx[a][b], -dr[a][b], r[i], nx[i], nr[i], &sv, &dv);
+            Sj[i] = sv * w[i];
+            Dj[i] = dv * w[i];
         }
     }
 }

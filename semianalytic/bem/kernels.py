@@ -295,17 +295,13 @@ def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288, out=No
     return S, Dl
 
 
-def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None) -> bool:
+def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None, chunk: int = 12288) -> None:
     """The dense block of the nodes (x, r) (normals (nx, nr), weights w) against themselves, written into
     the first n columns of the C-contiguous (n, ld) arrays S and D: S[i, j] w[j] and Dl[i, j] w[j] of
-    :func:`single_double` (Part I, eqs. (20)-(22)), the same numbers as :func:`single_double_dense`, with the
-    elliptic integrals evaluated once per pair {i, j} (their modulus is symmetric: this project's own
-    shortcut).  ``skip`` (a mask over the nodes, or None): pairs of two masked nodes are left unwritten.
-    Returns False, writing nothing, without the compiled kernels (the caller then uses
-    :func:`single_double_dense`)."""
-    lib = compiled()
-    if lib is None:
-        return False
+    :func:`single_double` (Part I, eqs. (20)-(22)), the same numbers as :func:`single_double_dense`.
+    Compiled, the elliptic integrals are evaluated once per pair {i, j} (their modulus is symmetric:
+    this project's own shortcut); numpy: :func:`single_double_dense` on the rows.  ``skip`` (a mask over
+    the nodes, or None): pairs of two masked nodes are left unwritten (the caller copies them from a cache)."""
     x, r, nx, nr, w = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (x, r, nx, nr, w))
     n = x.size
     if not (S.flags.c_contiguous and D.flags.c_contiguous and S.shape == D.shape and S.shape[0] == n
@@ -314,8 +310,18 @@ def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None) -> bool:
     mask = None if skip is None else np.ascontiguousarray(skip, dtype=np.uint8)
     if mask is not None and mask.size != n:
         raise ValueError("single_double_dense_sym: skip must have one entry per node")
-    lib.ring_dense_sym(n, *(address(a) for a in (x, r, nx, nr, w)), S.shape[1], address(mask), address(S), address(D))
-    return True
+    lib = compiled()
+    if lib is not None:
+        lib.ring_dense_sym(n, *(address(a) for a in (x, r, nx, nr, w)), S.shape[1], address(mask), address(S),
+                           address(D))
+        return
+    free = np.ones(n, bool) if mask is None else mask == 0
+    rows, kept = np.nonzero(free)[0], np.nonzero(~free)[0]
+    if rows.size:  # the free rows against every node, then the masked rows against the free nodes
+        S[rows, :n], D[rows, :n] = single_double_dense(x[rows], r[rows], x, r, nx, nr, w, chunk)
+        if kept.size:
+            cols = np.ix_(kept, rows)
+            S[cols], D[cols] = single_double_dense(x[kept], r[kept], x[rows], r[rows], nx[rows], nr[rows], w[rows], chunk)
 
 
 def _c_array(a, dtype=float):

@@ -100,17 +100,27 @@ class PanelSet:
         if on[0].size == 0:
             return dt, half, d2
         dtdu = half.copy() if half.shape == dt.shape else np.array(np.broadcast_to(half, dt.shape), dtype=float)
-        pko, uo = pk[on], u[on]
-        so = self._span[pko]
-        c, q = self.cluster[pko], self.power[pko]
-        lo = 0.5 * (1.0 - c * uo)  # distance from the corner end: (1 + u)/2 (c = -1) or (1 - u)/2 (c = +1)
-        sw = so * lo**q
-        dt[on] = np.where(c > 0, self.db[pko] - sw, da[on] + sw)
-        dtdu[on] = 0.5 * so * q * lo ** (q - 1.0)  # both ends: the sign of span
+        so, c, q, _, dt[on], (_, w1, w2) = self._corner(pk[on], u[on], second)
+        dtdu[on] = 0.5 * so * q * w1  # both ends: the sign of span
         if second:
-            d2w = 0.25 * q * (q - 1.0) * lo ** np.maximum(q - 2.0, 0.0)
+            d2w = 0.25 * q * (q - 1.0) * w2
             d2[on] = np.where(c > 0, -so * d2w, so * d2w)
         return dt, dtdu, d2
+
+    def _corner(self, pko, uo, second: bool = False):
+        """The corner substitution of :meth:`_param` at points on corner panels (panels ``pko``,
+        coordinates ``uo``): the span db - da, c, q, lo = (1 - c u)/2 (the distance from the
+        corner end: (1 + u)/2 for c = -1, (1 - u)/2 for c = +1), the offset dt and the powers
+        (lo^q, lo^(q - 1), lo^max(q - 2, 0) with ``second``, else None).  One home for
+        :meth:`_param`, :meth:`param_distance` and the numpy powers the compiled second
+        derivatives take (:meth:`_numpy_powers`)."""
+        so = self._span[pko]
+        c, q = self.cluster[pko], self.power[pko]
+        lo = 0.5 * (1.0 - c * uo)
+        w = lo**q
+        sw = so * w
+        dt = np.where(c > 0, self.db[pko] - sw, self.da[pko] + sw)
+        return so, c, q, lo, dt, (w, lo ** (q - 1.0), lo ** np.maximum(q - 2.0, 0.0) if second else None)
 
     def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False, split: bool = False):
         """Points and derivatives d/du at reference coordinates ``u`` of panels ``panel``.
@@ -231,13 +241,8 @@ class PanelSet:
         on = np.nonzero(self._clustered[pk])[0]
         if on.size == 0:
             return None
-        pko = pk[on]
-        q = self.power[pko]
-        lo = 0.5 * (1.0 - self.cluster[pko] * u[on])
         pw = np.empty((pk.size, 3))
-        pw[on, 0] = lo**q
-        pw[on, 1] = lo ** (q - 1.0)
-        pw[on, 2] = lo ** np.maximum(q - 2.0, 0.0)
+        pw[on, 0], pw[on, 1], pw[on, 2] = self._corner(pk[on], u[on], second=True)[5]
         return pw
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):
@@ -360,13 +365,9 @@ class PanelSet:
             return du
         du = np.array(du, dtype=float, copy=True)
         pk, uk, dk = panel[on], u[on], dist[on]
-        c, q = self.cluster[pk], self.power[pk]
-        so = self._span[pk]
+        # lo: corner-end coordinate in [0, 1]; w = lo^q: the fraction of the panel's parameter span from the corner
+        so, c, q, lo, dt, (w, _, _) = self._corner(pk, uk)
         span = np.abs(so)
-        lo = np.where(c < 0, 0.5 * (1.0 + uk), 0.5 * (1.0 - uk))  # corner-end coordinate in [0, 1]
-        w = lo**q  # fraction of the panel's parameter span from the corner
-        sw = so * w  # the parameter offset of _param on corner panels, from the same power
-        dt = np.where(c > 0, self.db[pk] - sw, self.da[pk] + sw)
         speed = np.empty(on.size)
         for seg, m, pkm in self._by_segment(pk):
             dx, dr = seg.derivative(self.base[pkm] + dt[m])

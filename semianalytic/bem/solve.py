@@ -28,7 +28,6 @@ pairs with dyadically graded rules; assembly vectorised over all pairs.
 from __future__ import annotations
 
 import contextlib
-import dataclasses
 import functools
 import math
 import threading
@@ -188,9 +187,7 @@ def _closest_compiled(ps: PanelSet, pan, xq, rq):
     lib, pk = got
     fn = lib.ring_closest_points
     c = ps._compiled_curves[0]
-    table = ps.__dict__.get("_closest_table")
-    if table is None:
-        table = ps.__dict__["_closest_table"] = [np.ascontiguousarray(a, dtype=float) for a in _sample_table(ps)]
+    table = [np.ascontiguousarray(a, dtype=float) for a in _sample_table(ps)]  # no copies: evaluate's own arrays
     samples = _samples(ps.order)
     xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
     out = [np.empty(pk.size) for _ in range(5)]
@@ -332,29 +329,6 @@ class PairQuadrature:
             got[key] = (self.target[:, None] * columns + self.panel[:, None] * order + np.arange(order)[None, :]).ravel()
         return got[key]
 
-    def with_distinct_points(self) -> "PairQuadrature":
-        """This rule with :attr:`distinct` set: the points of the pairs of a shared end rule
-        (a block with one (Q, p) matrix) on one panel are one set (this project's own
-        shortcut: the geometry is evaluated at a fifth to a ninth of the points, the same
-        numbers)."""
-        if not self.blocks or self.target_u is not None:
-            return self
-        npairs, npoints = len(self.target), self.u.size
-        shared = np.zeros(npairs, bool)
-        block = np.empty(npairs, dtype=np.int64)
-        for k, (f, n, _, lag) in enumerate(self.blocks):
-            block[f:f + n] = k
-            shared[f:f + n] = lag is not None and lag.ndim == 2
-        span = int(self.panel.max()) + 1
-        key = np.where(shared, block * span + self.panel, len(self.blocks) * span + np.arange(npairs))
-        _, first, inv = np.unique(key, return_index=True, return_inverse=True)
-        counts = np.diff(np.append(self.starts, npoints))
-        size = counts[first]
-        at = np.cumsum(size) - size  # first distinct point of each distinct pair
-        src = np.repeat(self.starts[first] - at, size) + np.arange(int(size.sum()))
-        within = np.arange(npoints) - self.starts[self.pair]
-        distinct = (self.panel[self.pair[src]], self.u[src], at[inv.ravel()][self.pair] + within)
-        return dataclasses.replace(self, distinct=distinct)
 
     @staticmethod
     def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
@@ -613,9 +587,11 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
 
     Pairs whose u* is an end of the panel (neighbouring panels: most pairs) take a rule
     built once per level (:func:`_end_rule`); the others are built together.  The rule's
-    :attr:`PairQuadrature.distinct` points are those of :meth:`PairQuadrature.with_distinct_points`,
-    found from the rules' structure (one set per end rule and panel, in the order of their
-    keys; then each other pair's points)."""
+    :attr:`PairQuadrature.distinct` points are found from the rules' structure: one set per end
+    rule and panel, in the order of their keys (the pairs of one end rule on one panel, the nodes
+    of its neighbour, share their points, whose geometry is then evaluated once: a fifth to a
+    ninth of the points, the same numbers; this project's own shortcut), then each other pair's
+    points."""
     target, panel = np.asarray(target), np.asarray(panel)
     if target.size == 0:
         return PairQuadrature.build(target, panel, order, [])
@@ -855,43 +831,19 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     N = ps.n_primary * p
     xt, rt = X[:N], R[:N]
 
-    def dense(rows, cols, out=None):
-        # compiled: one fused pass (into ``out``, blocks of S and D, when given); numpy: row
-        # blocks, so that temporaries stay small (DENSE_CHUNK)
-        return single_double_dense(xt[rows], rt[rows], X[cols], R[cols], NX[cols], NR[cols], W[cols], DENSE_CHUNK, out)
-
     if plan.fixed is not None and cache is None:
         raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
     fix = None if plan.fixed is None else np.repeat(plan.fixed, p)
     S, D = np.empty((N, X.size)), np.empty((N, X.size))
-    if _kernels.single_double_dense_sym(xt, rt, NX[:N], NR[:N], W[:N], S, D, fix):
-        # compiled: the primary nodes against themselves once per pair (the same numbers), then the mirror
-        # columns; the fixed panels' block from the cache
-        if X.size > N:
-            dense(slice(None), slice(N, None), (S[:, N:], D[:, N:]))  # written in place
-        if fix is not None:
-            k = int(np.count_nonzero(fix))
-            block = (slice(0, k),) * 2 if fix[:k].all() else np.ix_(*(np.nonzero(fix)[0],) * 2)  # slices when they lead
-            S[block], D[block] = cache.S[block], cache.D[block]
-    elif plan.fixed is None:
-        S, D = dense(slice(None), slice(None))
-    else:  # the block of the fixed panels from the cache, the rest computed
+    # the primary nodes against themselves (compiled: once per pair, the same numbers), then the
+    # mirror columns written in place, then the fixed panels' block from the cache
+    _kernels.single_double_dense_sym(xt, rt, NX[:N], NR[:N], W[:N], S, D, fix, DENSE_CHUNK)
+    if X.size > N:  # numpy: row blocks, so that temporaries stay small (DENSE_CHUNK)
+        single_double_dense(xt, rt, X[N:], R[N:], NX[N:], NR[N:], W[N:], DENSE_CHUNK, (S[:, N:], D[:, N:]))
+    if fix is not None:
         k = int(np.count_nonzero(fix))
-        if fix[:k].all():  # the fixed panels lead (the nose before the moving ones): blocks by slices
-            fi, fr, other = slice(0, k), slice(k, N), slice(k, None)
-            dense(slice(None), other, (S[:, other], D[:, other]))  # written in place
-            if k < N:
-                dense(fr, fi, (S[fr, fi], D[fr, fi]))
-            S[fi, fi] = cache.S[fi, fi]
-            D[fi, fi] = cache.D[fi, fi]
-        else:
-            fi, fr = np.nonzero(fix)[0], np.nonzero(~fix)[0]
-            other = np.concatenate([fr, np.arange(N, X.size)])
-            S[:, other], D[:, other] = dense(slice(None), other)
-            if fr.size:
-                S[np.ix_(fr, fi)], D[np.ix_(fr, fi)] = dense(fr, fi)
-            S[np.ix_(fi, fi)] = cache.S[np.ix_(fi, fi)]
-            D[np.ix_(fi, fi)] = cache.D[np.ix_(fi, fi)]
+        block = (slice(0, k),) * 2 if fix[:k].all() else np.ix_(*(np.nonzero(fix)[0],) * 2)  # slices when they lead
+        S[block], D[block] = cache.S[block], cache.D[block]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
