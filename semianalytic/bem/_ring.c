@@ -1,10 +1,11 @@
-/* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22);
- * errata items 1, 1a), compiled: the same formulas, in the same order of operations, as
- * single_double and single_double_split of semianalytic/bem/kernels.py (read their docstrings
- * for the notation), the dense blocks of assemble() (semianalytic/bem/solve.py: the surface against
- * itself and against its mirror image, once per pair) with the column weights applied, and the near and self rules of PairQuadrature.integrate after the
- * panel geometry (ring_pair_rules, the kernels of the same block() as the others).  The numpy
- * code of kernels.py and solve.py is the reference and the fallback.
+/* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22); errata
+ * items 1, 1a), compiled: the same formulas, in the same order of operations, as single_double and
+ * single_double_split of semianalytic/bem/kernels.py (read their docstrings for the notation), the
+ * dense blocks of assemble() (semianalytic/bem/solve.py: the surface against itself and against
+ * its mirror image, once per pair) with the column weights applied, and the near and self rules of
+ * PairQuadrature.integrate after the panel geometry (ring_pair_rules, the kernels of the same
+ * block() as the others).  The numpy code of kernels.py and solve.py is the reference and the
+ * fallback.
  *
  * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
  * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the

@@ -23,14 +23,14 @@ spurious singularity on the axis (where 1 - m -> 1) into both parts of the split
 
 :func:`single_double`, :func:`single_double_split` and the dense blocks of the assembly
 (:func:`single_double_dense`, and once per pair :func:`single_double_dense_sym` against the
-surface itself and :func:`single_double_dense_mirror` against its mirror image) run compiled from ``_ring.c`` (the same polynomials, passed from
-here, and the same formulas; built on first use into the per-user cache by
-:mod:`semianalytic.native`) when a C compiler is at hand, else, or with
-``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
-the two agree to a few units of 1e-16).  The same library, under the same dispatch, sums the
-near and self rules of the assembly after the panel geometry (:func:`pair_rules_compiled`) and
-evaluates the geometry of panels on lines, arcs and a table nose's cubic spline
-(``PanelSet.evaluate``, ``relative``).
+surface itself and :func:`single_double_dense_mirror` against its mirror image) run compiled
+from ``_ring.c`` (the same polynomials, passed from here, and the same formulas; built on
+first use into the per-user cache by :mod:`semianalytic.native`) when a C compiler is at hand,
+else, or with ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's
+own speed-up; the two agree to a few units of 1e-16).  The same library, under the same
+dispatch, sums the near and self rules of the assembly after the panel geometry
+(:func:`pair_rules_compiled`) and evaluates the geometry of panels on lines, arcs and a table
+nose's cubic spline (``PanelSet.evaluate``, ``relative``).
 """
 
 from __future__ import annotations
@@ -313,18 +313,18 @@ def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None, chunk: int = 12288
 
 def single_double_dense_mirror(x, r, nx, nr, w, xs, S, D, chunk: int = 12288) -> None:
     """The dense block of the nodes (x, r) against the images of the same nodes in the free surface (the
-    mirror surface S' of a half-space, Part I, eqs. (21)-(22): the image of node j at x = xs[j], the same r
-    and weight, the normal (-nx, nr)), column j the image of node j, written into the C-contiguous (n, n)
-    arrays S and D: S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` (Part I, eqs. (20)-(22)).
+    mirror surface S' of a half-space, Part I, eqs. (21)-(22): the image of node j at x = xs[j], the same
+    r and weight, the normal (-nx, nr)), column j the image of node j, written into the C-contiguous
+    (n, n) arrays S and D: S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` (Part I, eqs. (20)-(22)).
 
     The modulus of the elliptic integrals is symmetric in the pair: x_i - xs[j] and x_j - xs[i] are the
     same distance to round-off, and r_i - r_j only changes sign.  So every pair {i, j} takes its axial
     difference as dx[i, j] = dx[j, i] = x[min(i, j)] - xs[max(i, j)] (the source radius, normal and weight
-    stay each column's own), and compiled (``ring_dense_mirror_sym``) q, ln q, K, E and 1/(pi sqrt D) are evaluated once per pair
-    (this project's own shortcut); numpy: :func:`_single_double_numpy` on row blocks of about ``chunk``
-    entries with the same differences.  The difference is formed from the image coordinates, not as
-    x_i + x_j - 2 x_surface: next to the free surface both subtractions are exact (Sterbenz), where the
-    sum x_i + x_j would be rounded at the size of the depth first."""
+    stay each column's own), and compiled (``ring_dense_mirror_sym``) q, ln q, K, E and 1/(pi sqrt D) are
+    evaluated once per pair (this project's own shortcut); numpy: :func:`_single_double_numpy` on row
+    blocks of about ``chunk`` entries with the same differences.  The difference is formed from the image
+    coordinates, not as x_i + x_j - 2 x_surface: next to the free surface both subtractions are exact
+    (Sterbenz), where the sum x_i + x_j would be rounded at the size of the depth first."""
     x, r, nx, nr, w, xs = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (x, r, nx, nr, w, xs))
     n = x.size
     if not (S.flags.c_contiguous and D.flags.c_contiguous and S.shape == D.shape == (n, n)
