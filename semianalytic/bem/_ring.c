@@ -1,10 +1,11 @@
-/* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22);
- * errata items 1, 1a), compiled: the same formulas, in the same order of operations, as
- * single_double and single_double_split of semianalytic/bem/kernels.py (read their docstrings
- * for the notation), the dense block of assemble() (semianalytic/bem/solve.py) with the
- * column weights applied, and the near and self rules of PairQuadrature.integrate after the
- * panel geometry (ring_pair_rules, the kernels of the same block() as the others).  The numpy
- * code of kernels.py and solve.py is the reference and the fallback.
+/* Ring kernels of the axisymmetric Laplace problem (Part I, section 1.4, eqs. (20)-(22); errata
+ * items 1, 1a), compiled: the same formulas, in the same order of operations, as single_double and
+ * single_double_split of semianalytic/bem/kernels.py (read their docstrings for the notation), the
+ * dense blocks of assemble() (semianalytic/bem/solve.py: the surface against itself and against
+ * its mirror image, once per pair) with the column weights applied, and the near and self rules of
+ * PairQuadrature.integrate after the panel geometry (ring_pair_rules, the kernels of the same
+ * block() as the others).  The numpy code of kernels.py and solve.py is the reference and the
+ * fallback.
  *
  * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
  * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the
@@ -156,14 +157,12 @@ void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, con
     points(n, x, r, x1, r1, nx1, nr1, ddx, ddr, S, Dl, QS, QD);
 }
 
-/* The dense block of assemble(): S[i, j], D[i, j] (row-major, nrow x ncol) of the targets
- * (xr[i], rr[i]) against the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the
- * column weight wc[j]. */
-/* ring_dense into rows ld doubles apart (a block of a larger C-ordered matrix: row i of the
- * block at S + i * ld), the same numbers. */
-void ring_dense_ld(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
-                   const double *xc, const double *rc, const double *nxc, const double *nrc,
-                   const double *wc, ptrdiff_t ld, double *S, double *D)
+/* The plain dense block: S[i, j], D[i, j] (row-major, nrow x ncol) of the targets (xr[i], rr[i]) against
+ * the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the column weight wc[j] (the reference
+ * of ring_dense_sym and ring_dense_mirror_sym, which assemble() calls). */
+void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+                const double *xc, const double *rc, const double *nxc, const double *nrc,
+                const double *wc, double *S, double *D)
 {
     double dx[BLK], dr[BLK], s[BLK];
     for (ptrdiff_t i = 0; i < nrow; i++) {
@@ -175,17 +174,10 @@ void ring_dense_ld(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t
                 dr[j] = r - rc[a + j];
                 s[j] = r + rc[a + j];
             }
-            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ld + a, D + i * ld + a,
+            block(m, dx, dr, s, rc + a, nxc + a, nrc + a, wc + a, S + i * ncol + a, D + i * ncol + a,
                   NULL, NULL);
         }
     }
-}
-
-void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
-                const double *xc, const double *rc, const double *nxc, const double *nrc,
-                const double *wc, double *S, double *D)
-{
-    ring_dense_ld(nrow, xr, rr, ncol, xc, rc, nxc, nrc, wc, ncol, S, D);
 }
 
 /* The block of ring_dense() whose targets are its own source nodes (the primary nodes against the primary
@@ -197,15 +189,22 @@ void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t nc
  * are left as they are (their block is copied from a cache). */
 #define TILE 32
 
-/* One tile of ring_dense_sym: rows i0 .. i1-1 against columns j0 .. j1-1 (j0 >= i0), the pairs with j >= i;
- * the entries (i, j) written along the rows, then their mirror entries (j, i) along the rows too; pairs
- * of two skipped nodes are computed (in a tile that also holds others) but not written. */
-static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, const double *x, const double *r,
-                     const double *nx, const double *nr, const double *w, ptrdiff_t ld, const unsigned char *skip,
-                     double *restrict S, double *restrict D)
+/* One tile of ring_dense_sym (xs == NULL) or ring_dense_mirror_sym (xs != NULL): rows i0 .. i1-1 against
+ * columns j0 .. j1-1 (j0 >= i0), the pairs with j >= i; the entries (i, j) written along the rows, then their
+ * partner entries (j, i) along the rows too; pairs of two skipped nodes are computed (in a tile that also holds
+ * others) but not written.  Without xs, source j is node j, dx = x_i - x_j (the partner's differences are
+ * -dx, -dr).  With xs, source j is the image of node j in the free surface (x = xs[j], the same r and weight,
+ * the normal (-nx_j, nr_j)), dx = x_i - xs[j], which the partner (j, i*) shares (x_j - xs[i] is the same
+ * distance; dr changes sign).  Always inlined with a constant NULL or not: the compiler specialises each. */
+static inline __attribute__((always_inline)) void
+sym_tile(const double *xs, ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, const double *x,
+         const double *r, const double *nx, const double *nr, const double *w, ptrdiff_t ld,
+         const unsigned char *skip, double *restrict S, double *restrict D)
 {
     double dx[TILE][TILE], dr[TILE][TILE], d2[TILE][TILE], K[TILE][TILE], E[TILE][TILE], inv[TILE][TILE];
     double Dd[TILE], q[TILE], lnq[TILE];
+    /* the source's normal x-component and the partner's dx: negated for an image (exact) */
+    const double nsign = xs ? -1.0 : 1.0;
     for (ptrdiff_t i = i0; i < i1; i++) {
         ptrdiff_t a = i - i0, first = j0 > i ? j0 : i;
         int m = (int)(j1 - first);
@@ -216,7 +215,7 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
         double *tK = K[a] + (first - j0), *tE = E[a] + (first - j0), *tinv = inv[a] + (first - j0);
         for (int k = 0; k < m; k++) {
             double s = ri + r[first + k];
-            tdx[k] = xi - x[first + k];
+            tdx[k] = xi - (xs ? xs : x)[first + k];
             tdr[k] = ri - r[first + k];
             td2[k] = tdx[k] * tdx[k] + tdr[k] * tdr[k];
             Dd[k] = tdx[k] * tdx[k] + s * s;
@@ -229,17 +228,17 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
             tinv[k] = 1.0 / (PI * sqrt(Dd[k]));
         }
         double *Si = S + i * ld + first, *Di = D + i * ld + first;
-        for (int k = 0; k < m; k++) {  /* target i, source j = first + k */
+        for (int k = 0; k < m; k++) {  /* target i, source j = first + k (or its image) */
             ptrdiff_t j = first + k;
             if (skip && skip[i] && skip[j])
                 continue;
             double sv, dv;
-            ring_layers(tK[k], tE[k], tinv[k], td2[k], tdx[k], tdr[k], r[j], nx[j], nr[j], &sv, &dv);
+            ring_layers(tK[k], tE[k], tinv[k], td2[k], tdx[k], tdr[k], r[j], nsign * nx[j], nr[j], &sv, &dv);
             Si[k] = sv * w[j];
             Di[k] = dv * w[j];
         }
     }
-    for (ptrdiff_t j = j0; j < j1; j++) {  /* target j, source i < j: the differences are -dx, -dr */
+    for (ptrdiff_t j = j0; j < j1; j++) {  /* target j, source i < j (or its image): dr is -dr */
         ptrdiff_t b = j - j0, last = j < i1 ? j : i1;
         double *Sj = S + j * ld, *Dj = D + j * ld;
         for (ptrdiff_t i = i0; i < last; i++) {
@@ -247,15 +246,18 @@ static void sym_tile(ptrdiff_t i0, ptrdiff_t i1, ptrdiff_t j0, ptrdiff_t j1, con
             if (skip && skip[i] && skip[j])
                 continue;
             double sv, dv;
-            ring_layers(K[a][b], E[a][b], inv[a][b], d2[a][b], -dx[a][b], -dr[a][b], r[i], nx[i], nr[i], &sv, &dv);
+            ring_layers(K[a][b], E[a][b], inv[a][b], d2[a][b], -nsign * dx[a][b], -dr[a][b], r[i], nsign * nx[i],
+                        nr[i], &sv, &dv);
             Sj[i] = sv * w[i];
             Dj[i] = dv * w[i];
         }
     }
 }
 
-void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
-                    const double *w, ptrdiff_t ld, const unsigned char *skip, double *S, double *D)
+/* The tiles of the pairs j >= i of n nodes (sym_tile); a tile of skipped pairs only is left out. */
+static inline __attribute__((always_inline)) void
+sym_tiles(const double *xs, ptrdiff_t n, const double *x, const double *r, const double *nx,
+          const double *nr, const double *w, ptrdiff_t ld, const unsigned char *skip, double *S, double *D)
 {
     for (ptrdiff_t i0 = 0; i0 < n; i0 += TILE) {
         ptrdiff_t i1 = i0 + TILE < n ? i0 + TILE : n;
@@ -270,9 +272,28 @@ void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double 
                 if (all)
                     continue;
             }
-            sym_tile(i0, i1, j0, j1, x, r, nx, nr, w, ld, skip, S, D);
+            sym_tile(xs, i0, i1, j0, j1, x, r, nx, nr, w, ld, skip, S, D);
         }
     }
+}
+
+void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
+                    const double *w, ptrdiff_t ld, const unsigned char *skip, double *S, double *D)
+{
+    sym_tiles(NULL, n, x, r, nx, nr, w, ld, skip, S, D);
+}
+
+/* The nodes (x, r) (normals (nx, nr), weights w) against the images of the same nodes in the free surface
+ * (the half-space's mirror surface S': the image of node j at x = xs[j], the same r and weight, the normal
+ * (-nx, nr)), column j the image of node j: S[i, j], D[i, j] (rows ld apart) of ring_layers times w[j].
+ * The modulus is symmetric in the pair (x_i - x*_j = x_j - x*_i = x_i + x_j - 2 x_surface, s = r_i + r_j;
+ * dr only changes sign), so q, ln q, K, E and 1/(pi sqrt D) are computed once per pair {i, j} (i <= j, from
+ * dx = x_i - xs[j]) and give both (i, j*) and (j, i*) (this project's own shortcut, as ring_dense_sym).
+ * Every entry is the arithmetic of ring_dense with the differences formed so. */
+void ring_dense_mirror_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
+                           const double *w, const double *xs, ptrdiff_t ld, double *S, double *D)
+{
+    sym_tiles(xs, n, x, r, nx, nr, w, ld, NULL, S, D);
 }
 
 /* Row k of ws, wd (point s0 + k) times its Lagrange row into row pair[s0 + k] of outS, outD:

@@ -21,15 +21,16 @@ as their power series in 1 - m truncated after ``SPLIT_TERMS`` terms: the remain
 multiplies L by (1 - m)^SPLIT_TERMS, which is smooth, while the full K(1 - m) would put a
 spurious singularity on the axis (where 1 - m -> 1) into both parts of the split.
 
-:func:`single_double`, :func:`single_double_split` and the dense block of the assembly
-(:func:`single_double_dense`) run compiled from ``_ring.c`` (the same polynomials, passed from
-here, and the same formulas; built on first use into the per-user cache by
-:mod:`semianalytic.native`) when a C compiler is at hand, else, or with
-``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
-the two agree to a few units of 1e-16).  The same library, under the same dispatch, sums the
-near and self rules of the assembly after the panel geometry (:func:`pair_rules_compiled`) and
-evaluates the geometry of panels on lines, arcs and a table nose's cubic spline
-(``PanelSet.evaluate``, ``relative``).
+:func:`single_double`, :func:`single_double_split` and the dense blocks of the assembly
+(:func:`single_double_dense`, and once per pair :func:`single_double_dense_sym` against the
+surface itself and :func:`single_double_dense_mirror` against its mirror image) run compiled
+from ``_ring.c`` (the same polynomials, passed from here, and the same formulas; built on
+first use into the per-user cache by :mod:`semianalytic.native`) when a C compiler is at hand,
+else, or with ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's
+own speed-up; the two agree to a few units of 1e-16).  The same library, under the same
+dispatch, sums the near and self rules of the assembly after the panel geometry
+(:func:`pair_rules_compiled`) and evaluates the geometry of panels on lines, arcs and a table
+nose's cubic spline (``PanelSet.evaluate``, ``relative``).
 """
 
 from __future__ import annotations
@@ -196,10 +197,10 @@ def compiled():
     lib.ring_single_double_split.restype = None
     lib.ring_dense.argtypes = [_N, _P, _P, _N] + [_P] * 7
     lib.ring_dense.restype = None
-    lib.ring_dense_ld.argtypes = [_N, _P, _P, _N] + [_P] * 5 + [_N, _P, _P]
-    lib.ring_dense_ld.restype = None
     lib.ring_dense_sym.argtypes = [_N] + [_P] * 5 + [_N, _P, _P, _P]
     lib.ring_dense_sym.restype = None
+    lib.ring_dense_mirror_sym.argtypes = [_N] + [_P] * 6 + [_N, _P, _P]
+    lib.ring_dense_mirror_sym.restype = None
     lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
@@ -259,28 +260,14 @@ def single_double_split(x, r, x1, r1, nx1, nr1, delta=None):
     return tuple(out)
 
 
-def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288, out=None):
+def single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk: int = 12288):
     """S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` for the targets (xr, rr)[i] against
-    the source rings (xc, rc, normal (nxc, nrc), weight wc)[j]: the dense block of the assembly
-    (Part I, eqs. (20)-(22)).  Compiled: one fused pass writing the two (rows, cols) arrays;
-    numpy: blocks of about ``chunk`` entries, so that the temporaries stay small.
-
-    ``out``: two (rows, cols) float64 arrays, blocks of larger C-ordered matrices (rows at a
-    common stride, each row contiguous), written in place (no temporaries) and returned."""
+    the source rings (xc, rc, normal (nxc, nrc), weight wc)[j]: the plain dense block (Part I,
+    eqs. (20)-(22)), the reference of :func:`single_double_dense_sym` and
+    :func:`single_double_dense_mirror`.  Compiled: one fused pass writing the two (rows, cols)
+    arrays; numpy: blocks of about ``chunk`` entries, so that the temporaries stay small."""
     xr, rr, xc, rc, nxc, nrc, wc = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (xr, rr, xc, rc, nxc, nrc, wc))
     lib = compiled()
-    if out is not None:
-        S, Dl = out
-        if S.shape != (xr.size, xc.size) or Dl.shape != S.shape or S.dtype != float or Dl.dtype != float \
-                or S.strides != Dl.strides or S.strides[1] != S.itemsize:
-            raise ValueError("single_double_dense: out must be two (rows, cols) float64 blocks with contiguous rows")
-        if lib is not None and xr.size and xc.size:
-            ld = S.strides[0] // S.itemsize
-            lib.ring_dense_ld(xr.size, address(xr), address(rr), xc.size, *(address(a) for a in (xc, rc, nxc, nrc, wc)),
-                              ld, S.ctypes.data, Dl.ctypes.data)
-            return S, Dl
-        S[...], Dl[...] = single_double_dense(xr, rr, xc, rc, nxc, nrc, wc, chunk)
-        return S, Dl
     S, Dl = np.empty((xr.size, xc.size)), np.empty((xr.size, xc.size))
     if lib is not None:
         lib.ring_dense(xr.size, address(xr), address(rr), xc.size,
@@ -322,6 +309,43 @@ def single_double_dense_sym(x, r, nx, nr, w, S, D, skip=None, chunk: int = 12288
         if kept.size:
             cols = np.ix_(kept, rows)
             S[cols], D[cols] = single_double_dense(x[kept], r[kept], x[rows], r[rows], nx[rows], nr[rows], w[rows], chunk)
+
+
+def single_double_dense_mirror(x, r, nx, nr, w, xs, S, D, chunk: int = 12288) -> None:
+    """The dense block of the nodes (x, r) against the images of the same nodes in the free surface (the
+    mirror surface S' of a half-space, Part I, eqs. (21)-(22): the image of node j at x = xs[j], the same
+    r and weight, the normal (-nx, nr)), column j the image of node j, written into the C-contiguous
+    (n, n) arrays S and D: S[i, j] w[j] and Dl[i, j] w[j] of :func:`single_double` (Part I, eqs. (20)-(22)).
+
+    The modulus of the elliptic integrals is symmetric in the pair: x_i - xs[j] and x_j - xs[i] are the
+    same distance to round-off, and r_i - r_j only changes sign.  So every pair {i, j} takes its axial
+    difference as dx[i, j] = dx[j, i] = x[min(i, j)] - xs[max(i, j)] (the source radius, normal and weight
+    stay each column's own), and compiled (``ring_dense_mirror_sym``) q, ln q, K, E and 1/(pi sqrt D) are
+    evaluated once per pair (this project's own shortcut); numpy: :func:`_single_double_numpy` on row
+    blocks of about ``chunk`` entries with the same differences.  The difference is formed from the image
+    coordinates, not as x_i + x_j - 2 x_surface: next to the free surface both subtractions are exact
+    (Sterbenz), where the sum x_i + x_j would be rounded at the size of the depth first."""
+    x, r, nx, nr, w, xs = (np.ascontiguousarray(a, dtype=float).reshape(-1) for a in (x, r, nx, nr, w, xs))
+    n = x.size
+    if not (S.flags.c_contiguous and D.flags.c_contiguous and S.shape == D.shape == (n, n)
+            and S.dtype == D.dtype == np.float64) or any(a.size != n for a in (r, nx, nr, w, xs)):
+        raise ValueError("single_double_dense_mirror: arrays of inconsistent shapes")
+    lib = compiled()
+    if lib is not None:
+        if n:
+            lib.ring_dense_mirror_sym(n, *(address(a) for a in (x, r, nx, nr, w, xs)), n, address(S), address(D))
+        return
+    step = max(1, chunk // max(n, 1))
+    cols = np.arange(n)
+    for a in range(0, n, step):
+        rows = slice(a, a + step)
+        upper = cols >= cols[rows, None]  # j >= i: dx of the pair from (i, j*), else from (j, i*)
+        dx = np.where(upper, x[rows, None] - xs, x - xs[rows, None])
+        with np.errstate(divide="ignore", invalid="ignore"):
+            S[rows], D[rows] = _single_double_numpy(x[rows, None], r[rows, None], xs, r, -nx, nr,
+                                                    (dx, r[rows, None] - r))
+    S *= w
+    D *= w
 
 
 def _c_array(a, dtype=float):

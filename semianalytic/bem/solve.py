@@ -38,7 +38,7 @@ import numpy as np
 import scipy.linalg
 
 from semianalytic.bem.kernels import (
-    gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_dense, single_double_split,
+    gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
 from semianalytic.bem.panels import PanelSet
@@ -319,14 +319,19 @@ class PairQuadrature:
     def _point_target_u(self) -> np.ndarray:
         return self.target_u[self.pair]
 
-    def entries(self, order: int, columns: int) -> np.ndarray:
-        """Flat indices, in a C-ordered matrix of ``columns`` columns, of the (target, node)
-        entries of each pair's block (n_pairs, order): row target, columns panel * order + j
-        (kept per rule: the solves of a difference in P share it)."""
-        key = (order, columns)
+    def entries(self, order: int, n: int) -> np.ndarray:
+        """Flat indices of the (target, node) entries of each pair's block (n_pairs, order) in the
+        C-ordered (2, n, n) pair of matrices of :func:`assemble` (n primary nodes): row target,
+        column c = panel * order + j of matrix 0 for a primary node (c < n), and for a mirror
+        node (c >= n, the image of primary node 2n - 1 - c: :meth:`PanelSet.fold_mirror`) column
+        2n - 1 - c of matrix 1, the mirror block in folded order.  Kept per rule: the solves of a
+        difference in P share it."""
+        key = (order, n)
         got = self.__dict__.setdefault("_entries", {})
         if key not in got:
-            got[key] = (self.target[:, None] * columns + self.panel[:, None] * order + np.arange(order)[None, :]).ravel()
+            c = self.panel[:, None] * order + np.arange(order)[None, :]
+            c = np.where(c < n, c, n * n + (2 * n - 1 - c))
+            got[key] = (self.target[:, None] * n + c).ravel()
         return got[key]
 
 
@@ -834,12 +839,17 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     if plan.fixed is not None and cache is None:
         raise ValueError("a plan with fixed panels needs the AssemblyCache it was matched against")
     fix = None if plan.fixed is None else np.repeat(plan.fixed, p)
-    S, D = np.empty((N, X.size)), np.empty((N, X.size))
+    mirrored = X.size > N
+    # matrix 0: the primary nodes against the primary panels (the raw block the cache keeps);
+    # matrix 1 (half-space): against the mirror panels, column j the image of primary node j,
+    # i.e. already in the folded order of PanelSet.fold_mirror (no (N, 2N) matrices)
+    SS, DD = np.empty((1 + mirrored, N, N)), np.empty((1 + mirrored, N, N))
+    S, D = SS[0], DD[0]
     # the primary nodes against themselves (compiled: once per pair, the same numbers), then the
-    # mirror columns written in place, then the fixed panels' block from the cache
+    # fixed panels' block from the cache
     _kernels.single_double_dense_sym(xt, rt, NX[:N], NR[:N], W[:N], S, D, fix, DENSE_CHUNK)
-    if X.size > N:  # numpy: row blocks, so that temporaries stay small (DENSE_CHUNK)
-        single_double_dense(xt, rt, X[N:], R[N:], NX[N:], NR[N:], W[N:], DENSE_CHUNK, (S[:, N:], D[:, N:]))
+    if mirrored:  # the image of primary node j is mirror node 2N - 1 - j (PanelSet.fold_mirror)
+        _kernels.single_double_dense_mirror(xt, rt, NX[:N], NR[:N], W[:N], X[:N - 1:-1], SS[1], DD[1], DENSE_CHUNK)
     if fix is not None:
         k = int(np.count_nonzero(fix))
         block = (slice(0, k),) * 2 if fix[:k].all() else np.ix_(*(np.nonzero(fix)[0],) * 2)  # slices when they lead
@@ -847,13 +857,15 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
             Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
-            flat = rule.entries(p, S.shape[1])
-            S.put(flat, Sb)
-            D.put(flat, Db)
-    mirrored = ps.n_panels > ps.n_primary
+            flat = rule.entries(p, N)
+            SS.put(flat, Sb)
+            DD.put(flat, Db)
     if cache is not None:
-        cache.store(ps, S, D, copy=not mirrored)  # folding the mirror columns makes new matrices
-    S, D = ps.fold_mirror(S), ps.fold_mirror(D)
+        cache.store(ps, S, D, copy=not mirrored)  # with a mirror, the primary block is not written again
+    if mirrored:  # the folding (PanelSet.fold_mirror) in place: mirror block + primary block
+        S, D = SS[1], DD[1]
+        S += SS[0]
+        D += DD[0]
     # the double layer of a constant is -1/2 on the closed surface (S + S'): putting each
     # row's quadrature error on the diagonal makes (I/2 - D) act on phi - phi_i only, so
     # that near a corner the error follows the local variation of phi, not phi itself
