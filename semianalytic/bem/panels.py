@@ -32,6 +32,31 @@ GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type gra
 
 
 
+_UINTP = np.dtype(np.uintp)
+_MAX = np.maximum.reduce
+_KERNELS = []
+
+
+def _kernels():
+    """The module :mod:`semianalytic.bem.kernels`, imported on first use (it imports scipy.special:
+    not at start-up) and then kept (an import statement costs a microsecond per call, and the
+    geometry asks for the compiled library about 1000 times per table).  Its ``compiled`` is
+    looked up at each call, as tests replace it."""
+    if not _KERNELS:
+        from semianalytic.bem import kernels
+
+        _KERNELS.append(kernels)
+    return _KERNELS[0]
+
+
+def _outputs(k: int, shape) -> tuple[tuple, list]:
+    """k float64 output arrays of ``shape`` for a compiled call, rows of one block (one allocation
+    and one address instead of k: this project's own shortcut), and their addresses."""
+    block = np.empty((k,) + tuple(shape))
+    at, step = address(block), block[0].nbytes
+    return tuple(block[i, ...] for i in range(k)), [at + i * step for i in range(k)]  # [i, ...]: 0-d arrays too
+
+
 def _curve_row(seg):
     """The compiled geometry's kind of a segment's curve and its two numbers (see
     :attr:`PanelSet._compiled_curves`), or None for a curve it does not evaluate."""
@@ -235,14 +260,12 @@ class PanelSet:
         geometry applies (lines, arcs and a table's spline; indices in range), else None."""
         if self._compiled_curves is None:
             return None
-        from semianalytic.bem.kernels import compiled
-
-        lib = compiled()
+        lib = _kernels().compiled()
         if lib is None:
             return None
         pk = np.ascontiguousarray(panel, dtype=np.intp).reshape(-1)
         # numpy's negative indices: its own path (seen unsigned they exceed every panel index)
-        if pk.size and pk.view(np.uintp).max() >= self.n_panels:
+        if pk.size and _MAX(pk.view(_UINTP)) >= self.n_panels:
             return None
         return lib, pk
 
@@ -264,12 +287,11 @@ class PanelSet:
                c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"], c["nk"],
                c["knots"], c["cx"], c["cr"], None if pw is None else address(pw), *(address(a) for a in out))
             return tuple(out)
-        out = [np.empty(u.shape) for _ in range(8 if split else 4)]
-        ptr = [address(a) for a in out] + [None] * (0 if split else 4)
+        out, ptr = _outputs(8 if split else 4, u.shape)
         lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
-        return tuple(out)
+                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr, *(None,) * (8 - len(ptr)))
+        return out
 
     def _numpy_powers(self, pk, u):
         """numpy's lo^q, lo^(q - 1), lo^max(q - 2, 0) of :meth:`_param` at the
@@ -364,18 +386,21 @@ class PanelSet:
         """point(u_to) - point(u_from) on the same panel, free of cancellation: the
         segment's displacement over the parameter difference (needed where the two points
         are far closer to each other than to the origin)."""
-        panel, u_from, u_to = np.broadcast_arrays(np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float))
-        dx = np.empty(u_from.shape)
-        dr = np.empty(u_from.shape)
+        panel, u_from, u_to = np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float)
+        if not panel.shape == u_from.shape == u_to.shape:
+            panel, u_from, u_to = np.broadcast_arrays(panel, u_from, u_to)
         got = self._compiled_lib(panel) if u_from.size else None
         if got is not None:  # lines, arcs, a table's spline: ring_panel_relative of _ring.c, the same formulas
             lib, pk = got
             c = self._compiled_curves[0]
             uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
+            (dx, dr), ptr = _outputs(2, u_from.shape)
             lib.ring_panel_relative(pk.size, address(pk), address(uf), address(ut), c["base"], c["da"], c["db"],
                                     c["half"], c["sign"], c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                                    c["nk"], c["knots"], c["cx"], c["cr"], address(dx), address(dr))
+                                    c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
             return dx, dr
+        dx = np.empty(u_from.shape)
+        dr = np.empty(u_from.shape)
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
             uf, ut = u_from[mask], u_to[mask]
