@@ -53,8 +53,9 @@ def _outputs(k: int, shape) -> tuple[tuple, list]:
     """k float64 output arrays of ``shape`` for a compiled call, rows of one block (one allocation
     and one address instead of k: this project's own shortcut), and their addresses."""
     block = np.empty((k,) + tuple(shape))
-    at, step = address(block), block[0].nbytes
-    return tuple(block[i, ...] for i in range(k)), [at + i * step for i in range(k)]  # [i, ...]: 0-d arrays too
+    at, step = address(block), block.nbytes // k
+    rows = tuple(block) if block.ndim > 1 else tuple(block[i, ...] for i in range(k))  # [i, ...]: 0-d arrays
+    return rows, list(range(at, at + k * step, step)) if step else [at] * k
 
 
 def _curve_row(seg):
