@@ -755,25 +755,6 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     return AssemblyPlan(self_rule, near_quadrature(tgt, pan, ustar, du, p), fixed)
 
 
-def restrict_plan(plan: AssemblyPlan, ps: PanelSet, fixed: np.ndarray) -> AssemblyPlan:
-    """``plan`` without the pairs among the primary panels ``fixed`` (a mask containing
-    ``plan.fixed``), whose block :func:`assemble` then copies from its AssemblyCache: the
-    self pairs of their nodes and the near pairs of a node of theirs and a panel of theirs, as
-    :func:`plan_assembly` leaves them out; the other pairs keep their rules.
-
-    This project's own shortcut for the later sets of a difference in P: the layouts of a
-    stencil differ only in the piece cut by the free surface (and the mirror images), so the
-    panels of the other pieces have the same nodes in every set (:meth:`AssemblyCache.same`,
-    bit for bit) and the same block, computed once per depth instead of once per set."""
-    if not fixed.any() or (plan.fixed is not None and not (fixed & ~plan.fixed).any()):
-        return plan
-    p = ps.order
-    self_rule, near_rule = plan.self_rule, plan.near_rule
-    on_mirror = np.zeros(ps.n_panels - ps.n_primary, bool)  # mirror panels are never fixed
-    near_keep = ~(fixed[near_rule.target // p] & np.concatenate([fixed, on_mirror])[near_rule.panel])
-    return AssemblyPlan(self_rule.subset(~fixed[self_rule.target // p]), near_rule.subset(near_keep), fixed)
-
-
 @dataclass
 class AssemblyCache:
     """The raw single- and double-layer block of the primary nodes against the primary
@@ -817,20 +798,6 @@ class AssemblyCache:
         close = np.maximum(np.abs(x[:n] - ox[:n]).max(axis=1), np.abs(r[:n] - or_[:n]).max(axis=1)) <= 1e-13 * scale
         wclose = np.abs(w[:n] - ow[:n]).max(axis=1) <= 1e-13 * wmax[:n]
         np.logical_and(close, wclose, out=out[:n])
-        return out
-
-    def same(self, ps: PanelSet) -> np.ndarray:
-        """Mask over the primary panels of ``ps``: True where the panel of the same index in the
-        cache has exactly the same nodes and weights (bit for bit, not to a tolerance: its block
-        is then the one ``ps`` itself would give, see :func:`restrict_plan`)."""
-        out = np.zeros(ps.n_primary, bool)
-        if self.nodes is None or self.nodes[0].shape[1] != ps.order:
-            return out
-        x, r, w = self._signature(ps)[:3]
-        ox, or_, ow = self.nodes[:3]
-        n = min(len(x), len(ox))
-        np.logical_and.reduce([(x[:n] == ox[:n]).all(axis=1), (r[:n] == or_[:n]).all(axis=1),
-                               (w[:n] == ow[:n]).all(axis=1)], out=out[:n])
         return out
 
     def store(self, ps: PanelSet, S: np.ndarray, D: np.ndarray, copy: bool = True) -> None:

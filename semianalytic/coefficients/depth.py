@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
-from semianalytic.bem.solve import AssemblyCache, SurfaceSolution, plan_assembly, restrict_plan, solve_panels
+from semianalytic.bem.solve import AssemblyCache, SurfaceSolution, plan_assembly, solve_panels
 from semianalytic.geometry import Nose
 
 # central stencils (step h): order -> offsets, weights of the first derivative, and weights
@@ -102,13 +102,7 @@ def coefficients_at_depth(
         for ps in stencil:
             fixed &= cache.match(ps)
     plan = plan_assembly(panels, fixed)  # the same rules at every depth of the stencil
-    sols = []
-    for k, ps in zip(offsets, stencil):
-        use = plan
-        if cache is not None and sols:  # the panels this set shares with the previous one: their block copied
-            same = cache.same(ps)
-            use = restrict_plan(plan, ps, same if fixed is None else same | fixed)
-        sols.append(solve_panels(ps, "halfspace", depth=depth + k * h, plan=use, cache=cache))
+    sols = [solve_panels(ps, "halfspace", depth=depth + k * h, plan=plan, cache=cache) for k, ps in zip(offsets, stencil)]
     center = SurfaceSolution(
         panels,
         sum(c * s.phi_nodes for c, s in zip(interp, sols)),
