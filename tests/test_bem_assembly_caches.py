@@ -75,3 +75,34 @@ def test_cache_match_follows_each_panel_set():
     assemble(b, plan_assembly(b, cache.match(b)), cache)
     again = cache.match(a)
     assert np.array_equal(again[:n], same) and not again[n:].any()
+
+
+def _arrays(ps):
+    return [ps.base, ps.anchor_x, ps.anchor_r, ps.da, ps.db, ps.sign, ps.segment_index] + \
+        [a for a in (ps.power, ps.cluster) if a is not None]
+
+
+def test_restretched_stencil_sets_are_the_fresh_panel_sets():
+    """A stencil set built from the centre's arrays (``panels(like=...)``) has bit for bit the
+    arrays, nodes and compiled geometry of the panel set built from its pieces: on an ogive cut
+    by the free surface (one stretched piece), past its shoulder (a new shank line) and on a
+    table nose cut between knots (many pieces, a spline)."""
+    from semianalytic.coefficients.study import study_nose
+
+    for nose, P in ((ogive_nose(D, 3.0), 0.5), (ogive_nose(D, 3.0), 2.0), (study_nose("table"), 0.6)):
+        P *= nose.length
+        layout = halfspace_layout(nose, P, OPTS)
+        centre = layout.panels()
+        for k in (-1, 1):
+            moved = layout.at_depth(P + k * 1e-3 * P)
+            fresh, derived = moved.panels(), moved.panels(like=centre)
+            assert derived.segments == fresh.segments and derived.offset == fresh.offset
+            assert derived.n_primary == fresh.n_primary and (derived.power is None) == (fresh.power is None)
+            for a, b in zip(_arrays(derived), _arrays(fresh)):
+                assert a.dtype == b.dtype and np.array_equal(a, b)
+            for a, b in zip(dataclasses.astuple(derived.nodes), dataclasses.astuple(fresh.nodes)):
+                assert np.array_equal(a, b)
+            assert not np.array_equal(fresh.nodes.x, centre.nodes.x)  # the test sees a stale copy
+            if kernels.compiled() is not None:
+                (ad, kd), (af, kf) = derived._compiled_curves, fresh._compiled_curves
+                assert set(kd) == set(kf) and all(np.array_equal(kd[n], kf[n]) for n in kf)

@@ -410,7 +410,8 @@ def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
         raise ValueError("pair_rules_compiled: per-point arrays of different lengths")
     # with an index: the Jacobians and normals of the x.size distinct points once (3 x.size more)
     ngeo = min(xu.size, ru.size) if p_index is not None else 0
-    S, D, work = np.zeros((npairs, p)), np.zeros((npairs, p)), np.empty(2 * n + 3 * ngeo)
+    SD, work = np.zeros((2, npairs, p)), np.empty(2 * n + 3 * ngeo)  # S and D: one block, one address
+    S, D = SD[0], SD[1]
     ptr = address
     mask = psplit = tsplit = None
     if tiny is not None:
@@ -420,8 +421,9 @@ def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
                 or any(v.size < xt.size for v in ts_):
             raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
         psplit, tsplit = (np.array([address(v) for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
+    at = address(SD)
     lib.ring_pair_rules(n, p_index, ptr(x), ptr(r), ptr(xu), ptr(ru), p_tgt, ptr(xt), ptr(rt), ptr(ddx), ptr(ddr),
-                        p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, p, ptr(work), ptr(S), ptr(D),
+                        p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, p, ptr(work), at, at + S.nbytes,
                         ptr(mask), ptr(psplit), ptr(tsplit), ngeo, address(work[2 * n:]) if ngeo else None)
     return S, D
 

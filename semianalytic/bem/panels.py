@@ -32,6 +32,42 @@ GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type gra
 
 
 
+_UINTP = np.dtype(np.uintp)
+_MAX = np.maximum.reduce
+_KERNELS = []
+
+
+def _kernels():
+    """The module :mod:`semianalytic.bem.kernels`, imported on first use (it imports scipy.special:
+    not at start-up) and then kept (an import statement costs a microsecond per call, and the
+    geometry asks for the compiled library about 1000 times per table).  Its ``compiled`` is
+    looked up at each call, as tests replace it."""
+    if not _KERNELS:
+        from semianalytic.bem import kernels
+
+        _KERNELS.append(kernels)
+    return _KERNELS[0]
+
+
+def _outputs(k: int, shape) -> tuple[tuple, list]:
+    """k float64 output arrays of ``shape`` for a compiled call, rows of one block (one allocation
+    and one address instead of k: this project's own shortcut), and their addresses."""
+    block = np.empty((k,) + tuple(shape))
+    at, step = address(block), block.nbytes // k
+    rows = tuple(block) if block.ndim > 1 else tuple(block[i, ...] for i in range(k))  # [i, ...]: 0-d arrays
+    return rows, list(range(at, at + k * step, step)) if step else [at] * k
+
+
+def _curve_row(seg):
+    """The compiled geometry's kind of a segment's curve and its two numbers (see
+    :attr:`PanelSet._compiled_curves`), or None for a curve it does not evaluate."""
+    k = {Line: 0, Arc: 1, EllipseArc: 2, SplineCurve: 3}.get(type(seg))
+    if k is None:
+        return None
+    return ((k, seg.p1[0] - seg.p0[0], seg.p1[1] - seg.p0[1]) if k == 0 else
+            (k, seg.radius, 0.0) if k == 1 else (k, seg.a, seg.b) if k == 2 else (k, 0.0, 0.0))
+
+
 @dataclass(frozen=True)
 class PanelSet:
     """Panels over one or more segments.
@@ -154,28 +190,44 @@ class PanelSet:
         semi-axes; 3 a table nose's cubic spline, whose knots and coefficients are passed once),
         the anchors, parameters, signs and corner substitutions; None when a panel lies on
         another curve (a power law, a Bezier nose, two different splines: the numpy path)."""
-        kinds = {Line: 0, Arc: 1, EllipseArc: 2, SplineCurve: 3}
+        return self._compiled_with(self._compiled_segments(self.__dict__.get("_like")))
+
+    def _compiled_segments(self, like: "PanelSet | None" = None):
+        """The curve part of :attr:`_compiled_curves` (kind, c0, c1 per panel; the spline's knots
+        and coefficients) as (addresses, arrays), or None.  ``like``: a panel set of the same
+        topology whose part is reused when its segments are these, or when only the last
+        differs, a line as before (a layout stretched by :meth:`HalfspaceLayout.at_depth`:
+        only that segment's rows are computed again; the same numbers)."""
+        if like is not None and like.n_panels == self.n_panels and len(like.segments) == len(self.segments) \
+                and all(a is b for a, b in zip(like.segments[:-1], self.segments)):
+            got = like._compiled_curves
+            if got is None:
+                return None
+            addr, keep = got
+            old, seg = like.segments[-1], self.segments[-1]
+            if seg is old:
+                return ({k: addr[k] for k in ("kind", "c0", "c1", "nk", "knots", "cx", "cr")},
+                        {k: keep[k] for k in ("kind", "c0", "c1", "knots", "cx", "cr") if k in keep})
+            if type(seg) is Line and type(old) is Line:
+                rows = np.nonzero(self.segment_index == len(self.segments) - 1)[0]
+                c0, c1 = keep["c0"].copy(), keep["c1"].copy()
+                c0[rows], c1[rows] = _curve_row(seg)[1:]
+                part = {k: keep[k] for k in ("kind", "knots", "cx", "cr") if k in keep} | {"c0": c0, "c1": c1}
+                return {k: addr[k] for k in ("kind", "nk", "knots", "cx", "cr")} | {"c0": address(c0), "c1": address(c1)}, part
         rows = []
         splines = None
         for seg in self.segments:
-            k = kinds.get(type(seg))
-            if k is None:
+            row = _curve_row(seg)
+            if row is None:
                 return None
-            if k == 3:
+            if row[0] == 3:
                 if splines is not None and seg._splines is not splines:
                     return None
                 splines = seg._splines
-            rows.append((k, seg.p1[0] - seg.p0[0], seg.p1[1] - seg.p0[1]) if k == 0 else
-                        (k, seg.radius, 0.0) if k == 1 else (k, seg.a, seg.b) if k == 2 else (k, 0.0, 0.0))
-        keep = {name: np.ascontiguousarray(a, dtype=float) for name, a in (
-            ("base", self.base), ("da", self.da), ("db", self.db), ("half", self._half), ("sign", self.sign),
-            ("ax", self.anchor_x), ("ar", self.anchor_r))}
-        keep["kind"] = np.ascontiguousarray(np.array([r[0] for r in rows], dtype=np.intp)[self.segment_index])
+            rows.append(row)
+        keep = {"kind": np.ascontiguousarray(np.array([r[0] for r in rows], dtype=np.intp)[self.segment_index])}
         for j, name in ((1, "c0"), (2, "c1")):
             keep[name] = np.ascontiguousarray(np.array([r[j] for r in rows], dtype=float)[self.segment_index])
-        corner = self.cluster is not None and bool(self._clustered.any())
-        if corner:
-            keep["cluster"], keep["power"] = (np.ascontiguousarray(a, dtype=float) for a in (self.cluster, self.power))
         if splines is not None:  # scipy CubicSpline's knots and (4, n - 1) coefficients, as its evaluation reads them
             knots, sx, sr = splines
             keep["knots"] = np.ascontiguousarray(sx.x, dtype=float)
@@ -183,26 +235,38 @@ class PanelSet:
             if keep["cx"].shape != (4, keep["knots"].size - 1) or keep["cr"].shape != keep["cx"].shape:
                 return None
         addr = {name: address(a) for name, a in keep.items()}
-        if not corner:
-            addr["cluster"] = addr["power"] = None
         addr["nk"] = 0 if splines is None else int(keep["knots"].size)
         if splines is None:
             addr["knots"] = addr["cx"] = addr["cr"] = None
         return addr, keep
+
+    def _compiled_with(self, curves):
+        """:attr:`_compiled_curves` from its curve part ``curves`` (:meth:`_compiled_segments`)
+        and this panel set's parameters, anchors, signs and corner substitutions."""
+        if curves is None:
+            return None
+        keep = {name: np.ascontiguousarray(a, dtype=float) for name, a in (
+            ("base", self.base), ("da", self.da), ("db", self.db), ("half", self._half), ("sign", self.sign),
+            ("ax", self.anchor_x), ("ar", self.anchor_r))}
+        corner = self.cluster is not None and bool(self._clustered.any())
+        if corner:
+            keep["cluster"], keep["power"] = (np.ascontiguousarray(a, dtype=float) for a in (self.cluster, self.power))
+        addr = {name: address(a) for name, a in keep.items()} | curves[0]
+        if not corner:
+            addr["cluster"] = addr["power"] = None
+        return addr, keep | curves[1]
 
     def _compiled_lib(self, panel):
         """The compiled library and the panel indices as a flat intp array when the compiled
         geometry applies (lines, arcs and a table's spline; indices in range), else None."""
         if self._compiled_curves is None:
             return None
-        from semianalytic.bem.kernels import compiled
-
-        lib = compiled()
+        lib = _kernels().compiled()
         if lib is None:
             return None
         pk = np.ascontiguousarray(panel, dtype=np.intp).reshape(-1)
         # numpy's negative indices: its own path (seen unsigned they exceed every panel index)
-        if pk.size and pk.view(np.uintp).max() >= self.n_panels:
+        if pk.size and _MAX(pk.view(_UINTP)) >= self.n_panels:
             return None
         return lib, pk
 
@@ -224,12 +288,11 @@ class PanelSet:
                c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"], c["nk"],
                c["knots"], c["cx"], c["cr"], None if pw is None else address(pw), *(address(a) for a in out))
             return tuple(out)
-        out = [np.empty(u.shape) for _ in range(8 if split else 4)]
-        ptr = [address(a) for a in out] + [None] * (0 if split else 4)
+        out, ptr = _outputs(8 if split else 4, u.shape)
         lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
                               c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
-        return tuple(out)
+                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr, *(None,) * (8 - len(ptr)))
+        return out
 
     def _numpy_powers(self, pk, u):
         """numpy's lo^q, lo^(q - 1), lo^max(q - 2, 0) of :meth:`_param` at the
@@ -324,18 +387,21 @@ class PanelSet:
         """point(u_to) - point(u_from) on the same panel, free of cancellation: the
         segment's displacement over the parameter difference (needed where the two points
         are far closer to each other than to the origin)."""
-        panel, u_from, u_to = np.broadcast_arrays(np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float))
-        dx = np.empty(u_from.shape)
-        dr = np.empty(u_from.shape)
+        panel, u_from, u_to = np.asarray(panel), np.asarray(u_from, float), np.asarray(u_to, float)
+        if not panel.shape == u_from.shape == u_to.shape:
+            panel, u_from, u_to = np.broadcast_arrays(panel, u_from, u_to)
         got = self._compiled_lib(panel) if u_from.size else None
         if got is not None:  # lines, arcs, a table's spline: ring_panel_relative of _ring.c, the same formulas
             lib, pk = got
             c = self._compiled_curves[0]
             uf, ut = (np.ascontiguousarray(v, dtype=float).reshape(-1) for v in (u_from, u_to))
+            (dx, dr), ptr = _outputs(2, u_from.shape)
             lib.ring_panel_relative(pk.size, address(pk), address(uf), address(ut), c["base"], c["da"], c["db"],
                                     c["half"], c["sign"], c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                                    c["nk"], c["knots"], c["cx"], c["cr"], address(dx), address(dr))
+                                    c["nk"], c["knots"], c["cx"], c["cr"], *ptr)
             return dx, dr
+        dx = np.empty(u_from.shape)
+        dr = np.empty(u_from.shape)
         for seg, mask, pk in self._by_segment(panel):
             half = 0.5 * (self.db[pk] - self.da[pk])
             uf, ut = u_from[mask], u_to[mask]
@@ -546,6 +612,34 @@ def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float
     return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n, power_arr, cluster_arr, label)
 
 
+def restretched(like: PanelSet, pieces, offset: float) -> PanelSet:
+    """:func:`panel_set` of ``pieces`` (mirrored as ``like``) from ``like``, the panel set of pieces
+    that differ only in the last piece's end parameter, end point and segment (a layout and its
+    :meth:`HalfspaceLayout.at_depth`): only the last piece's rows are computed again, by
+    :func:`panel_set`'s formulas, the other arrays are shared (this project's own shortcut, the
+    same numbers; the two sets of a difference in P per depth)."""
+    last = pieces[-1]
+    rows = np.asarray(last.panels, dtype=float).reshape(-1, 3)
+    m, n = len(rows), like.n_primary
+    mirrored = like.n_panels > n
+    if len(like.segments) != len(pieces) or like.n_panels != (2 * n if mirrored else n) or m > n:
+        raise ValueError("restretched: pieces of another topology than the panel set's")
+    start = rows[:, 0] == 0
+    span = float(last.t1 - last.t0)
+    new = (np.where(start, float(last.t0), float(last.t1)), np.where(start, float(last.p0[0]), float(last.p1[0])),
+           np.where(start, float(last.p0[1]), float(last.p1[1])), rows[:, 1] * span, rows[:, 2] * span)
+    arrays = [a.copy() for a in (like.base, like.anchor_x, like.anchor_r, like.da, like.db)]
+    for a, v in zip(arrays, new):
+        a[n - m:n] = v
+    if mirrored:  # the mirror panels of the last piece: reversed, da and db swapped
+        for a, v in zip(arrays, new[:3] + (new[4], new[3])):
+            a[n:n + m] = v[::-1]
+    ps = PanelSet(like.segments[:-1] + (last.segment,), like.segment_index, *arrays, like.sign, offset, like.order,
+                  n, like.power, like.cluster, like.label)
+    ps.__dict__["_like"] = like  # for the curve part of the compiled geometry (PanelSet._compiled_segments)
+    return ps
+
+
 TIP_POWER = 2.0  # substitution at a conical tip (axisymmetric point exponent nu in (1/2, 1))
 MAX_POWER = 6.0
 
@@ -719,9 +813,53 @@ class HalfspaceLayout:
             new = last.stretched(t1, (-depth, float(last.segment.point(t1)[1])))
         return HalfspaceLayout(self.nose, depth, (*head, new), self.options, self.shank)
 
-    def panels(self) -> PanelSet:
-        """Primary panels (tip at x = P in the target frame) followed by their mirror images."""
+    def panels(self, like: PanelSet | None = None) -> PanelSet:
+        """Primary panels (tip at x = P in the target frame) followed by their mirror images.
+        ``like``: the panel set of a layout that this one is :meth:`at_depth` of (or the reverse),
+        whose arrays are reused (:func:`restretched`, the same numbers)."""
+        if like is not None:
+            return restretched(like, self.pieces, self.depth)
         return panel_set(self.pieces, self.options.order, offset=self.depth, mirror=True, label=f"{self.nose.kind} nose")
+
+
+@dataclass(frozen=True)
+class _LayoutFrame:
+    """What :func:`halfspace_layout` reads of a nose at every depth and that does not depend on
+    the depth: the segments (a table's spline cut at its knots, so that panels never straddle
+    one), whether the tip is conical, the turning angles at the joints and at the shoulder, the
+    joints, and per segment its end abscissae, its arc length and its number of inner knots."""
+
+    segs: tuple
+    tip_conical: bool
+    turning: tuple
+    joints: tuple
+    shoulder_turning: float
+    shoulder_corner: bool
+    x_start: tuple
+    x_end: tuple
+    arc: tuple
+    inner_knots: tuple
+
+
+def _layout_frame(nose: Nose) -> _LayoutFrame:
+    """The :class:`_LayoutFrame` of ``nose``, worked out once and kept on the nose (this project's
+    own shortcut: the same numbers; a table lays out about 75 depths of one nose, and on a table
+    nose these were a tenth of its layout time)."""
+    got = nose.__dict__.get("_layout_frame")
+    if got is None:
+        segs = tuple(p for seg in nose.segments for p in (seg.between_knots() if isinstance(seg, SplineCurve) else (seg,)))
+        tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
+        tip_conical = tip_conical or getattr(segs[0], "singular_at_t0", False)  # a power-law tip, 1/n not an integer
+        got = _LayoutFrame(
+            segs, tip_conical, tuple(Meridian(segs, closed=False).corners()) if len(segs) > 1 else (),
+            tuple(_joints(segs)),
+            _shoulder_turning(nose), _shoulder_is_corner(nose),
+            tuple(float(seg.point(seg.t0)[0]) for seg in segs), tuple(float(seg.point(seg.t1)[0]) for seg in segs),
+            tuple(segment_arc_length(seg, seg.t0, seg.t1) for seg in segs),
+            tuple(int(np.sum((seg.knots > seg.t0) & (seg.knots < seg.t1))) if isinstance(seg, SplineCurve) else 0
+                  for seg in segs))
+        nose.__dict__["_layout_frame"] = got
+    return got
 
 
 def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOptions()) -> HalfspaceLayout:
@@ -737,14 +875,11 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         raise ValueError("depth must be positive")
     R, Lh = nose.radius, nose.length
     lev, ref = options.levels, options.refinement
-    # a table's spline is cut at its knots, so that panels never straddle one
-    segs = tuple(p for seg in nose.segments for p in (seg.between_knots() if isinstance(seg, SplineCurve) else (seg,)))
+    frame = _layout_frame(nose)
+    segs, tip_conical, turning, joints = frame.segs, frame.tip_conical, frame.turning, frame.joints
+    shoulder_turning, shoulder_corner = frame.shoulder_turning, frame.shoulder_corner
     cut_on_nose = depth < Lh
     scale = R if not cut_on_nose else max(min(R, depth), 1e-300)
-    tip_conical = nose.tip_half_angle() < 0.5 * math.pi - 1e-9
-    tip_conical = tip_conical or getattr(segs[0], "singular_at_t0", False)  # a power-law tip, 1/n not an integer
-    turning = Meridian(segs, closed=False).corners() if len(segs) > 1 else []
-    joints = _joints(segs)
 
     def junction(k: int) -> int:
         # a knot of a table's spline (C^2: only the third derivative jumps) needs no grading
@@ -756,17 +891,16 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
 
     pieces = []
     for k, seg in enumerate(segs):
-        x_end = float(seg.point(seg.t1)[0])
-        cut_here = cut_on_nose and -depth >= x_end - 1e-15 * max(Lh, R)
+        cut_here = cut_on_nose and -depth >= frame.x_end[k] - 1e-15 * max(Lh, R)
         t1 = param_at_x(seg, -depth) if cut_here else seg.t1
-        arc = segment_arc_length(seg, seg.t0, t1)
+        arc = segment_arc_length(seg, seg.t0, t1) if cut_here else frame.arc[k]
         if arc <= 0:
             continue
         # a straight segment next to a corner whose s^1 term is not polynomial in the substituted
         # panel (q not an integer: a cone's shoulder): three times the panels (measured on the
         # 30 deg cone at depth: identity error 1.8e-6 -> 7e-7 for 32 more unknowns; on curved
         # segments the gain does not pay for its cost)
-        ends = [turning[k - 1] if k > 0 else 0.0, turning[k] if k < len(segs) - 1 else _shoulder_turning(nose)]
+        ends = [turning[k - 1] if k > 0 else 0.0, turning[k] if k < len(segs) - 1 else shoulder_turning]
         rough = isinstance(seg, Line) and any(abs(corner_power(a) - round(corner_power(a))) > 1e-9 for a in ends)
         # a segment wholly in the target (a flat face at a shallow depth) is counted on its own
         # length, not on the depth: its solution varies on the depth's scale only next to the
@@ -782,11 +916,12 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         # refinement: the clamp of 2 panels made --refinement a no-op on a flat nose, whose face
         # is one radius long (this project's own rule; 2 at the tables' default 0.3)
         at_corner = any(a and abs(corner_power(a) - 1.0) > 1e-9 for a in ends) or (
-            k == len(segs) - 1 and not cut_here and _shoulder_is_corner(nose))
+            k == len(segs) - 1 and not cut_here and shoulder_corner)
         minimum = 1 if isinstance(seg, SplineCurve) else (max(2, math.ceil(2.0 * ref / 0.3 - 1e-9)) if at_corner else 2)
         n = _count(arc, seg_scale, ref, 4.8 if rough else 1.6, minimum=minimum)
         if isinstance(seg, SplineCurve):
-            n = max(n, int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) + 1)
+            inside = int(np.sum((seg.knots > seg.t0) & (seg.knots < t1))) if cut_here else frame.inner_knots[k]
+            n = max(n, inside + 1)
         if k == 0:
             g0 = lev if tip_conical else 0
         else:
@@ -795,16 +930,15 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
             g1 = lev
         elif k < len(segs) - 1:
             g1 = options.corner_grading(turning[k]) if turning[k] else junction(k)
-            nxt = segs[k + 1]
-            if cut_on_nose and options.levels and -depth >= float(nxt.point(nxt.t1)[0]) - 1e-15 * max(Lh, R):
+            if cut_on_nose and options.levels and -depth >= frame.x_end[k + 1] - 1e-15 * max(Lh, R):
                 # the free surface cuts the next segment: grade towards the joint down to the
                 # length left between the joint and the cut
-                gap = abs(float(nxt.point(nxt.t0)[0]) + depth)
+                gap = abs(frame.x_start[k + 1] + depth)
                 need = math.ceil(math.log(gap / (arc / n)) / math.log(GRADING_RATIO)) if 0 < gap < arc / n else 0
                 g1 = max(g1, min(need, 22))
         else:
-            g1 = options.corner_grading(_shoulder_turning(nose)) if _shoulder_is_corner(nose) else options.junction_levels
-            if _shoulder_is_corner(nose) and depth > Lh and options.levels:
+            g1 = options.corner_grading(shoulder_turning) if shoulder_corner else options.junction_levels
+            if shoulder_corner and depth > Lh and options.levels:
                 # the shoulder's mirror image lies 2 (P - L_h) away: grade down to that scale
                 gap = 0.5 * (depth - Lh)
                 need = math.ceil(math.log(gap / (arc / n)) / math.log(GRADING_RATIO)) if gap < arc / n else 0
@@ -822,7 +956,7 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
         elif k < len(segs) - 1:
             q1 = corner_power(turning[k])
         else:
-            q1 = corner_power(_shoulder_turning(nose))
+            q1 = corner_power(shoulder_turning)
         if n == 1 and g0 and g1:
             n = 2
         pieces.append(Piece(seg, seg.t0, t1, p0, p1, graded_panels(n, g0, g1), (q0, q1)))

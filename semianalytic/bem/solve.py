@@ -72,6 +72,7 @@ def _threadpools():
 
 
 _BLAS_LIMIT = threading.local()
+_ALL = np.logical_and.reduce  # np.all without its Python wrappers (booleans in, a boolean out)
 
 
 @contextlib.contextmanager
@@ -220,8 +221,10 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     cx, cr = ps.centers
     reach = NEAR_FACTOR * ps.lengths[None, :]
     dx = xt[:, None] - cx[None, :]
-    near = _closer(dx, rt[:, None] - cr[None, :], reach)
-    near_img = _closer(dx, rt[:, None] + cr[None, :], reach)
+    with np.errstate(over="ignore"):
+        dx2 = dx * dx  # shared by both searches
+    near = _closer(dx, rt[:, None] - cr[None, :], reach, dx2)
+    near_img = _closer(dx, rt[:, None] + cr[None, :], reach, dx2)
     if exclude_panel is not None:
         rows = np.arange(len(xt))
         near[rows, exclude_panel] = False
@@ -250,16 +253,17 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     return tgt, pan, u, du, uq[n + m:], duq[n + m:]
 
 
-def _closer(a, b, reach):
+def _closer(a, b, reach, a2=None):
     """hypot(a, b) < reach elementwise (a, b of one shape, reach broadcasting to it), numpy's
     hypot deciding only where a^2 + b^2 lies within 1e-12 of reach^2 (this project's own
     shortcut, the same booleans at a quarter of the cost: a^2 + b^2 and hypot^2 differ by a
-    few ulps, 1e-15; squares near under- or overflow take hypot everywhere)."""
+    few ulps, 1e-15; squares near under- or overflow take hypot everywhere).  ``a2``: a * a if
+    the caller has it."""
     if not 1e-140 < float(np.min(reach)) <= float(np.max(reach)) < 1e140:
         return np.hypot(a, b) < reach
     r2 = reach * reach
     with np.errstate(over="ignore"):  # a^2 = inf: far, as hypot says
-        s = a * a + b * b
+        s = (a * a if a2 is None else a2) + b * b
     out = s < r2 * (1.0 - 1e-12)
     edge = np.nonzero(~out & (s <= r2 * (1.0 + 1e-12)))
     if edge[0].size:
@@ -272,7 +276,8 @@ def _levels(side: np.ndarray, du: np.ndarray) -> np.ndarray:
     with np.errstate(divide="ignore", invalid="ignore"):
         lev = np.ceil(np.log2(side / du))
     lev = np.where(side <= 0, 0, np.where(np.isfinite(lev), lev, MAX_LEVELS))
-    return np.clip(lev, 0, MAX_LEVELS).astype(int)
+    # np.clip's value, without its Python wrappers (lev has no NaN here)
+    return np.minimum(np.maximum(lev, 0), MAX_LEVELS, out=lev).astype(int)
 
 
 @dataclass(frozen=True)
@@ -468,7 +473,8 @@ class PairQuadrature:
         if (stop if starts else 0) != self.u.size:
             raise ValueError("PairQuadrature: blocks that do not cover the points")
         starts.append(self.u.size)
-        addresses = np.array([address(k) for k in keep], dtype=np.uintp)
+        # the end rules' shared matrices are read-only (address() would fail over to .ctypes)
+        addresses = np.array([address(k) if k.flags.writeable else k.ctypes.data for k in keep], dtype=np.uintp)
         return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
 
     def _compiled_rule(self, split: bool):
@@ -994,7 +1000,7 @@ class SurfaceSolution:
         g = ps.nodes
         J = g.J[:n]
         dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
-        if not (np.all(np.isfinite(dphi_ds)) and np.all(np.isfinite(self.phi_nodes))):
+        if not (_ALL(np.isfinite(dphi_ds), axis=None) and _ALL(np.isfinite(self.phi_nodes), axis=None)):
             raise_non_finite(ps, self.depth, "surface velocity")
         return SurfaceNodes(
             x=g.x[:n].ravel() + ps.offset,
@@ -1125,9 +1131,10 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
     A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
     A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
-    with _single_threaded_blas():
+    # nested in a table's setting (its 150 solves): no context manager of its own
+    with contextlib.nullcontext() if getattr(_BLAS_LIMIT, "on", False) else _single_threaded_blas():
         phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
-    if phi is None or not np.all(np.isfinite(phi)):
+    if phi is None or not _ALL(np.isfinite(phi), axis=None):
         raise_non_finite(ps, depth)
     shape = (ps.n_primary, ps.order)
     return phi.reshape(shape), g.reshape(shape)

@@ -95,7 +95,7 @@ def coefficients_at_depth(
     h = step if step is not None else _step(nose, depth)
     offsets, weights, interp = STENCILS[fd_order]
     panels = layout.panels()
-    stencil = [layout.at_depth(depth + k * h).panels() for k in offsets]
+    stencil = [layout.at_depth(depth + k * h).panels(like=panels) for k in offsets]  # the topology shared
     fixed = None
     if cache is not None:
         fixed = cache.match(panels)
