@@ -48,6 +48,8 @@ def address(a) -> int | None:
     ``a.ctypes.data``."""
     if a is None:
         return None
+    if not a.flags.writeable:  # the buffer route raises for these: no exception to catch
+        return a.ctypes.data
     try:
         return _addressof(_char.from_buffer(a))
     except (TypeError, ValueError, BufferError):

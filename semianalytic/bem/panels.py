@@ -587,19 +587,12 @@ def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float
         at1 = ~at0 & (anchor == 1) & (b == 0.0) & (q1 > 1.0)
         power = np.where(at0, q0, np.where(at1, q1, 1.0))
         cluster = np.where(at0, -1.0, np.where(at1, 1.0, 0.0))
-        arrays = [np.where(start, t0, t1), np.where(start, x0, x1), np.where(start, r0, r1), a * span, b * span]
+        arrays = _anchored(rows, t0, t1, x0, r0, x1, r1, span)
     n = len(idx)
     if mirror:
         # reversed order, reversed parameter direction
         idx = np.concatenate([idx, idx[::-1]])
-        base, ax, ar, da, db = arrays
-        arrays = [
-            np.concatenate([base, base[::-1]]),
-            np.concatenate([ax, ax[::-1]]),
-            np.concatenate([ar, ar[::-1]]),
-            np.concatenate([da, db[::-1]]),
-            np.concatenate([db, da[::-1]]),
-        ]
+        arrays = [np.concatenate([v, m]) for v, m in zip(arrays, _mirror_rows(arrays))]
         sign = np.concatenate([np.ones(n), -np.ones(n)])
         power = np.concatenate([power, power[::-1]])
         cluster = np.concatenate([cluster, -cluster[::-1]])  # the parameter runs backwards
@@ -610,6 +603,21 @@ def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float
     if not np.any(cluster_arr):
         power_arr = cluster_arr = None
     return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n, power_arr, cluster_arr, label)
+
+
+def _anchored(rows, t0, t1, x0, r0, x1, r1, span) -> list:
+    """base, anchor x, anchor r, da, db of panels (rows: anchor end 0 or 1, a, b of the piece's
+    span) of pieces running from (t0, x0, r0) to (t1, x1, r1) over ``span`` (per panel): one home
+    for :func:`panel_set` and :func:`restretched`."""
+    start, a, b = rows[:, 0] == 0, rows[:, 1], rows[:, 2]
+    return [np.where(start, t0, t1), np.where(start, x0, x1), np.where(start, r0, r1), a * span, b * span]
+
+
+def _mirror_rows(arrays) -> tuple:
+    """The mirror images' base, anchor x, anchor r, da, db of panels' arrays (reversed order, the parameter
+    running backwards: da and db swapped)."""
+    base, ax, ar, da, db = arrays
+    return base[::-1], ax[::-1], ar[::-1], db[::-1], da[::-1]
 
 
 def restretched(like: PanelSet, pieces, offset: float) -> PanelSet:
@@ -624,16 +632,14 @@ def restretched(like: PanelSet, pieces, offset: float) -> PanelSet:
     mirrored = like.n_panels > n
     if len(like.segments) != len(pieces) or like.n_panels != (2 * n if mirrored else n) or m > n:
         raise ValueError("restretched: pieces of another topology than the panel set's")
-    start = rows[:, 0] == 0
-    span = float(last.t1 - last.t0)
-    new = (np.where(start, float(last.t0), float(last.t1)), np.where(start, float(last.p0[0]), float(last.p1[0])),
-           np.where(start, float(last.p0[1]), float(last.p1[1])), rows[:, 1] * span, rows[:, 2] * span)
+    new = _anchored(rows, float(last.t0), float(last.t1), float(last.p0[0]), float(last.p0[1]), float(last.p1[0]),
+                    float(last.p1[1]), float(last.t1 - last.t0))
     arrays = [a.copy() for a in (like.base, like.anchor_x, like.anchor_r, like.da, like.db)]
     for a, v in zip(arrays, new):
         a[n - m:n] = v
-    if mirrored:  # the mirror panels of the last piece: reversed, da and db swapped
-        for a, v in zip(arrays, new[:3] + (new[4], new[3])):
-            a[n:n + m] = v[::-1]
+    if mirrored:  # the mirror panels of the last piece (the first m mirror panels)
+        for a, v in zip(arrays, _mirror_rows(new)):
+            a[n:n + m] = v
     ps = PanelSet(like.segments[:-1] + (last.segment,), like.segment_index, *arrays, like.sign, offset, like.order,
                   n, like.power, like.cluster, like.label)
     ps.__dict__["_like"] = like  # for the curve part of the compiled geometry (PanelSet._compiled_segments)

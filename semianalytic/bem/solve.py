@@ -473,8 +473,7 @@ class PairQuadrature:
         if (stop if starts else 0) != self.u.size:
             raise ValueError("PairQuadrature: blocks that do not cover the points")
         starts.append(self.u.size)
-        # the end rules' shared matrices are read-only (address() would fail over to .ctypes)
-        addresses = np.array([address(k) if k.flags.writeable else k.ctypes.data for k in keep], dtype=np.uintp)
+        addresses = np.array([address(k) for k in keep], dtype=np.uintp)
         return np.array(starts, dtype=np.intp), np.array(q, dtype=np.intp), addresses, self.lag.shape[1], keep
 
     def _compiled_rule(self, split: bool):
@@ -1131,8 +1130,7 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
     A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
     A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
-    # nested in a table's setting (its 150 solves): no context manager of its own
-    with contextlib.nullcontext() if getattr(_BLAS_LIMIT, "on", False) else _single_threaded_blas():
+    with _single_threaded_blas():
         phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
     if phi is None or not _ALL(np.isfinite(phi), axis=None):
         raise_non_finite(ps, depth)
