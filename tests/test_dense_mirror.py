@@ -150,3 +150,30 @@ def test_halfspace_assembly_against_the_previous_path_numpy(depth_over_length, m
     """The same on the numpy fallback (every kernel in numpy)."""
     monkeypatch.setattr(kernels, "compiled", lambda: None)
     _check_against_previous("cone", depth_over_length)
+
+
+@needs_c
+def test_rules_write_into_the_matrices_only_within_bounds():
+    """The compiled rules write their entries straight into the assembly's matrices (numpy's put
+    without its overhead); indices beyond the matrices, or matrices of the wrong type, are refused
+    before the C code runs (it does not check them itself)."""
+    nose = study_nose("cone")
+    ps = halfspace_layout(nose, 0.5 * nose.length, LayoutOptions()).panels()
+    plan = plan_assembly(ps)
+    X, R = _flat_nodes(ps)[:2]
+    N = ps.n_primary * ps.order
+    rule = plan.near_rule
+    flat, bound = rule._entries(ps.order, N)
+    SS, DD = np.zeros((2, N, N)), np.zeros((2, N, N))
+    Sb, Db = rule.integrate(ps, X[:N], R[:N], _layers, node_targets=True, into=(SS, DD, flat, bound))
+    ref = np.zeros((2, N, N))
+    ref.put(flat, Sb)
+    assert np.array_equal(SS, ref)
+    ref.put(flat, Db)
+    assert np.array_equal(DD, ref)
+    for bad in ((np.zeros((1, N, N)), np.zeros((1, N, N)), flat, bound),  # the mirror block missing
+                (SS, DD, flat, 2 * N * N + 1),
+                (SS.astype(np.float32), DD, flat, bound),
+                (SS, DD, flat[:-1], bound)):
+        with pytest.raises(ValueError):
+            rule.integrate(ps, X[:N], R[:N], _layers, node_targets=True, into=bad)

@@ -329,7 +329,8 @@ accumulate(ptrdiff_t s0, ptrdiff_t s1, ptrdiff_t Q, const double *rows, const pt
  * repeating every bq[i] points).  With tiny != NULL, the points k with tiny[k] != 0 (on panels
  * graded far below their distance from the origin) take their differences through the anchors:
  * (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]) and likewise in r with [1], [3],
- * psplit the points' (anchor x, anchor r, offset x, offset r), tsplit the targets'. */
+ * psplit the points' (anchor x, anchor r, offset x, offset r), tsplit the targets'.  With flat != NULL
+ * the nflat entries of the blocks are then also written to intoS, intoD at the flat indices flat[i]. */
 void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
                      const double *xu, const double *ru, const ptrdiff_t *tgt, const double *xt,
                      const double *rt, const double *ddx, const double *ddr, const double *a,
@@ -337,7 +338,7 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
                      const ptrdiff_t *bq, const double *const *brows, ptrdiff_t p, double *work,
                      double *outS, double *outD, const unsigned char *tiny,
                      const double *const *psplit, const double *const *tsplit, ptrdiff_t nsrc,
-                     double *geo)
+                     double *geo, ptrdiff_t nflat, const ptrdiff_t *flat, double *intoS, double *intoD)
 {
     double dx[BLK], dr[BLK], s[BLK], r1[BLK], nx1[BLK], nr1[BLK], J[BLK];
     double S[BLK], Dl[BLK], QS[BLK], QD[BLK];
@@ -401,6 +402,13 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
         default: accumulate(s0, s1, bq[i], brows[i], pair, ws, wd, p, outS, outD);
         }
     }
+    /* with flat != NULL: entry i of the blocks (n_pairs * p = nflat of them) written to intoS, intoD at
+     * flat[i] (numpy's put, without its per-call overhead: the caller checked the indices) */
+    if (flat)
+        for (ptrdiff_t i = 0; i < nflat; i++) {
+            intoS[flat[i]] = outS[i];
+            intoD[flat[i]] = outD[i];
+        }
 }
 
 /* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs,

@@ -201,7 +201,7 @@ def compiled():
     lib.ring_dense_sym.restype = None
     lib.ring_dense_mirror_sym.argtypes = [_N] + [_P] * 6 + [_N, _P, _P]
     lib.ring_dense_mirror_sym.restype = None
-    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P]
+    lib.ring_pair_rules.argtypes = [_N] + [_P] * 13 + [_N, _P, _P, _P, _N, _P, _P, _P, _P, _P, _P, _N, _P, _N, _P, _P, _P]
     lib.ring_pair_rules.restype = None
     lib.ring_panel_points.argtypes = [_N] + [_P] * 9 + [ctypes.c_double] + [_P] * 5 + [_N] + [_P] * 11
     lib.ring_panel_points.restype = None
@@ -398,8 +398,12 @@ def pair_rules_prepare(index, tgt, a, b, pair, blocks, npairs: int):
     return n, npairs, p, need, ptrs, keep
 
 
-def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
-    """:func:`pair_rules_compiled` with the per-rule arguments from :func:`pair_rules_prepare`."""
+def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None, into=None):
+    """:func:`pair_rules_compiled` with the per-rule arguments from :func:`pair_rules_prepare`.
+
+    ``into`` (or None): (S_all, D_all, flat, bound), C-contiguous float64 arrays, the intp flat
+    indices (n_pairs * p of them) and one past their largest (worked out once per rule): the
+    blocks' entries are also written there, as ``S_all.put(flat, S)`` would (in the same call)."""
     lib = compiled()
     n, npairs, p, (nsrc, ntgt), (p_index, p_tgt, p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, _), _ = rule
     x, r, xu, ru, xt, rt = (_c_array(v) for v in (x, r, xu, ru, xt, rt))
@@ -422,9 +426,17 @@ def pair_rules_run(rule, x, r, xu, ru, xt, rt, delta, tiny=None):
             raise ValueError("pair_rules_compiled: split arrays of the wrong lengths")
         psplit, tsplit = (np.array([address(v) for v in vs], dtype=np.uintp) for vs in (ps_, ts_))
     at = address(SD)
+    flat = p_flat = p_into = None
+    if into is not None:
+        S_all, D_all, flat, bound = into
+        if flat.dtype != np.intp or not flat.flags.c_contiguous or flat.size != S.size or bound > S_all.size \
+                or S_all.size != D_all.size or any(v.dtype != np.float64 or not v.flags.c_contiguous for v in (S_all, D_all)):
+            raise ValueError("pair_rules_compiled: into arrays of the wrong type or length")
+        p_flat, p_into = address(flat), (address(S_all), address(D_all))
     lib.ring_pair_rules(n, p_index, ptr(x), ptr(r), ptr(xu), ptr(ru), p_tgt, ptr(xt), ptr(rt), ptr(ddx), ptr(ddr),
                         p_a, p_b, p_pair, nblk, p_starts, p_q, p_addr, p, ptr(work), at, at + S.nbytes,
-                        ptr(mask), ptr(psplit), ptr(tsplit), ngeo, address(work[2 * n:]) if ngeo else None)
+                        ptr(mask), ptr(psplit), ptr(tsplit), ngeo, address(work[2 * n:]) if ngeo else None,
+                        S.size, p_flat, *(p_into or (None, None)))
     return S, D
 
 

@@ -331,12 +331,20 @@ class PairQuadrature:
         node (c >= n, the image of primary node 2n - 1 - c: :meth:`PanelSet.fold_mirror`) column
         2n - 1 - c of matrix 1, the mirror block in folded order.  Kept per rule: the solves of a
         difference in P share it."""
+        return self._entries(order, n)[0]
+
+    def _entries(self, order: int, n: int) -> tuple[np.ndarray, int]:
+        """:meth:`entries` and one past its largest index (0 when empty): the bound a compiled
+        write through them is checked against."""
         key = (order, n)
-        got = self.__dict__.setdefault("_entries", {})
+        got = self.__dict__.setdefault("_entries_memo", {})
         if key not in got:
             c = self.panel[:, None] * order + np.arange(order)[None, :]
             c = np.where(c < n, c, n * n + (2 * n - 1 - c))
-            got[key] = (self.target[:, None] * n + c).ravel()
+            flat = np.ascontiguousarray((self.target[:, None] * n + c).ravel(), dtype=np.intp)
+            if flat.size and flat.min() < 0:
+                raise ValueError("PairQuadrature.entries: a negative index (a panel or target out of range)")
+            got[key] = flat, int(flat.max()) + 1 if flat.size else 0
         return got[key]
 
 
@@ -486,8 +494,13 @@ class PairQuadrature:
                                             self._row_blocks, len(self.target))
         return got[split]
 
-    def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False):
+    def integrate(self, ps: PanelSet, xt, rt, kernels, node_targets: bool = False, into=None):
         """Blocks (n_pairs, p) of each kernel integrated against the Lagrange basis.
+
+        ``into`` (or None): (S_all, D_all, flat, bound) for the two kernels of ``_layers`` or
+        ``_layers_split``: the blocks' entries are also written into those arrays at the flat
+        indices (:meth:`entries`, all below ``bound``), ``S_all.put(flat, S)`` (in the compiled
+        call when it runs).
 
         ``kernels(X, R, x, r, nx, nr)`` returns a tuple of kernel arrays, or of (K, Q)
         pairs when the rule carries logarithms (b != 0).  The single and double layer
@@ -532,7 +545,7 @@ class PairQuadrature:
         if fast:
             # the differences of the points on tiny panels through the anchors, as below
             through = (on_tiny, parts, ps.node_split) if tiny else None
-            return list(pair_rules_run(self._compiled_rule(split), x, r, xu, ru, xt, rt, delta, through))
+            return list(pair_rules_run(self._compiled_rule(split), x, r, xu, ru, xt, rt, delta, through, into))
         out = []
         for ker in kernels(xt[t], rt[t], x, r, nx, nr, delta):
             if isinstance(ker, tuple):
@@ -541,6 +554,9 @@ class PairQuadrature:
             else:
                 wk = self.a * ker * J
             out.append(self._reduce(wk))
+        if into is not None:
+            for dest, block in zip(into[:2], out):
+                dest.put(into[2], block)
         return out
 
 
@@ -861,10 +877,7 @@ def assemble(ps: PanelSet, plan: AssemblyPlan | None = None, cache: AssemblyCach
         S[block], D[block] = cache.S[block], cache.D[block]
     for rule, kernels in ((plan.self_rule, _layers_split), (plan.near_rule, _layers)):
         if rule.target.size:
-            Sb, Db = rule.integrate(ps, xt, rt, kernels, node_targets=True)
-            flat = rule.entries(p, N)
-            SS.put(flat, Sb)
-            DD.put(flat, Db)
+            rule.integrate(ps, xt, rt, kernels, node_targets=True, into=(SS, DD, *rule._entries(p, N)))
     if cache is not None:
         cache.store(ps, S, D, copy=not mirrored)  # with a mirror, the primary block is not written again
     if mirrored:  # the folding (PanelSet.fold_mirror) in place: mirror block + primary block
