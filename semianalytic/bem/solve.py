@@ -73,6 +73,7 @@ def _threadpools():
 
 _BLAS_LIMIT = threading.local()
 _ALL = np.logical_and.reduce  # np.all without its Python wrappers (booleans in, a boolean out)
+_SUM = np.add.reduce  # np.sum without its Python wrappers (the same reduction: np.sum calls it)
 
 
 @contextlib.contextmanager
@@ -993,6 +994,17 @@ class SurfaceSolution:
         return self.phi_nodes.size
 
     @cached_property
+    def flat(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """x, r, nx, weight and phi of :attr:`nodes` (flat arrays), without the surface velocity:
+        what the A of a solve and a difference in P read (this project's own shortcut: the two
+        solves of a depth need no dphi/ds)."""
+        ps = self.panels
+        n = ps.n_primary
+        g = ps.nodes
+        return (g.x[:n].ravel() + ps.offset, g.r[:n].ravel(), g.tr[:n].ravel(), (2 * math.pi * g.r[:n] * g.w[:n]).ravel(),
+                self.phi_nodes.ravel())
+
+    @cached_property
     def nodes(self) -> SurfaceNodes:
         ps = self.panels
         n = ps.n_primary
@@ -1001,28 +1013,21 @@ class SurfaceSolution:
         dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
         if not (_ALL(np.isfinite(dphi_ds), axis=None) and _ALL(np.isfinite(self.phi_nodes), axis=None)):
             raise_non_finite(ps, self.depth, "surface velocity")
-        return SurfaceNodes(
-            x=g.x[:n].ravel() + ps.offset,
-            r=g.r[:n].ravel(),
-            nx=g.tr[:n].ravel(),
-            nr=-g.tx[:n].ravel(),
-            weight=(2 * math.pi * g.r[:n] * g.w[:n]).ravel(),
-            phi=self.phi_nodes.ravel(),
-            dphi_ds=dphi_ds.ravel(),
-            g=self.g_nodes.ravel(),
-        )
+        x, r, nx, weight, phi = self.flat
+        return SurfaceNodes(x=x, r=r, nx=nx, nr=-g.tx[:n].ravel(), weight=weight, phi=phi, dphi_ds=dphi_ds.ravel(),
+                            g=self.g_nodes.ravel())
 
     @property
     def A(self) -> float:
         """A = integral of phi n_x dS over the (primary) surface: Part I, eq. (12) [m^3]."""
-        s = self.nodes
-        return float(np.sum(s.weight * s.phi * s.nx))
+        _, _, nx, weight, phi = self.flat
+        return float(_SUM(weight * phi * nx, axis=None))
 
     @property
     def C(self) -> float:
         """C = integral of n_x dS: Part I, eq. (12) [m^2] (the projected contact area)."""
-        s = self.nodes
-        return float(np.sum(s.weight * s.nx))
+        _, _, nx, weight, _ = self.flat
+        return float(_SUM(weight * nx, axis=None))
 
     @property
     def added_mass_coefficient(self) -> float:
