@@ -587,6 +587,15 @@ def graded_panels(n: int, grade0: int, grade1: int, ratio: float = GRADING_RATIO
     return np.array(rows, dtype=float)
 
 
+@lru_cache(maxsize=256)
+def _graded_rows(n: int, grade0: int, grade1: int) -> np.ndarray:
+    """:func:`graded_panels` at the default ratio, made once per (n, grade0, grade1) and read-only:
+    :func:`halfspace_layout` asks for the same few at every depth of a table."""
+    rows = graded_panels(n, grade0, grade1)
+    rows.setflags(write=False)
+    return rows
+
+
 def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float = 0.0, mirror: bool = False,
               label: str = "body") -> PanelSet:
     """Assemble pieces (and optionally their mirror images) into a :class:`PanelSet`.
@@ -807,7 +816,7 @@ def param_at_x(seg: Segment, x: float) -> float:
         (x0, _), (x1, _) = seg.p0, seg.p1
         return (x - x0) / (x1 - x0)
     if isinstance(seg, Arc):
-        c = np.clip((x - seg.center[0]) / seg.radius, -1.0, 1.0)
+        c = min(max((x - seg.center[0]) / seg.radius, -1.0), 1.0)  # np.clip's numbers, without its wrappers
         return float(np.arccos(c))
     from scipy.optimize import brentq  # here, not at start-up (scipy.optimize: ~0.5 s to import)
 
@@ -999,7 +1008,7 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
             q1 = corner_power(shoulder_turning)
         if n == 1 and g0 and g1:
             n = 2
-        pieces.append(Piece(seg, seg.t0, t1, p0, p1, graded_panels(n, g0, g1), (q0, q1)))
+        pieces.append(Piece(seg, seg.t0, t1, p0, p1, _graded_rows(n, g0, g1), (q0, q1)))
         if cut_here:
             break
     shank = depth > Lh
