@@ -1023,7 +1023,8 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     where phi varies ever more slowly."""
     R, Lh = nose.radius, nose.length
     length = depth - Lh
-    grade = options.corner_grading(_shoulder_turning(nose)) if _shoulder_is_corner(nose) else options.junction_levels
+    frame = _layout_frame(nose)  # the shoulder's turning and corner, worked out once per nose
+    grade = options.corner_grading(frame.shoulder_turning) if frame.shoulder_corner else options.junction_levels
     growth = min(3.0, 2.0 ** (1.0 / options.refinement))  # 2 at refinement 1
     h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
     edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]
@@ -1037,9 +1038,14 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     else:
         edges.append(length)
     tau = np.array(edges) / length
-    rows = [(0, a, b) if a + b <= 1.0 else (1, a - 1.0, b - 1.0) for a, b in zip(tau[:-1], tau[1:])]
-    powers = (corner_power(_shoulder_turning(nose)), 1.0)
-    return Piece(Line((-Lh, R), (-depth, R)), 0.0, 1.0, (-Lh, R), (-depth, R), np.array(rows, dtype=float), powers)
+    # rows (0, a, b), or (1, a - 1, b - 1) anchored at the free surface past the middle, for all at once
+    rows = np.empty((len(tau) - 1, 3))
+    rows[:, 1], rows[:, 2] = tau[:-1], tau[1:]
+    far = rows[:, 1] + rows[:, 2] > 1.0
+    rows[:, 0] = far
+    rows[far, 1:] -= 1.0
+    powers = (corner_power(frame.shoulder_turning), 1.0)
+    return Piece(Line((-Lh, R), (-depth, R)), 0.0, 1.0, (-Lh, R), (-depth, R), rows, powers)
 
 
 def _shoulder_turning(nose: Nose) -> float:

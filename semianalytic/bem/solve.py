@@ -74,16 +74,23 @@ def _threadpools():
 _BLAS_LIMIT = threading.local()
 _ALL = np.logical_and.reduce  # np.all without its Python wrappers (booleans in, a boolean out)
 _SUM = np.add.reduce  # np.sum without its Python wrappers (the same reduction: np.sum calls it)
+_MAX = np.maximum.reduce  # ndarray.max without its Python wrappers (the same reduction)
 
 
-@contextlib.contextmanager
+_NESTED = contextlib.nullcontext()  # reusable: no state
+
+
 def _single_threaded_blas():
     """Small dense solves run far faster on one BLAS thread on a loaded 2-core machine
     (numerical notes); the limit is lifted again on exit.  Nested uses inside one thread cost
-    nothing (a table sets it once for its 150 solves: each setting is ~0.1 ms of library calls)."""
-    if getattr(_BLAS_LIMIT, "on", False):
-        yield
-        return
+    nothing (a table sets it once for its 150 solves: each setting is ~0.1 ms of library calls;
+    a nested use is a shared null context, not a new generator)."""
+    return _NESTED if getattr(_BLAS_LIMIT, "on", False) else _blas_limited()
+
+
+@contextlib.contextmanager
+def _blas_limited():
+    """The BLAS limit of :func:`_single_threaded_blas` when none is on in this thread."""
     with _threadpools().limit(limits=1, user_api="blas"):
         _BLAS_LIMIT.on = True
         try:
@@ -786,8 +793,10 @@ class AssemblyCache:
             g = ps.nodes
             n = ps.n_primary
             x, r, w = g.x[:n], g.r[:n], g.w[:n]
-            scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(r).max(initial=0.0)), 1e-300)
-            got = (x, r, w, scale, np.abs(w).max(axis=1, initial=0.0))
+            # np.maximum.reduce: ndarray.max without its Python wrappers (the same reduction)
+            scale = max(float(_MAX(np.abs(x), axis=None, initial=0.0)), float(_MAX(np.abs(r), axis=None, initial=0.0)),
+                        1e-300)
+            got = (x, r, w, scale, _MAX(np.abs(w), axis=1, initial=0.0))
             ps.__dict__["_assembly_signature"] = got
         return got
 
@@ -800,8 +809,8 @@ class AssemblyCache:
         x, r, w, scale, wmax = self._signature(ps)
         ox, or_, ow = self.nodes[:3]
         n = min(len(x), len(ox))
-        close = np.maximum(np.abs(x[:n] - ox[:n]).max(axis=1), np.abs(r[:n] - or_[:n]).max(axis=1)) <= 1e-13 * scale
-        wclose = np.abs(w[:n] - ow[:n]).max(axis=1) <= 1e-13 * wmax[:n]
+        close = np.maximum(_MAX(np.abs(x[:n] - ox[:n]), axis=1), _MAX(np.abs(r[:n] - or_[:n]), axis=1)) <= 1e-13 * scale
+        wclose = _MAX(np.abs(w[:n] - ow[:n]), axis=1) <= 1e-13 * wmax[:n]
         np.logical_and(close, wclose, out=out[:n])
         return out
 
@@ -1133,8 +1142,8 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
-    A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
+    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else np.negative(D, order="C")
+    A.reshape(-1)[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix (a view: A is C-ordered)
     with _single_threaded_blas():
         phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
     if phi is None or not _ALL(np.isfinite(phi), axis=None):
