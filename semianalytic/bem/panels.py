@@ -20,7 +20,7 @@ from __future__ import annotations
 
 import math
 from dataclasses import dataclass
-from functools import cached_property
+from functools import cached_property, lru_cache
 
 import numpy as np
 
@@ -34,6 +34,7 @@ GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type gra
 
 _UINTP = np.dtype(np.uintp)
 _MAX = np.maximum.reduce
+_ANY = np.logical_or.reduce
 _KERNELS = []
 
 
@@ -56,6 +57,18 @@ def _outputs(k: int, shape) -> tuple[tuple, list]:
     at, step = address(block), block.nbytes // k
     rows = tuple(block) if block.ndim > 1 else tuple(block[i, ...] for i in range(k))  # [i, ...]: 0-d arrays
     return rows, list(range(at, at + k * step, step)) if step else [at] * k
+
+
+@lru_cache(maxsize=64)
+def _node_grid(n_panels: int, order: int) -> tuple:
+    """The panel index (intp) and the Gauss coordinate u of every node of ``n_panels`` panels of
+    ``order`` nodes, panel by panel, as flat arrays and their addresses (this project's own
+    shortcut: the node grid of a size is built once, not for each of the three panel sets of a
+    depth).  The arrays stay private to this cache, which keeps them alive."""
+    u, _ = gauss_legendre(order)
+    pk = np.repeat(np.arange(n_panels, dtype=np.intp), order)
+    uu = np.tile(u, n_panels)
+    return pk, uu, address(pk), address(uu)
 
 
 def _curve_row(seg):
@@ -254,6 +267,9 @@ class PanelSet:
         addr = {name: address(a) for name, a in keep.items()} | curves[0]
         if not corner:
             addr["cluster"] = addr["power"] = None
+        # the geometry arguments of ring_panel_points in its order, once (read by every evaluation)
+        addr["points"] = tuple(addr[k] for k in ("base", "da", "db", "half", "sign", "ax", "ar")) + (float(self.offset),) \
+            + tuple(addr[k] for k in ("cluster", "power", "kind", "c0", "c1", "nk", "knots", "cx", "cr"))
         return addr, keep | curves[1]
 
     def _compiled_lib(self, panel):
@@ -288,10 +304,14 @@ class PanelSet:
                c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"], c["nk"],
                c["knots"], c["cx"], c["cr"], None if pw is None else address(pw), *(address(a) for a in out))
             return tuple(out)
-        out, ptr = _outputs(8 if split else 4, u.shape)
-        lib.ring_panel_points(pk.size, address(pk), address(uu), c["base"], c["da"], c["db"], c["half"], c["sign"],
-                              c["ax"], c["ar"], float(self.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
-                              c["nk"], c["knots"], c["cx"], c["cr"], *ptr, *(None,) * (8 - len(ptr)))
+        return self._points_compiled(lib, pk.size, address(pk), address(uu), u.shape, split)
+
+    def _points_compiled(self, lib, n: int, pk_at: int, u_at: int, shape, split: bool):
+        """``ring_panel_points`` at ``n`` points (panel indices and coordinates at the addresses
+        ``pk_at`` and ``u_at``, checked by the caller): x, r, x_u, r_u (and the four arrays of
+        :meth:`split` with ``split``), of ``shape``."""
+        out, ptr = _outputs(8 if split else 4, shape)
+        lib.ring_panel_points(n, pk_at, u_at, *self._compiled_curves[0]["points"], *ptr, *(None,) * (8 - len(ptr)))
         return out
 
     def _numpy_powers(self, pk, u):
@@ -450,8 +470,14 @@ class PanelSet:
     @cached_property
     def nodes(self) -> "NodeGeometry":
         u, w = gauss_legendre(self.order)
-        panel = np.repeat(np.arange(self.n_panels), self.order).reshape(self.n_panels, self.order)
-        x, r, xu, ru, *parts = self.evaluate(panel, np.broadcast_to(u, panel.shape), split=True)
+        shape = (self.n_panels, self.order)
+        lib = self._compiled_curves is not None and shape[0] and _kernels().compiled()
+        if lib:  # the compiled geometry on the node grid of this size, its indices in range by construction
+            _, _, pk_at, u_at = _node_grid(*shape)
+            x, r, xu, ru, *parts = self._points_compiled(lib, shape[0] * shape[1], pk_at, u_at, shape, True)
+        else:
+            panel = np.repeat(np.arange(self.n_panels), self.order).reshape(shape)
+            x, r, xu, ru, *parts = self.evaluate(panel, np.broadcast_to(u, shape), split=True)
         self.__dict__["node_split"] = tuple(a.ravel() for a in parts)  # the same points: node_split for free
         J = np.hypot(xu, ru)
         return NodeGeometry(x=x, r=r, tx=xu / J, tr=ru / J, J=J, w=w * J)
@@ -561,6 +587,15 @@ def graded_panels(n: int, grade0: int, grade1: int, ratio: float = GRADING_RATIO
     return np.array(rows, dtype=float)
 
 
+@lru_cache(maxsize=256)
+def _graded_rows(n: int, grade0: int, grade1: int) -> np.ndarray:
+    """:func:`graded_panels` at the default ratio, made once per (n, grade0, grade1) and read-only:
+    :func:`halfspace_layout` asks for the same few at every depth of a table."""
+    rows = graded_panels(n, grade0, grade1)
+    rows.setflags(write=False)
+    return rows
+
+
 def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float = 0.0, mirror: bool = False,
               label: str = "body") -> PanelSet:
     """Assemble pieces (and optionally their mirror images) into a :class:`PanelSet`.
@@ -570,54 +605,63 @@ def panel_set(pieces: list[Piece] | tuple[Piece, ...], order: int, offset: float
     segs = [piece.segment for piece in pieces]
     rows = [np.asarray(piece.panels, dtype=float).reshape(-1, 3) for piece in pieces]
     counts = [len(r) for r in rows]
-    if sum(counts) == 0:
+    n = sum(counts)
+    block = np.empty((5, 2 * n if mirror else n))  # base, anchor x, anchor r, da, db (see _anchored)
+    if n == 0:
         idx, power, cluster = np.array([]), np.empty(0), np.empty(0)
-        arrays = [np.empty(0) for _ in range(5)]
     else:
-        rows = np.concatenate(rows)
-        anchor, a, b = rows[:, 0], rows[:, 1], rows[:, 2]
-        # per piece: t0, t1, p0, p1, span and the end powers, repeated over its panels
-        t0, t1, x0, r0, x1, r1, span, q0, q1 = np.repeat(np.array(
-            [[float(pc.t0), float(pc.t1), float(pc.p0[0]), float(pc.p0[1]), float(pc.p1[0]), float(pc.p1[1]),
-              float(pc.t1 - pc.t0), float(pc.powers[0]), float(pc.powers[1])] for pc in pieces]).T, counts, axis=1)
+        rows = np.concatenate(rows) if len(rows) > 1 else rows[0]
+        # per piece: t0, x0, r0, t1, x1, r1, span and the end powers, repeated over its panels
+        per = np.array([[float(pc.t0), float(pc.p0[0]), float(pc.p0[1]), float(pc.t1), float(pc.p1[0]),
+                         float(pc.p1[1]), float(pc.t1 - pc.t0), float(pc.powers[0]), float(pc.powers[1])]
+                        for pc in pieces]).T
+        per = per.repeat(counts, axis=1) if len(pieces) > 1 else per
         idx = np.repeat(np.arange(len(pieces)), counts)
-        start = anchor == 0
+        start = _anchored(block[:, :n], rows, per[:3], per[3:6], per[6])
+        anchor, a, b = rows.T
+        q0, q1 = per[7], per[8]
         # corner panels: anchored at the end of the piece that has a substitution power
         at0 = start & (a == 0.0) & (q0 > 1.0)
         at1 = ~at0 & (anchor == 1) & (b == 0.0) & (q1 > 1.0)
         power = np.where(at0, q0, np.where(at1, q1, 1.0))
         cluster = np.where(at0, -1.0, np.where(at1, 1.0, 0.0))
-        arrays = _anchored(rows, t0, t1, x0, r0, x1, r1, span)
-    n = len(idx)
+    sign = np.ones(len(block[0]))
     if mirror:
         # reversed order, reversed parameter direction
         idx = np.concatenate([idx, idx[::-1]])
-        arrays = [np.concatenate([v, m]) for v, m in zip(arrays, _mirror_rows(arrays))]
-        sign = np.concatenate([np.ones(n), -np.ones(n)])
+        _mirror_rows(block, 0, n)
+        sign[n:] = -1.0
         power = np.concatenate([power, power[::-1]])
         cluster = np.concatenate([cluster, -cluster[::-1]])  # the parameter runs backwards
-    else:
-        sign = np.ones(n)
-    base, ax, ar, da, db = arrays
     power_arr, cluster_arr = power, cluster
-    if not np.any(cluster_arr):
+    if not _ANY(cluster_arr != 0.0, axis=None):
         power_arr = cluster_arr = None
-    return PanelSet(tuple(segs), idx, base, ax, ar, da, db, sign, offset, order, n, power_arr, cluster_arr, label)
+    ps = PanelSet(tuple(segs), idx, *block, sign, offset, order, n, power_arr, cluster_arr, label)
+    ps.__dict__["_block"] = block
+    return ps
 
 
-def _anchored(rows, t0, t1, x0, r0, x1, r1, span) -> list:
+def _anchored(out, rows, at0, at1, span) -> np.ndarray:
     """base, anchor x, anchor r, da, db of panels (rows: anchor end 0 or 1, a, b of the piece's
-    span) of pieces running from (t0, x0, r0) to (t1, x1, r1) over ``span`` (per panel): one home
-    for :func:`panel_set` and :func:`restretched`."""
-    start, a, b = rows[:, 0] == 0, rows[:, 1], rows[:, 2]
-    return [np.where(start, t0, t1), np.where(start, x0, x1), np.where(start, r0, r1), a * span, b * span]
+    span) of pieces running from ``at0`` = (t0, x0, r0) to ``at1`` = (t1, x1, r1) over ``span``
+    (per panel, or one piece's numbers), written into the rows of ``out`` (5, n); returns the
+    mask of panels anchored at t0.  One home for :func:`panel_set` and :func:`restretched`."""
+    start = rows[:, 0] == 0
+    out[:3] = np.where(start, at0, at1)
+    np.multiply(rows[:, 1:].T, span, out=out[3:])
+    return start
 
 
-def _mirror_rows(arrays) -> tuple:
-    """The mirror images' base, anchor x, anchor r, da, db of panels' arrays (reversed order, the parameter
-    running backwards: da and db swapped)."""
-    base, ax, ar, da, db = arrays
-    return base[::-1], ax[::-1], ar[::-1], db[::-1], da[::-1]
+def _mirror_rows(block, k: int, m: int) -> None:
+    """The mirror images of panels k .. k + m - 1 of ``block`` (5, 2n: base, anchor x, anchor r,
+    da, db) written into their places among the mirror panels n + (n - k - m) .. 2n - 1 - k
+    (reversed order, the parameter running backwards: da and db swapped)."""
+    n = block.shape[1] // 2
+    lo, hi = 2 * n - k - m, 2 * n - k
+    src = slice(k + m - 1, k - 1 if k else None, -1)
+    block[:3, lo:hi] = block[:3, src]
+    block[3, lo:hi] = block[4, src]
+    block[4, lo:hi] = block[3, src]
 
 
 def restretched(like: PanelSet, pieces, offset: float) -> PanelSet:
@@ -632,17 +676,16 @@ def restretched(like: PanelSet, pieces, offset: float) -> PanelSet:
     mirrored = like.n_panels > n
     if len(like.segments) != len(pieces) or like.n_panels != (2 * n if mirrored else n) or m > n:
         raise ValueError("restretched: pieces of another topology than the panel set's")
-    new = _anchored(rows, float(last.t0), float(last.t1), float(last.p0[0]), float(last.p0[1]), float(last.p1[0]),
-                    float(last.p1[1]), float(last.t1 - last.t0))
-    arrays = [a.copy() for a in (like.base, like.anchor_x, like.anchor_r, like.da, like.db)]
-    for a, v in zip(arrays, new):
-        a[n - m:n] = v
+    old = like.__dict__.get("_block")
+    block = old.copy() if old is not None else np.array([like.base, like.anchor_x, like.anchor_r, like.da, like.db])
+    _anchored(block[:, n - m:n], rows, np.array([float(last.t0), float(last.p0[0]), float(last.p0[1])])[:, None],
+              np.array([float(last.t1), float(last.p1[0]), float(last.p1[1])])[:, None], float(last.t1 - last.t0))
     if mirrored:  # the mirror panels of the last piece (the first m mirror panels)
-        for a, v in zip(arrays, _mirror_rows(new)):
-            a[n:n + m] = v
-    ps = PanelSet(like.segments[:-1] + (last.segment,), like.segment_index, *arrays, like.sign, offset, like.order,
+        _mirror_rows(block, n - m, m)
+    ps = PanelSet(like.segments[:-1] + (last.segment,), like.segment_index, *block, like.sign, offset, like.order,
                   n, like.power, like.cluster, like.label)
     ps.__dict__["_like"] = like  # for the curve part of the compiled geometry (PanelSet._compiled_segments)
+    ps.__dict__["_block"] = block
     return ps
 
 
@@ -773,7 +816,7 @@ def param_at_x(seg: Segment, x: float) -> float:
         (x0, _), (x1, _) = seg.p0, seg.p1
         return (x - x0) / (x1 - x0)
     if isinstance(seg, Arc):
-        c = np.clip((x - seg.center[0]) / seg.radius, -1.0, 1.0)
+        c = min(max((x - seg.center[0]) / seg.radius, -1.0), 1.0)  # np.clip's numbers, without its wrappers
         return float(np.arccos(c))
     from scipy.optimize import brentq  # here, not at start-up (scipy.optimize: ~0.5 s to import)
 
@@ -965,7 +1008,7 @@ def halfspace_layout(nose: Nose, depth: float, options: LayoutOptions = LayoutOp
             q1 = corner_power(shoulder_turning)
         if n == 1 and g0 and g1:
             n = 2
-        pieces.append(Piece(seg, seg.t0, t1, p0, p1, graded_panels(n, g0, g1), (q0, q1)))
+        pieces.append(Piece(seg, seg.t0, t1, p0, p1, _graded_rows(n, g0, g1), (q0, q1)))
         if cut_here:
             break
     shank = depth > Lh
@@ -980,7 +1023,8 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     where phi varies ever more slowly."""
     R, Lh = nose.radius, nose.length
     length = depth - Lh
-    grade = options.corner_grading(_shoulder_turning(nose)) if _shoulder_is_corner(nose) else options.junction_levels
+    frame = _layout_frame(nose)  # the shoulder's turning and corner, worked out once per nose
+    grade = options.corner_grading(frame.shoulder_turning) if frame.shoulder_corner else options.junction_levels
     growth = min(3.0, 2.0 ** (1.0 / options.refinement))  # 2 at refinement 1
     h = min(0.8 * R / max(options.refinement, 1e-9), 0.5 * length)
     edges = [0.0] + [h * GRADING_RATIO**k for k in range(grade, 0, -1)]
@@ -994,9 +1038,14 @@ def _shank_piece(nose: Nose, depth: float, options: LayoutOptions) -> Piece:
     else:
         edges.append(length)
     tau = np.array(edges) / length
-    rows = [(0, a, b) if a + b <= 1.0 else (1, a - 1.0, b - 1.0) for a, b in zip(tau[:-1], tau[1:])]
-    powers = (corner_power(_shoulder_turning(nose)), 1.0)
-    return Piece(Line((-Lh, R), (-depth, R)), 0.0, 1.0, (-Lh, R), (-depth, R), np.array(rows, dtype=float), powers)
+    # rows (0, a, b), or (1, a - 1, b - 1) anchored at the free surface past the middle, for all at once
+    rows = np.empty((len(tau) - 1, 3))
+    rows[:, 1], rows[:, 2] = tau[:-1], tau[1:]
+    far = rows[:, 1] + rows[:, 2] > 1.0
+    rows[:, 0] = far
+    rows[far, 1:] -= 1.0
+    powers = (corner_power(frame.shoulder_turning), 1.0)
+    return Piece(Line((-Lh, R), (-depth, R)), 0.0, 1.0, (-Lh, R), (-depth, R), rows, powers)
 
 
 def _shoulder_turning(nose: Nose) -> float:

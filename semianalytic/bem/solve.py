@@ -73,16 +73,24 @@ def _threadpools():
 
 _BLAS_LIMIT = threading.local()
 _ALL = np.logical_and.reduce  # np.all without its Python wrappers (booleans in, a boolean out)
+_SUM = np.add.reduce  # np.sum without its Python wrappers (the same reduction: np.sum calls it)
+_MAX = np.maximum.reduce  # ndarray.max without its Python wrappers (the same reduction)
 
 
-@contextlib.contextmanager
+_NESTED = contextlib.nullcontext()  # reusable: no state
+
+
 def _single_threaded_blas():
     """Small dense solves run far faster on one BLAS thread on a loaded 2-core machine
     (numerical notes); the limit is lifted again on exit.  Nested uses inside one thread cost
-    nothing (a table sets it once for its 150 solves: each setting is ~0.1 ms of library calls)."""
-    if getattr(_BLAS_LIMIT, "on", False):
-        yield
-        return
+    nothing (a table sets it once for its 150 solves: each setting is ~0.1 ms of library calls;
+    a nested use is a shared null context, not a new generator)."""
+    return _NESTED if getattr(_BLAS_LIMIT, "on", False) else _blas_limited()
+
+
+@contextlib.contextmanager
+def _blas_limited():
+    """The BLAS limit of :func:`_single_threaded_blas` when none is on in this thread."""
     with _threadpools().limit(limits=1, user_api="blas"):
         _BLAS_LIMIT.on = True
         try:
@@ -801,8 +809,10 @@ class AssemblyCache:
             g = ps.nodes
             n = ps.n_primary
             x, r, w = g.x[:n], g.r[:n], g.w[:n]
-            scale = max(float(np.abs(x).max(initial=0.0)), float(np.abs(r).max(initial=0.0)), 1e-300)
-            got = (x, r, w, scale, np.abs(w).max(axis=1, initial=0.0))
+            # np.maximum.reduce: ndarray.max without its Python wrappers (the same reduction)
+            scale = max(float(_MAX(np.abs(x), axis=None, initial=0.0)), float(_MAX(np.abs(r), axis=None, initial=0.0)),
+                        1e-300)
+            got = (x, r, w, scale, _MAX(np.abs(w), axis=1, initial=0.0))
             ps.__dict__["_assembly_signature"] = got
         return got
 
@@ -815,8 +825,8 @@ class AssemblyCache:
         x, r, w, scale, wmax = self._signature(ps)
         ox, or_, ow = self.nodes[:3]
         n = min(len(x), len(ox))
-        close = np.maximum(np.abs(x[:n] - ox[:n]).max(axis=1), np.abs(r[:n] - or_[:n]).max(axis=1)) <= 1e-13 * scale
-        wclose = np.abs(w[:n] - ow[:n]).max(axis=1) <= 1e-13 * wmax[:n]
+        close = np.maximum(_MAX(np.abs(x[:n] - ox[:n]), axis=1), _MAX(np.abs(r[:n] - or_[:n]), axis=1)) <= 1e-13 * scale
+        wclose = _MAX(np.abs(w[:n] - ow[:n]), axis=1) <= 1e-13 * wmax[:n]
         np.logical_and(close, wclose, out=out[:n])
         return out
 
@@ -1006,6 +1016,17 @@ class SurfaceSolution:
         return self.phi_nodes.size
 
     @cached_property
+    def flat(self) -> tuple[np.ndarray, np.ndarray, np.ndarray, np.ndarray, np.ndarray]:
+        """x, r, nx, weight and phi of :attr:`nodes` (flat arrays), without the surface velocity:
+        what the A of a solve and a difference in P read (this project's own shortcut: the two
+        solves of a depth need no dphi/ds)."""
+        ps = self.panels
+        n = ps.n_primary
+        g = ps.nodes
+        return (g.x[:n].ravel() + ps.offset, g.r[:n].ravel(), g.tr[:n].ravel(), (2 * math.pi * g.r[:n] * g.w[:n]).ravel(),
+                self.phi_nodes.ravel())
+
+    @cached_property
     def nodes(self) -> SurfaceNodes:
         ps = self.panels
         n = ps.n_primary
@@ -1014,28 +1035,21 @@ class SurfaceSolution:
         dphi_ds = (self.phi_nodes @ differentiation_matrix(ps.order).T) / J
         if not (_ALL(np.isfinite(dphi_ds), axis=None) and _ALL(np.isfinite(self.phi_nodes), axis=None)):
             raise_non_finite(ps, self.depth, "surface velocity")
-        return SurfaceNodes(
-            x=g.x[:n].ravel() + ps.offset,
-            r=g.r[:n].ravel(),
-            nx=g.tr[:n].ravel(),
-            nr=-g.tx[:n].ravel(),
-            weight=(2 * math.pi * g.r[:n] * g.w[:n]).ravel(),
-            phi=self.phi_nodes.ravel(),
-            dphi_ds=dphi_ds.ravel(),
-            g=self.g_nodes.ravel(),
-        )
+        x, r, nx, weight, phi = self.flat
+        return SurfaceNodes(x=x, r=r, nx=nx, nr=-g.tx[:n].ravel(), weight=weight, phi=phi, dphi_ds=dphi_ds.ravel(),
+                            g=self.g_nodes.ravel())
 
     @property
     def A(self) -> float:
         """A = integral of phi n_x dS over the (primary) surface: Part I, eq. (12) [m^3]."""
-        s = self.nodes
-        return float(np.sum(s.weight * s.phi * s.nx))
+        _, _, nx, weight, phi = self.flat
+        return float(_SUM(weight * phi * nx, axis=None))
 
     @property
     def C(self) -> float:
         """C = integral of n_x dS: Part I, eq. (12) [m^2] (the projected contact area)."""
-        s = self.nodes
-        return float(np.sum(s.weight * s.nx))
+        _, _, nx, weight, _ = self.flat
+        return float(_SUM(weight * nx, axis=None))
 
     @property
     def added_mass_coefficient(self) -> float:
@@ -1141,8 +1155,8 @@ def solve_assembled(ps: PanelSet, S: np.ndarray, D: np.ndarray, neumann=None, de
     else:
         x = geo.x[:n].ravel() + ps.offset
         g = np.asarray(neumann(x, geo.r[:n].ravel(), geo.tr[:n].ravel(), -geo.tx[:n].ravel()), dtype=float)
-    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else -D
-    A.flat[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix
+    A = np.negative(D, out=D) if overwrite and D.flags.c_contiguous else np.negative(D, order="C")
+    A.reshape(-1)[:: A.shape[0] + 1] += 0.5  # I/2 - D, without an identity matrix (a view: A is C-ordered)
     with _single_threaded_blas():
         phi = _dense_solve(A, S @ -g)  # -S g, the same numbers (negation is exact) without -S
     if phi is None or not _ALL(np.isfinite(phi), axis=None):

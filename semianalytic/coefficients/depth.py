@@ -23,7 +23,7 @@ from dataclasses import dataclass
 import numpy as np
 
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
-from semianalytic.bem.solve import AssemblyCache, SurfaceSolution, plan_assembly, solve_panels
+from semianalytic.bem.solve import _SUM, AssemblyCache, SurfaceSolution, plan_assembly, solve_panels
 from semianalytic.geometry import Nose
 
 # central stencils (step h): order -> offsets, weights of the first derivative, and weights
@@ -117,11 +117,11 @@ def _combine(center: SurfaceSolution, sols, weights, h) -> DepthCoefficients:
     """Part I, eqs. (9), (12): B = int (+-|grad phi|^2 + 2 phi'_P) n_x dS in the three readings,
     with phi'_P following the body (chain rule for nodes that slide along it) or a target point."""
     s = center.nodes
-    phi_nodes = [c.nodes for c in sols]
-    dphi_node = sum(w * n.phi for w, n in zip(weights, phi_nodes)) / h
+    flat = [c.flat for c in sols]  # x, r, nx, weight, phi: no surface velocity at the stencil's depths
+    dphi_node = sum(w * f[4] for w, f in zip(weights, flat)) / h
     # body-frame node positions x_b = x - P; velocity of each node relative to the body
-    vx = sum(w * (n.x - c.depth) for w, n, c in zip(weights, phi_nodes, sols)) / h
-    vr = sum(w * n.r for w, n in zip(weights, phi_nodes)) / h
+    vx = sum(w * (f[0] - c.depth) for w, f, c in zip(weights, flat, sols)) / h
+    vr = sum(w * f[1] for w, f in zip(weights, flat)) / h
     tx, tr = -s.nr, s.nx
     dphi_body = dphi_node - s.dphi_ds * (tx * vx + tr * vr)
     dphi_lit = dphi_body - s.dphi_dx
@@ -133,9 +133,9 @@ def _combine(center: SurfaceSolution, sols, weights, h) -> DepthCoefficients:
         depth=center.depth,
         A=center.A,
         C=center.C,
-        B_body=float(np.sum(wn * (grad2 + 2 * dphi_body))),
-        B_literal=float(np.sum(wn * (grad2 + 2 * dphi_lit))),
-        B_bernoulli=float(np.sum(wn * (-grad2 + 2 * dphi_lit))),
+        B_body=float(_SUM(wn * (grad2 + 2 * dphi_body), axis=None)),
+        B_literal=float(_SUM(wn * (grad2 + 2 * dphi_lit), axis=None)),
+        B_bernoulli=float(_SUM(wn * (-grad2 + 2 * dphi_lit), axis=None)),
         dA_dP=float(np.dot(weights, A_all) / h),
         phi_tip=center.phi_tip,
         dphi_tip_dP=float(np.dot(weights, tip) / h),

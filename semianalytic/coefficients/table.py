@@ -39,6 +39,7 @@ hundredth of the distance to b; across the gap the table is linear.
 from __future__ import annotations
 
 import bisect
+import functools
 import io
 import json
 import math
@@ -180,6 +181,12 @@ class Piece:
             return np.where(np.isinf(P), 0.0, self.scale / P)
 
     def P(self, v):
+        if isinstance(v, float) and self.kind != "graded":
+            # one knot (a Python or numpy float): the same double operations without numpy's 0-d arrays
+            # (not the graded power: numpy's and the C library's pow may differ by an ulp)
+            if self.kind == "deep":
+                return math.inf if v == 0 else self.scale / v
+            return self.scale * v * v if self.kind == "root" else self.scale * v
         v = np.asarray(v, float)
         if self.kind == "root":
             return self.scale * v * v
@@ -348,22 +355,31 @@ def _quintic_bernstein(x: np.ndarray, Y: np.ndarray) -> np.ndarray:
     second derivatives ``Y`` (n, 3) at the knots ``x``: scipy's ``BPoly.from_derivatives`` (its
     ``_construct_from_derivatives``), the same operations in the same order, on all the intervals at
     once instead of one Python call per interval (the same numbers; this project's own speed-up)."""
-    from scipy.special import comb, poch
-
+    comb, poch = _bernstein_numbers()
     ya, yb = Y[:-1], Y[1:]
     # (xb - xa)**q as scipy takes it: a float64 scalar power per interval (numpy's array power may round
     # differently from the C library's pow)
     dxq = [np.array([d**q for d in x[1:] - x[:-1]]) for q in range(3)]
     c = np.empty((6, len(x) - 1))
     for q in range(3):  # from the left end
-        c[q] = ya[:, q] / poch(6 - q, q) * dxq[q]
+        c[q] = ya[:, q] / poch[q] * dxq[q]
         for j in range(q):
-            c[q] -= (-1) ** (j + q) * comb(q, j) * c[j]
+            c[q] -= (-1) ** (j + q) * comb[q, j] * c[j]
     for q in range(3):  # from the right end
-        c[-q - 1] = yb[:, q] / poch(6 - q, q) * (-1) ** q * dxq[q]
+        c[-q - 1] = yb[:, q] / poch[q] * (-1) ** q * dxq[q]
         for j in range(q):
-            c[-q - 1] -= (-1) ** (j + 1) * comb(q, j + 1) * c[-q + j]
+            c[-q - 1] -= (-1) ** (j + 1) * comb[q, j + 1] * c[-q + j]
     return c
+
+
+@functools.cache
+def _bernstein_numbers() -> tuple[dict, list]:
+    """scipy's comb(q, j) (q, j <= 2) and poch(6 - q, q) (q <= 2) that :func:`_quintic_bernstein` reads,
+    worked out once by scipy itself (the same numpy floats; a scalar call of scipy.special costs
+    several microseconds, and a table made about 450 of them)."""
+    from scipy.special import comb, poch
+
+    return {(q, j): comb(q, j) for q in range(3) for j in range(3)}, [poch(6 - q, q) for q in range(3)]
 
 
 def _degree(n: int) -> int:
@@ -380,7 +396,9 @@ def _splines(v: np.ndarray, Y: np.ndarray) -> list:
     if n == 1:
         return [None] * Y.shape[1]
     both = make_interp_spline(v, Y, k=_degree(n))
-    return [BSpline(both.t, np.ascontiguousarray(both.c[:, j]), both.k) for j in range(Y.shape[1])]
+    # construct_fast: the knots are both's, checked once by make_interp_spline (BSpline's own checks cost
+    # ~20 us a column; the same spline objects)
+    return [BSpline.construct_fast(both.t, np.ascontiguousarray(both.c[:, j]), both.k) for j in range(Y.shape[1])]
 
 
 def _coef6(f, v0: float, fallback: float) -> list:
@@ -763,6 +781,7 @@ class _Builder:
         self.noise_limited = 0
         self.limit_err: dict = {}
         self.solved: dict = {}  # depth -> (row, nodes, unknowns)
+        self._extrapolated: dict = {}  # (v, y) bytes -> _extrapolate_to_zero(v, y), see update_limit
         from semianalytic.bem.solve import AssemblyCache  # the BEM: imported when a table is built
 
         self.cache = AssemblyCache()  # blocks of the panels that stay in place from depth to depth
@@ -824,7 +843,13 @@ class _Builder:
         row, err = {}, {}
         for name in INTERPOLATED + ("dA_dP", "dphi_tip_dP"):
             y = np.array([r[name] for r in pk.rows[:4]])
-            val, e, slope, curv = _extrapolate_to_zero(v, y)
+            # the same four knots are extrapolated again after most rounds: each fit once (keyed by
+            # the bits of its inputs; this project's own shortcut, the same numbers)
+            key = (v.tobytes(), y.tobytes())
+            got = self._extrapolated.get(key)
+            if got is None:
+                got = self._extrapolated[key] = _extrapolate_to_zero(v, y)
+            val, e, slope, curv = got
             row[name], err[name] = val, e
             if name == "A":
                 row["dA_dv"], row["d2A_dv2"] = slope, curv
