@@ -649,7 +649,7 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     at_end = n_l * n_r == 0  # a side is empty
     key = n_l - n_r  # of an end pair: -n_r (u* = -1: pieces to the right) or n_l (u* = +1)
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
-    # point's u and w gathered from the rules' concatenated points; then the other pairs.
+    # point's u and w those of its distinct point; then the other pairs.
     # keys within +-_KEYS: sorted as int16 (numpy's radix sort; the same stable order)
     if _ALL(at_end):
         ends, inner = np.argsort(key.astype(np.int16), kind="stable"), np.empty(0, np.intp)
@@ -676,15 +676,13 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     g_at = np.cumsum(g_size) - g_size
     n_distinct = int(g_size.sum())
     d_src = np.repeat(first_of[g_key] - g_at, g_size) + np.arange(n_distinct)
-    d_panel, d_u = np.repeat(g_panel, g_size), uw_cat[0][d_src]
-    # per point: its place in the concatenated rules, its distinct point, its pair
-    n_points = int(counts.sum())
-    src, d_index, pair = np.repeat(np.stack([first_of[sk] - pair_at, g_at[group_of] - pair_at, np.arange(ends.size)]),
-                                   counts, axis=1)
-    step = np.arange(n_points)
-    src += step
-    d_index += step
-    u_end, w_end = uw_cat[0][src], uw_cat[1][src]
+    d_panel, d_u, d_w = np.repeat(g_panel, g_size), uw_cat[0].take(d_src), uw_cat[1].take(d_src)
+    # per point: its distinct point (whose u and w are its own) and its pair (ndarray.take: the
+    # same gathers as indexing, at two thirds of its cost)
+    d_index = np.repeat(g_at[group_of] - pair_at, counts)
+    d_index += np.arange(d_index.size)
+    pair = np.repeat(np.arange(ends.size), counts)
+    u_end, w_end = d_u.take(d_index), d_w.take(d_index)
     flat = np.empty((0, order))
     if inner.size:
         pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
