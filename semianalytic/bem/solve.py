@@ -645,8 +645,24 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     # pieces per side, left (1 + u*) and right (1 - u*) in one call; 0: the side is empty
     sides = np.concatenate([1.0 + ustar, 1.0 - ustar])
     n_lr = np.where(sides > 0, _levels(sides, np.concatenate([du, du])) + 1, 0)
+    at_end = n_lr[:npairs] * n_lr[npairs:] == 0  # a side is empty
+    # the rule depends on the pairs, their pieces and the u* of the pairs not at an end only: kept
+    # for the next calls (neighbouring depths often repeat it; this project's own shortcut)
+    inner_u = b"" if _ALL(at_end) else np.ascontiguousarray(ustar[~at_end], dtype=float).tobytes()
+    return _near_rule(order, target.dtype.str, target.tobytes(), panel.dtype.str, panel.tobytes(),
+                      np.ascontiguousarray(n_lr, dtype=np.int64).tobytes(), inner_u)
+
+
+@functools.lru_cache(maxsize=32)
+def _near_rule(order: int, tdt: str, tgt: bytes, pdt: str, pan: bytes, pieces: bytes, inner_u: bytes) -> PairQuadrature:
+    """:func:`near_quadrature` from its inputs as bytes: targets and panels (dtype, data), the
+    numbers of pieces left and right of u* (int64, all left then all right) and u* of the pairs
+    not at an end."""
+    target, panel = np.frombuffer(tgt, dtype=tdt), np.frombuffer(pan, dtype=pdt)
+    n_lr = np.frombuffer(pieces, dtype=np.int64)
+    npairs = target.size
     n_l, n_r = n_lr[:npairs], n_lr[npairs:]
-    at_end = n_l * n_r == 0  # a side is empty
+    at_end = n_l * n_r == 0
     key = n_l - n_r  # of an end pair: -n_r (u* = -1: pieces to the right) or n_l (u* = +1)
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
     # point's u and w those of its distinct point; then the other pairs.
@@ -685,7 +701,7 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     u_end, w_end = d_u.take(d_index), d_w.take(d_index)
     flat = np.empty((0, order))
     if inner.size:
-        pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
+        pair, u, w = _dyadic_sides(np.frombuffer(inner_u, dtype=float), n_l[inner], n_r[inner])
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
         u, w = u[pts], w[pts]
         flat = lagrange_matrix(gauss_legendre(order)[0], u)
