@@ -73,3 +73,21 @@ def test_closer_is_hypot_below_reach():
         a[5:10] = np.nextafter(0.6 * reach, np.inf)
         a[10:15] = np.nextafter(0.6 * reach, -np.inf)
         assert np.array_equal(_closer(a, b, reach[None, :]), np.hypot(a, b) < reach[None, :])
+
+
+def test_closer_both_searches_in_one_pass():
+    """solve._closer as _near_pairs_with calls it: a of (targets, panels) broadcast against b of
+    (2, targets, panels) (the target and its axis image), points on the circle of radius reach
+    among them: the same booleans as hypot for each search alone."""
+    from semianalytic.bem.solve import _closer, _signed_radii
+
+    rng = np.random.default_rng(5)
+    dx = rng.standard_normal((40, 20))
+    rt, cr = np.abs(rng.standard_normal(40)), np.abs(rng.standard_normal(20))
+    reach = np.abs(rng.standard_normal(20))[None, :] * 1.5
+    dx[:5] = 0.6 * reach[0]  # on the circle for targets at r = cr +- 0.8 reach
+    rt[:5] = cr[3] + 0.8 * reach[0, 3]
+    both = _closer(dx, rt[:, None] - _signed_radii(cr), reach, dx * dx)
+    assert both.shape == (2, 40, 20)
+    assert np.array_equal(both[0], np.hypot(dx, rt[:, None] - cr[None, :]) < reach)
+    assert np.array_equal(both[1], np.hypot(dx, rt[:, None] + cr[None, :]) < reach)

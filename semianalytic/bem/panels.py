@@ -164,12 +164,17 @@ class PanelSet:
         :meth:`_param`, :meth:`param_distance` and the numpy powers the compiled second
         derivatives take (:meth:`_numpy_powers`)."""
         so = self._span[pko]
+        c, q, lo, powers = self._corner_powers(pko, uo, second)
+        sw = so * powers[0]
+        dt = np.where(c > 0, self.db[pko] - sw, self.da[pko] + sw)
+        return so, c, q, lo, dt, powers
+
+    def _corner_powers(self, pko, uo, second: bool = False):
+        """c, q, lo and the powers of :meth:`_corner`, without its offset (what
+        :meth:`_numpy_powers` needs)."""
         c, q = self.cluster[pko], self.power[pko]
         lo = 0.5 * (1.0 - c * uo)
-        w = lo**q
-        sw = so * w
-        dt = np.where(c > 0, self.db[pko] - sw, self.da[pko] + sw)
-        return so, c, q, lo, dt, (w, lo ** (q - 1.0), lo ** np.maximum(q - 2.0, 0.0) if second else None)
+        return c, q, lo, (lo**q, lo ** (q - 1.0), lo ** np.maximum(q - 2.0, 0.0) if second else None)
 
     def evaluate(self, panel: np.ndarray, u: np.ndarray, second: bool = False, split: bool = False):
         """Points and derivatives d/du at reference coordinates ``u`` of panels ``panel``.
@@ -325,7 +330,7 @@ class PanelSet:
         if on.size == 0:
             return None
         pw = np.empty((pk.size, 3))
-        pw[on, 0], pw[on, 1], pw[on, 2] = self._corner(pk[on], u[on], second=True)[5]
+        pw[on, 0], pw[on, 1], pw[on, 2] = self._corner_powers(pk[on], u[on], second=True)[3]
         return pw
 
     def _evaluate_segment(self, seg, pk, u, second, split=False):

@@ -114,11 +114,30 @@ def _sample_table(ps: PanelSet):
     (the same numbers; kept on the panel set)."""
     table = ps.__dict__.get("_closest_samples")
     if table is None:
-        samples = _samples(ps.order)
-        pk = np.repeat(np.arange(ps.n_panels), samples.size).reshape(ps.n_panels, samples.size)
-        table = ps.evaluate(pk, np.broadcast_to(samples, pk.shape))
+        table = ps.evaluate(*_sample_grid(ps.n_panels, ps.order))
         ps.__dict__["_closest_samples"] = table
     return table
+
+
+@functools.lru_cache(maxsize=64)
+def _sample_grid(n_panels: int, order: int):
+    """The panel and the u of every sample of :func:`_sample_table`, (n_panels, 2p+1) each
+    (read-only; shared by the panel sets of a topology)."""
+    samples = _samples(order)
+    pk = np.repeat(np.arange(n_panels), samples.size).reshape(n_panels, samples.size)
+    u = np.ascontiguousarray(np.broadcast_to(samples, pk.shape))
+    for a in (pk, u):
+        a.setflags(write=False)
+    return pk, u
+
+
+def _centers(ps: PanelSet) -> tuple[np.ndarray, np.ndarray]:
+    """:attr:`PanelSet.centers` (the points at u = 0) read from :func:`_sample_table`, whose middle
+    sample is u = 0 (the same evaluation, one call fewer per panel set); else ``ps.centers``."""
+    if _samples(ps.order)[ps.order] != 0.0:
+        return ps.centers
+    sx, sr = _sample_table(ps)[:2]
+    return sx[:, ps.order], sr[:, ps.order]
 
 
 def closest_points(ps: PanelSet, pan: np.ndarray, xq: np.ndarray, rq: np.ndarray):
@@ -168,13 +187,14 @@ def _newton(ps: PanelSet, pan, u, xq, rq):
         c = ps._compiled_curves[0]
         u = np.array(u, dtype=float)
         xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
-        out = [np.empty(u.size) for _ in range(4)]  # the point at the last step: ex, er, x_u, r_u
+        out = np.empty((4, u.size))  # the point at the last step: ex, er, x_u, r_u (rows at address + k * row)
+        at, row = address(out), out.strides[0]
         for last in (False, True):
             pw = ps._numpy_powers(pk, u)
             fn(pk.size, address(pk), address(u), address(xq), address(rq), c["base"], c["da"], c["db"], c["half"],
                c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"], c["power"], c["kind"], c["c0"], c["c1"],
                c["nk"], c["knots"], c["cx"], c["cr"], None if pw is None else address(pw),
-               *((address(a) for a in out) if last else (None,) * 4))
+               *((at, at + row, at + 2 * row, at + 3 * row) if last else (None,) * 4))
         return (u, *out)
     for _ in range(2):  # Newton on (y(u) - x) . y'(u) = 0 (from the nearest of 2p+1 samples)
         xn, rn, xun, run, xuu, ruu = ps.evaluate(pan, u, second=True)
@@ -194,17 +214,18 @@ def _closest_compiled(ps: PanelSet, pan, xq, rq):
     if got is None:
         return None
     lib, pk = got
-    fn = lib.ring_closest_points
     c = ps._compiled_curves[0]
     table = [np.ascontiguousarray(a, dtype=float) for a in _sample_table(ps)]  # no copies: evaluate's own arrays
     samples = _samples(ps.order)
     xq, rq = (np.ascontiguousarray(a, dtype=float) for a in (xq, rq))
-    out = [np.empty(pk.size) for _ in range(5)]
+    out = np.empty((5, pk.size))  # u, ex, er, x_u, r_u: the rows of one block, at address + k * row
     todo = np.empty(pk.size, dtype=np.int8)
-    fn(pk.size, address(pk), address(xq), address(rq), samples.size, address(samples), *(address(a) for a in table),
-       c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"],
-       c["power"], c["kind"], c["c0"], c["c1"], c["nk"], c["knots"], c["cx"], c["cr"],
-       *(address(a) for a in out), address(todo))
+    at, row = address(out), out.strides[0]
+    lib.ring_closest_points(
+        pk.size, address(pk), address(xq), address(rq), samples.size, address(samples), *(address(a) for a in table),
+        c["base"], c["da"], c["db"], c["half"], c["sign"], c["ax"], c["ar"], float(ps.offset), c["cluster"],
+        c["power"], c["kind"], c["c0"], c["c1"], c["nk"], c["knots"], c["cx"], c["cr"],
+        at, at + row, at + 2 * row, at + 3 * row, at + 4 * row, address(todo))
     return (*out, np.nonzero(todo)[0])
 
 
@@ -226,21 +247,19 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     """:func:`near_pairs`, and the nearest points of the further queries ``also`` = (panel,
     x, r) if given (fifth and sixth outputs, u and du): all found by one call of
     :func:`closest_points` (the same numbers as separate calls, a third of the calls)."""
-    cx, cr = ps.centers
+    cx, cr = _centers(ps)
     reach = NEAR_FACTOR * ps.lengths[None, :]
     dx = xt[:, None] - cx[None, :]
     with np.errstate(over="ignore"):
         dx2 = dx * dx  # shared by both searches
-    near = _closer(dx, rt[:, None] - cr[None, :], reach, dx2)
-    near_img = _closer(dx, rt[:, None] + cr[None, :], reach, dx2)
+    # the target (r - r_c) and its axis image (r + r_c, as r - (-r_c): the same numbers) against
+    # every panel centre in one (2, targets, panels) array: one pass of _closer for both searches
+    near = _closer(dx, rt[:, None] - _signed_radii(cr), reach, dx2)
     if exclude_panel is not None:
-        rows = np.arange(len(xt))
-        near[rows, exclude_panel] = False
-        near_img[rows, exclude_panel] = False
+        near[:, np.arange(len(xt)), exclude_panel] = False
     if exclude_block is not None:
-        skip = exclude_block[0][:, None] & exclude_block[1][None, :]
-        near &= ~skip
-        near_img &= ~skip
+        near &= ~(exclude_block[0][:, None] & exclude_block[1][None, :])
+    near, near_img = near
     tgt, pan = np.nonzero(near | near_img)
     img = np.nonzero(near_img[tgt, pan])[0]
     n, m = tgt.size, img.size
@@ -261,8 +280,17 @@ def _near_pairs_with(ps: PanelSet, xt, rt, exclude_panel=None, exclude_block=Non
     return tgt, pan, u, du, uq[n + m:], duq[n + m:]
 
 
+def _signed_radii(cr: np.ndarray) -> np.ndarray:
+    """(2, 1, n) of +cr and -cr: r - (+-cr) is the distance in r from a panel centre and from its
+    image in the axis."""
+    out = np.empty((2, 1, cr.size))
+    out[0, 0] = cr
+    np.negative(cr, out=out[1, 0])
+    return out
+
+
 def _closer(a, b, reach, a2=None):
-    """hypot(a, b) < reach elementwise (a, b of one shape, reach broadcasting to it), numpy's
+    """hypot(a, b) < reach elementwise (a and reach broadcasting to the shape of b), numpy's
     hypot deciding only where a^2 + b^2 lies within 1e-12 of reach^2 (this project's own
     shortcut, the same booleans at a quarter of the cost: a^2 + b^2 and hypot^2 differ by a
     few ulps, 1e-15; squares near under- or overflow take hypot everywhere).  ``a2``: a * a if
@@ -275,7 +303,7 @@ def _closer(a, b, reach, a2=None):
     out = s < r2 * (1.0 - 1e-12)
     edge = np.nonzero(~out & (s <= r2 * (1.0 + 1e-12)))
     if edge[0].size:
-        out[edge] = np.hypot(a[edge], b[edge]) < np.broadcast_to(reach, s.shape)[edge]
+        out[edge] = np.hypot(np.broadcast_to(a, s.shape)[edge], b[edge]) < np.broadcast_to(reach, s.shape)[edge]
     return out
 
 
@@ -604,15 +632,23 @@ def _end_rule(order: int, end: float, n: int):
     return u, w, lag
 
 
+_KEYS = MAX_LEVELS + 1  # the end rules' keys lie within +-_KEYS; key + _KEYS indexes tables of them
+
+
 @functools.lru_cache(maxsize=256)
 def _end_rules(order: int, keys: bytes):
-    """The end rules of ``keys`` (int64, each the signed number of pieces of :func:`_end_rule`):
-    their Lagrange matrices, numbers of points and first points in the concatenation of their
-    points and weights (kept per set of keys: the neighbouring depths of a table share them)."""
+    """The end rules of ``keys`` (int64, ascending, each the signed number of pieces of
+    :func:`_end_rule`): their Lagrange matrices, numbers of points, the u and w of their points
+    concatenated (rows of one (2, points) array), and per key + _KEYS its rule's number of points and
+    first point in that concatenation (kept per set of keys: the neighbouring depths of a table
+    share them)."""
     rules = [_end_rule(order, -1.0 if k < 0 else 1.0, int(abs(k))) for k in np.frombuffer(keys, dtype=np.int64).tolist()]
     size = np.array([r[0].size for r in rules], dtype=np.int64)
-    cat = [np.concatenate([r[j] for r in rules]) if rules else np.empty(0) for j in (0, 1)]
-    return tuple(r[2] for r in rules), size, np.cumsum(size) - size, cat[0], cat[1]
+    uw = np.array([np.concatenate([r[j] for r in rules]) if rules else np.empty(0) for j in (0, 1)])
+    at = np.frombuffer(keys, dtype=np.int64) + _KEYS
+    size_of, first_of = np.zeros(2 * _KEYS + 1, np.int64), np.zeros(2 * _KEYS + 1, np.int64)
+    size_of[at], first_of[at] = size, np.cumsum(size) - size
+    return tuple(r[2] for r in rules), size, uw, size_of, first_of
 
 
 def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
@@ -633,53 +669,78 @@ def near_quadrature(target, panel, ustar, du, order) -> PairQuadrature:
     # pieces per side, left (1 + u*) and right (1 - u*) in one call; 0: the side is empty
     sides = np.concatenate([1.0 + ustar, 1.0 - ustar])
     n_lr = np.where(sides > 0, _levels(sides, np.concatenate([du, du])) + 1, 0)
+    at_end = n_lr[:npairs] * n_lr[npairs:] == 0  # a side is empty
+    # the rule depends on the pairs, their pieces and the u* of the pairs not at an end only: kept
+    # for the next calls (neighbouring depths often repeat it; this project's own shortcut)
+    inner_u = b"" if _ALL(at_end) else np.ascontiguousarray(ustar[~at_end], dtype=float).tobytes()
+    return _near_rule(order, target.dtype.str, target.tobytes(), panel.dtype.str, panel.tobytes(),
+                      np.ascontiguousarray(n_lr, dtype=np.int64).tobytes(), inner_u)
+
+
+@functools.lru_cache(maxsize=32)
+def _near_rule(order: int, tdt: str, tgt: bytes, pdt: str, pan: bytes, pieces: bytes, inner_u: bytes) -> PairQuadrature:
+    """:func:`near_quadrature` from its inputs as bytes: targets and panels (dtype, data), the
+    numbers of pieces left and right of u* (int64, all left then all right) and u* of the pairs
+    not at an end."""
+    target, panel = np.frombuffer(tgt, dtype=tdt), np.frombuffer(pan, dtype=pdt)
+    n_lr = np.frombuffer(pieces, dtype=np.int64)
+    npairs = target.size
     n_l, n_r = n_lr[:npairs], n_lr[npairs:]
-    at_end = (n_l == 0) | (n_r == 0)
-    key = np.where(n_l == 0, -1, 1) * (n_l + n_r)
+    at_end = n_l * n_r == 0
+    key = n_l - n_r  # of an end pair: -n_r (u* = -1: pieces to the right) or n_l (u* = +1)
     # the end rules' pairs grouped by rule (ascending key, pairs in order within a key), each
-    # point's u and w gathered from the rules' concatenated points; then the other pairs
-    ends = np.nonzero(at_end)[0]
-    # keys within +-2 (MAX_LEVELS + 1): sorted as int16 (numpy's radix sort; the same stable order)
-    ends = ends[np.argsort(key[ends].astype(np.int16), kind="stable")]
-    sk = key[ends]
-    first = np.flatnonzero(np.concatenate([[True], sk[1:] != sk[:-1]])) if sk.size else np.empty(0, np.int64)
-    per_key = np.diff(np.append(first, sk.size))
-    lags, size, rule_first, u_cat, w_cat = _end_rules(order, np.ascontiguousarray(sk[first], dtype=np.int64).tobytes())
-    blocks = tuple(zip(first.tolist(), per_key.tolist(), size.tolist(), lags))
-    counts = np.repeat(size, per_key)  # points of each end pair
+    # point's u and w those of its distinct point; then the other pairs.
+    # keys within +-_KEYS: sorted as int16 (numpy's radix sort; the same stable order)
+    if _ALL(at_end):
+        ends, inner = np.argsort(key.astype(np.int16), kind="stable"), np.empty(0, np.intp)
+    else:
+        ends, inner = np.nonzero(at_end)[0], np.nonzero(~at_end)[0]
+        ends = ends[np.argsort(key[ends].astype(np.int16), kind="stable")]
+    sk = key[ends] + _KEYS
+    tally = np.bincount(sk, minlength=2 * _KEYS + 1)  # pairs per key
+    present = tally.nonzero()[0]
+    per_key = tally[present]
+    lags, size, uw_cat, size_of, first_of = _end_rules(order, (present - _KEYS).tobytes())
+    blocks = tuple(zip((np.cumsum(per_key) - per_key).tolist(), per_key.tolist(), size.tolist(), lags))
+    counts = size_of[sk]  # points of each end pair
     pair_at = np.cumsum(counts) - counts
-    src = np.repeat(np.repeat(rule_first, per_key) - pair_at, counts) + np.arange(int(pair_at[-1] + counts[-1]) if counts.size else 0)
-    u_end, w_end = u_cat[src], w_cat[src]
-    # distinct points: one set per (end rule, panel), in ascending rule * span + panel
+    # distinct points: one set per (end rule, panel), in ascending key, then panel
     span = int(panel.max()) + 1
-    gkey = np.repeat(np.arange(size.size), per_key) * span + panel[ends]
-    present = np.zeros(size.size * span, bool)
+    gkey = sk * span + panel[ends]
+    present = np.zeros((2 * _KEYS + 1) * span, bool)
     present[gkey] = True
     groups = np.flatnonzero(present)
     group_of = (np.cumsum(present) - 1)[gkey]  # each end pair's set
-    g_rule, g_size = groups // span, size[groups // span]
+    g_key, g_panel = np.divmod(groups, span)
+    g_size = size_of[g_key]
     g_at = np.cumsum(g_size) - g_size
-    d_src = np.repeat(rule_first[g_rule] - g_at, g_size) + np.arange(int(g_size.sum()))
-    d_panel, d_u = np.repeat(groups % span, g_size), u_cat[d_src]
-    d_index = np.repeat(g_at[group_of] - pair_at, counts) + np.arange(u_end.size)
+    n_distinct = int(g_size.sum())
+    d_src = np.repeat(first_of[g_key] - g_at, g_size) + np.arange(n_distinct)
+    d_panel, d_u, d_w = np.repeat(g_panel, g_size), uw_cat[0].take(d_src), uw_cat[1].take(d_src)
+    # per point: its distinct point (whose u and w are its own) and its pair (ndarray.take: the
+    # same gathers as indexing, at two thirds of its cost)
+    d_index = np.repeat(g_at[group_of] - pair_at, counts)
+    d_index += np.arange(d_index.size)
+    pair = np.repeat(np.arange(ends.size), counts)
+    u_end, w_end = d_u.take(d_index), d_w.take(d_index)
     flat = np.empty((0, order))
-    inner = np.nonzero(~at_end)[0]
     if inner.size:
-        pair, u, w = _dyadic_sides(ustar[inner], n_l[inner], n_r[inner])
+        pair, u, w = _dyadic_sides(np.frombuffer(inner_u, dtype=float), n_l[inner], n_r[inner])
         pts = np.argsort(pair, kind="stable")  # already sorted; kept explicit
         u, w = u[pts], w[pts]
         flat = lagrange_matrix(gauss_legendre(order)[0], u)
         blocks += ((ends.size, inner.size, 0, None),)
         counts = np.concatenate([counts, np.bincount(pair, minlength=inner.size)])
         # each inner pair's points are a set of their own, after the end rules' sets
-        d_index = np.concatenate([d_index, int(g_size.sum()) + np.arange(u.size)])
+        d_index = np.concatenate([d_index, n_distinct + np.arange(u.size)])
         d_panel = np.concatenate([d_panel, panel[inner][pair[pts]]])
         d_u = np.concatenate([d_u, u])
         u_end, w_end = np.concatenate([u_end, u]), np.concatenate([w_end, w])
-    order_idx = np.concatenate([ends, inner])
-    return PairQuadrature(target[order_idx], panel[order_idx], np.repeat(np.arange(order_idx.size), counts),
-                          np.cumsum(counts) - counts, u_end, w_end, np.zeros(u_end.size), flat, None, blocks,
-                          (d_panel, d_u, d_index))
+        pair_at = np.cumsum(counts) - counts
+        pair = np.repeat(np.arange(counts.size), counts)
+        ends = np.concatenate([ends, inner])
+    return PairQuadrature(target[ends], panel[ends], pair, pair_at, u_end, w_end, np.zeros(u_end.size), flat, None,
+                          blocks, (d_panel, d_u, d_index))
 
 
 def self_quadrature(levels: np.ndarray, order: int) -> PairQuadrature:
@@ -732,6 +793,33 @@ class AssemblyPlan:
     fixed: np.ndarray | None = None
 
 
+@functools.lru_cache(maxsize=64)
+def _primary_nodes(N: int, p: int):
+    """The panel and the Gauss coordinate of each of N primary nodes of order p (read-only; the
+    same at every depth of a topology)."""
+    own = np.arange(N) // p
+    uq = gauss_legendre(p)[0][np.arange(N) % p]
+    for a in (own, uq):
+        a.setflags(write=False)
+    return own, uq
+
+
+@functools.lru_cache(maxsize=64)
+def _corner_levels(cluster: bytes, p: int):
+    """The nodes on corner panels of the primary ``cluster`` (:attr:`PanelSet.cluster` as float64
+    bytes) and the least levels of both sides of their self rules: the substitution is singular
+    at the corner end, at (1 + u_q) from the node, and the innermost pieces stay within half of
+    that.  Depends on the topology only, so kept per cluster (this project's own shortcut)."""
+    c = np.repeat(np.frombuffer(cluster, dtype=float), p)
+    mapped = np.nonzero(c != 0)[0]
+    um = gauss_legendre(p)[0][mapped % p]
+    gap = 0.5 * np.where(c[mapped] < 0, 1.0 + um, 1.0 - um)
+    lev = _levels(np.concatenate([1.0 - um, 1.0 + um]), np.concatenate([gap, gap]))
+    for a in (mapped, lev):
+        a.setflags(write=False)
+    return mapped, lev[:mapped.size], lev[mapped.size:]
+
+
 def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan:
     """Choose the self and near rules for the primary nodes of ``ps``.
 
@@ -745,10 +833,9 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     X, R, _, _, _ = _flat_nodes(ps)
     N = ps.n_primary * p
     xt, rt = X[:N], R[:N]
-    own_panel = np.arange(N) // p
-    uq = gauss_legendre(p)[0][np.arange(N) % p]
+    own_panel, uq = _primary_nodes(N, p)
     levels = np.zeros((N, 2), dtype=int)
-    cx, cr = ps.centers
+    cx, cr = _centers(ps)
     if fixed is not None and not fixed.any():
         fixed = None
     free_node = np.ones(N, bool) if fixed is None else ~fixed[own_panel]
@@ -760,23 +847,14 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     # the near pairs and the self pairs' axis images: one search of the nearest points
     tgt, pan, ustar, du, _, du_img = _near_pairs_with(ps, xt, rt, own_panel, block,
                                                       (own_panel[close], xt[close], -rt[close]))
-    mapped = np.nonzero(ps._clustered[own_panel])[0]  # nodes on corner panels
-    # the levels of both sides of the close nodes and of the mapped ones, in one call
-    m, n = close.size, mapped.size
-    if m or n:
-        c = ps.cluster[own_panel[mapped]] if n else np.empty(0)
-        uc, um = uq[close], uq[mapped]
-        # corner panels: the substitution is singular at the corner end, at (1 + u_q) from
-        # the node; keep the self rule's innermost pieces within half of that
-        gap = 0.5 * np.where(c < 0, 1.0 + um, 1.0 - um)
-        d = du_img / IMAGE_MARGIN
-        lev = _levels(np.concatenate([1.0 - uc, 1.0 + uc, 1.0 - um, 1.0 + um]), np.concatenate([d, d, gap, gap]))
-        if m:
-            levels[close, 0] = lev[:m]
-            levels[close, 1] = lev[m:2 * m]
-        if n:
-            levels[mapped, 0] = np.maximum(levels[mapped, 0], lev[2 * m:2 * m + n])
-            levels[mapped, 1] = np.maximum(levels[mapped, 1], lev[2 * m + n:])
+    if close.size:  # both sides of the close nodes, in one call
+        uc, d = uq[close], du_img / IMAGE_MARGIN
+        levels[close] = _levels(np.concatenate([1.0 - uc, 1.0 + uc]), np.concatenate([d, d])).reshape(2, -1).T
+    if ps.cluster is not None:  # nodes on corner panels
+        mapped, right, left = _corner_levels(np.ascontiguousarray(ps.cluster[:ps.n_primary], dtype=float).tobytes(), p)
+        if mapped.size:
+            levels[mapped, 0] = np.maximum(levels[mapped, 0], right)
+            levels[mapped, 1] = np.maximum(levels[mapped, 1], left)
     self_rule = self_quadrature(levels, p)
     if fixed is not None:
         self_rule = self_rule.subset(free_node[self_rule.target])
