@@ -62,13 +62,16 @@ def _outputs(k: int, shape) -> tuple[tuple, list]:
 @lru_cache(maxsize=64)
 def _node_grid(n_panels: int, order: int) -> tuple:
     """The panel index (intp) and the Gauss coordinate u of every node of ``n_panels`` panels of
-    ``order`` nodes, panel by panel, as flat arrays and their addresses (this project's own
-    shortcut: the node grid of a size is built once, not for each of the three panel sets of a
-    depth).  The arrays stay private to this cache, which keeps them alive."""
+    ``order`` nodes, panel by panel, as flat read-only arrays and their addresses (this project's
+    own shortcut: the node grid of a size is built once, not for each of the three panel sets of a
+    depth, nor for each plan, which reads the primary panels' grid).  The cache keeps them alive."""
     u, _ = gauss_legendre(order)
     pk = np.repeat(np.arange(n_panels, dtype=np.intp), order)
     uu = np.tile(u, n_panels)
-    return pk, uu, address(pk), address(uu)
+    at = address(pk), address(uu)
+    for a in (pk, uu):
+        a.setflags(write=False)
+    return pk, uu, *at
 
 
 def _curve_row(seg):
@@ -476,13 +479,12 @@ class PanelSet:
     def nodes(self) -> "NodeGeometry":
         u, w = gauss_legendre(self.order)
         shape = (self.n_panels, self.order)
+        pk, uu, pk_at, u_at = _node_grid(*shape)
         lib = self._compiled_curves is not None and shape[0] and _kernels().compiled()
-        if lib:  # the compiled geometry on the node grid of this size, its indices in range by construction
-            _, _, pk_at, u_at = _node_grid(*shape)
-            x, r, xu, ru, *parts = self._points_compiled(lib, shape[0] * shape[1], pk_at, u_at, shape, True)
+        if lib:  # the compiled geometry on the node grid, its indices in range by construction
+            x, r, xu, ru, *parts = self._points_compiled(lib, pk.size, pk_at, u_at, shape, True)
         else:
-            panel = np.repeat(np.arange(self.n_panels), self.order).reshape(shape)
-            x, r, xu, ru, *parts = self.evaluate(panel, np.broadcast_to(u, shape), split=True)
+            x, r, xu, ru, *parts = self.evaluate(pk.reshape(shape), uu.reshape(shape), split=True)
         self.__dict__["node_split"] = tuple(a.ravel() for a in parts)  # the same points: node_split for free
         J = np.hypot(xu, ru)
         return NodeGeometry(x=x, r=r, tx=xu / J, tr=ru / J, J=J, w=w * J)

@@ -41,7 +41,7 @@ from semianalytic.bem.kernels import (
     gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_split,
 )
 from semianalytic.bem import kernels as _kernels
-from semianalytic.bem.panels import PanelSet
+from semianalytic.bem.panels import PanelSet, _node_grid
 from semianalytic.native import address
 from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
@@ -796,17 +796,6 @@ class AssemblyPlan:
 
 
 @functools.lru_cache(maxsize=64)
-def _primary_nodes(N: int, p: int):
-    """The panel and the Gauss coordinate of each of N primary nodes of order p (read-only; the
-    same at every depth of a topology)."""
-    own = np.arange(N) // p
-    uq = gauss_legendre(p)[0][np.arange(N) % p]
-    for a in (own, uq):
-        a.setflags(write=False)
-    return own, uq
-
-
-@functools.lru_cache(maxsize=64)
 def _corner_levels(cluster: bytes, p: int):
     """The nodes on corner panels of the primary ``cluster`` (:attr:`PanelSet.cluster` as float64
     bytes) and the least levels of both sides of their self rules: the substitution is singular
@@ -835,7 +824,7 @@ def plan_assembly(ps: PanelSet, fixed: np.ndarray | None = None) -> AssemblyPlan
     X, R, _, _, _ = _flat_nodes(ps)
     N = ps.n_primary * p
     xt, rt = X[:N], R[:N]
-    own_panel, uq = _primary_nodes(N, p)
+    own_panel, uq = _node_grid(ps.n_primary, p)[:2]  # each node's panel and Gauss coordinate
     levels = np.zeros((N, 2), dtype=int)
     cx, cr = _centers(ps)
     if fixed is not None and not fixed.any():

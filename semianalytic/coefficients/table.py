@@ -181,19 +181,19 @@ class Piece:
             return np.where(np.isinf(P), 0.0, self.scale / P)
 
     def P(self, v):
-        if isinstance(v, float) and self.kind != "graded":
-            # one knot (a Python or numpy float): the same double operations without numpy's 0-d arrays
-            # (not the graded power: numpy's and the C library's pow may differ by an ulp)
-            if self.kind == "deep":
-                return math.inf if v == 0 else self.scale / v
-            return self.scale * v * v if self.kind == "root" else self.scale * v
-        v = np.asarray(v, float)
+        # one knot (a Python or numpy float) stays a float: the same double operations without numpy's
+        # 0-d arrays; the graded power always takes numpy's (the C library's pow may differ by an ulp)
+        one = isinstance(v, float)
+        if not one or self.kind == "graded":
+            v = np.asarray(v, float)
         if self.kind == "root":
             return self.scale * v * v
         if self.kind == "mid":
             return self.scale * v
         if self.kind == "graded":
             return self.origin + self.scale * v**self.power
+        if one:
+            return math.inf if v == 0 else self.scale / v
         with np.errstate(divide="ignore"):
             return np.where(v == 0, np.inf, self.scale / np.where(v == 0, 1.0, v))
 
