@@ -282,9 +282,11 @@ def test_compiled_panel_geometry(monkeypatch):
                for k, f in (("ogive", 3.5), ("cone", 2.0), ("cone", 0.2), ("table", 0.4), ("table", 1.5))] + [
                    body_panels(spheroid_body(3.0, 1.0))]
     got = []
-    for ps in layouts:
+    for i, ps in enumerate(layouts):
         assert ps._compiled_curves is not None
         pan = rng.integers(0, ps.n_panels, 3000)
+        if i % 2:  # the points of a panel together, as the rules ask for them (the spline's anchor kept)
+            pan = np.sort(pan)
         u, step = rng.uniform(-1, 1, 3000), rng.uniform(-1e-3, 1e-3, 3000)
         got.append((ps, pan, u, step, ps.evaluate(pan, u, split=True) + ps.relative(pan, u, u + step)))
     monkeypatch.setattr(kernels, "compiled", lambda: None)
@@ -385,3 +387,39 @@ def test_compiled_closest_points(monkeypatch):
         u0, du0 = closest_points(ps, pan, xq, rq)
         assert np.max(np.abs(u - u0)) <= 1e-12
         assert np.max(np.abs(du - du0) / np.maximum(du0, 1e-300)) <= 1e-12
+
+
+@needs_c
+def test_wide_build_gives_the_baseline_numbers(tmp_path, monkeypatch):
+    """_ring.c's kernels built for AVX2 (WIDE: target clones, picked by the processor) give the
+    numbers of the baseline x86-64 build bit for bit: the same IEEE operations, no contraction
+    into fused multiply-adds.  The baseline is compiled here with -DRING_BASELINE (the same
+    flags otherwise) and both assemble the half-space matrices of the ogive (arcs) and the table
+    nose (a spline, a graded corner, tiny panels): the dense blocks, the near and self rules.
+    Exact equality: any difference in operations would show in the last bits of some entry."""
+    import ctypes
+
+    from semianalytic import native
+    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+    from semianalytic.bem.solve import assemble, plan_assembly
+    from semianalytic.coefficients.study import study_nose
+
+    cmd = native._compiler()
+    if cmd is None:
+        pytest.skip("no C compiler")
+    so = tmp_path / "ring-baseline.so"
+    proc = subprocess.run([*cmd, *native.CFLAGS, "-DRING_BASELINE", "-o", str(so), str(kernels._SOURCE), "-lm"],
+                          capture_output=True, text=True, timeout=300)
+    assert proc.returncode == 0, proc.stderr
+    baseline = kernels.configured(ctypes.CDLL(str(so)))
+    cases = [halfspace_layout(study_nose(k), f * study_nose(k).depth_unit, LayoutOptions(8, 0.3, 6)).panels()
+             for k, f in (("ogive", 3.5), ("table", 0.4), ("table", 1.5))]
+    wide = [assemble(ps, plan_assembly(ps)) for ps in cases]
+    x, r, x1, r1, nx1, nr1, delta = _points()
+    wide_points = kernels.single_double_split(x, r, x1, r1, nx1, nr1, delta)
+    monkeypatch.setattr(kernels, "compiled", lambda: baseline)
+    for ps, (S, D) in zip(cases, wide):
+        S0, D0 = assemble(ps, plan_assembly(ps))
+        assert np.array_equal(S, S0) and np.array_equal(D, D0)
+    for a, b in zip(wide_points, kernels.single_double_split(x, r, x1, r1, nx1, nr1, delta)):
+        assert np.array_equal(a, b, equal_nan=True)

@@ -16,6 +16,20 @@
 #include <stddef.h>
 
 #define PI 3.14159265358979323846
+
+/* The kernels' loops without calls (block(), sym_tile()) are vectorised by the compiler.  On x86-64
+ * Linux with GCC, WIDE builds each exported kernel twice, for AVX2 (four doubles a vector) and for the
+ * baseline x86-64 (SSE2, two), and the loader picks the one the processor runs (an ifunc): a library
+ * built on one machine still runs on an older one sharing the home folder.  AVX2 here brings no fused
+ * multiply-add (that is the separate FMA extension, and -ffp-contract=off forbids it anyway): the same
+ * IEEE operations in the same order on wider registers, so the same numbers, bit for bit (compiled with
+ * -DRING_BASELINE, the baseline code only: tests/test_ring_kernel_c.py compares the two builds). */
+#if !defined(RING_BASELINE) && defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) \
+    && __GNUC__ >= 8
+#define WIDE __attribute__((target_clones("avx2", "default")))
+#else
+#define WIDE
+#endif
 #define SPLIT_TERMS 10
 
 /* The polynomials, filled once by the loader from kernels.py (one home for the numbers):
@@ -83,7 +97,7 @@ static inline void ring_layers(double K, double E, double inv, double d2, double
     *Dl = (E * bracket / d2 - 0.5 * nr1 * K) * inv;
 }
 
-static void block(int n, const double *dx, const double *dr, const double *s, const double *r1,
+static inline __attribute__((always_inline)) void block(int n, const double *dx, const double *dr, const double *s, const double *r1,
                   const double *nx1, const double *nr1, const double *w,
                   double *restrict S, double *restrict Dl, double *restrict QS, double *restrict QD)
 {
@@ -125,7 +139,7 @@ static void block(int n, const double *dx, const double *dr, const double *s, co
 
 /* single_double (QS == NULL) or single_double_split on n points (every array contiguous, of
  * length n); ddx, ddr NULL or the `delta` differences. */
-static void points(ptrdiff_t n, const double *x, const double *r, const double *x1, const double *r1,
+static inline __attribute__((always_inline)) void points(ptrdiff_t n, const double *x, const double *r, const double *x1, const double *r1,
                    const double *nx1, const double *nr1, const double *ddx, const double *ddr,
                    double *S, double *Dl, double *QS, double *QD)
 {
@@ -142,14 +156,14 @@ static void points(ptrdiff_t n, const double *x, const double *r, const double *
     }
 }
 
-void ring_single_double(ptrdiff_t n, const double *x, const double *r, const double *x1,
+WIDE void ring_single_double(ptrdiff_t n, const double *x, const double *r, const double *x1,
                         const double *r1, const double *nx1, const double *nr1,
                         const double *ddx, const double *ddr, double *S, double *Dl)
 {
     points(n, x, r, x1, r1, nx1, nr1, ddx, ddr, S, Dl, NULL, NULL);
 }
 
-void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, const double *x1,
+WIDE void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, const double *x1,
                               const double *r1, const double *nx1, const double *nr1,
                               const double *ddx, const double *ddr, double *S, double *Dl,
                               double *QS, double *QD)
@@ -160,7 +174,7 @@ void ring_single_double_split(ptrdiff_t n, const double *x, const double *r, con
 /* The plain dense block: S[i, j], D[i, j] (row-major, nrow x ncol) of the targets (xr[i], rr[i]) against
  * the nodes (xc[j], rc[j]) with normals (nxc[j], nrc[j]), times the column weight wc[j] (the reference
  * of ring_dense_sym and ring_dense_mirror_sym, which assemble() calls). */
-void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
+WIDE void ring_dense(ptrdiff_t nrow, const double *xr, const double *rr, ptrdiff_t ncol,
                 const double *xc, const double *rc, const double *nxc, const double *nrc,
                 const double *wc, double *S, double *D)
 {
@@ -277,7 +291,7 @@ sym_tiles(const double *xs, ptrdiff_t n, const double *x, const double *r, const
     }
 }
 
-void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
+WIDE void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
                     const double *w, ptrdiff_t ld, const unsigned char *skip, double *S, double *D)
 {
     sym_tiles(NULL, n, x, r, nx, nr, w, ld, skip, S, D);
@@ -290,7 +304,7 @@ void ring_dense_sym(ptrdiff_t n, const double *x, const double *r, const double 
  * dr only changes sign), so q, ln q, K, E and 1/(pi sqrt D) are computed once per pair {i, j} (i <= j, from
  * dx = x_i - xs[j]) and give both (i, j*) and (j, i*) (this project's own shortcut, as ring_dense_sym).
  * Every entry is the arithmetic of ring_dense with the differences formed so. */
-void ring_dense_mirror_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
+WIDE void ring_dense_mirror_sym(ptrdiff_t n, const double *x, const double *r, const double *nx, const double *nr,
                            const double *w, const double *xs, ptrdiff_t ld, double *S, double *D)
 {
     sym_tiles(xs, n, x, r, nx, nr, w, ld, NULL, S, D);
@@ -331,7 +345,7 @@ accumulate(ptrdiff_t s0, ptrdiff_t s1, ptrdiff_t Q, const double *rows, const pt
  * (tsplit[0][t] - psplit[0][j]) + (tsplit[2][t] - psplit[2][j]) and likewise in r with [1], [3],
  * psplit the points' (anchor x, anchor r, offset x, offset r), tsplit the targets'.  With flat != NULL
  * the nflat entries of the blocks are then also written to intoS, intoD at the flat indices flat[i]. */
-void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
+WIDE void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const double *r,
                      const double *xu, const double *ru, const ptrdiff_t *tgt, const double *xt,
                      const double *rt, const double *ddx, const double *ddr, const double *a,
                      const double *b, const ptrdiff_t *pair, ptrdiff_t nblk, const ptrdiff_t *bstart,
@@ -412,7 +426,7 @@ void ring_pair_rules(ptrdiff_t n, const ptrdiff_t *index, const double *x, const
 }
 
 /* The panel geometry of PanelSet (semianalytic/bem/panels.py) on lines, circular arcs,
- * ellipse arcs and a table nose's cubic spline (kind 3, spline_eval above), the same formulas in the same order as PanelSet._param, _evaluate_segment,
+ * ellipse arcs and a table nose's cubic spline (kind 3, spline_interval and spline_at below), the same formulas in the same order as PanelSet._param, _evaluate_segment,
  * relative and the segments' displacement and derivative (semianalytic/geometry.py).  Per
  * panel k: segment parameter of the anchor base, offsets da, db of the ends, half = (db - da)/2,
  * sign, anchor (ax, ar), the corner substitution (cluster -1, 0 or +1 and power; cluster NULL:
@@ -430,17 +444,18 @@ typedef struct {
 
 /* scipy's PPoly evaluation of a cubic (scipy/interpolate/_ppoly.pyx: find_interval_ascending
  * with extrapolation, evaluate_poly1), operation for operation so that the numbers are the
- * same: the interval with knots[i] <= t < knots[i+1] (the last one closed; outside, the end
- * intervals), s = t - knots[i], and the terms summed from the lowest power up as
- * res + c z prefactor with z = s^k built by products.  nu = 0, 1 or 2. */
-static inline void spline_eval(const panels_t *P, double t, int nu, double *x, double *r)
+ * same, in two parts so that the derivatives at a point share its search: spline_interval, the
+ * interval with knots[i] <= t < knots[i+1] (the last one closed; outside, the end intervals;
+ * -1 for NaN), and spline_at, with s = t - knots[i], the terms summed from the lowest power up
+ * as res + c z prefactor with z = s^k built by products.  nu = 0, 1 or 2. */
+static inline ptrdiff_t spline_interval(const panels_t *P, double t)
 {
-    ptrdiff_t nk = P->nk, m = nk - 1, i;
+    ptrdiff_t nk = P->nk, i;
     double a = P->knots[0], b = P->knots[nk - 1];
     if (!(a <= t && t <= b)) {
         if (t < a) i = 0;
         else if (t > b) i = nk - 2;
-        else { *x = NAN; *r = NAN; return; }  /* NaN */
+        else i = -1;  /* NaN */
     } else if (t == b) {
         i = nk - 2;
     } else {
@@ -450,6 +465,18 @@ static inline void spline_eval(const panels_t *P, double t, int nu, double *x, d
             if (P->knots[mid] <= t) lo = mid; else hi = mid - 1;
         }
         i = lo;
+    }
+    return i;
+}
+
+/* The cubic of interval i (spline_interval; -1: NaN) at t. */
+static inline void spline_at(const panels_t *P, ptrdiff_t i, double t, int nu, double *x, double *r)
+{
+    ptrdiff_t m = P->nk - 1;
+    if (i < 0) {
+        *x = NAN;
+        *r = NAN;
+        return;
     }
     double s = t - P->knots[i];
     const double *cs[2] = {P->cx, P->cr};
@@ -483,6 +510,13 @@ static inline void spline_eval(const panels_t *P, double t, int nu, double *x, d
     *r = out[1];
 }
 
+/* The spline's point at the last anchor parameter t of a loop over points (the points of a panel come
+ * together and share their anchor): evaluated once, not once per point (the same numbers). */
+typedef struct {
+    double t, x, r;
+    int ok;
+} anchor_t;
+
 /* Offset dt of the segment parameter from the anchor at u, and d dt/du (PanelSet._param). */
 static inline double param(const panels_t *P, ptrdiff_t k, double uu, double *dtdu)
 {
@@ -498,8 +532,11 @@ static inline double param(const panels_t *P, ptrdiff_t k, double uu, double *dt
     return dt;
 }
 
-/* point(t + dt) - point(t) of the curve of panel k (the segments' displacement). */
-static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double dt, double *ex, double *er)
+/* point(t + dt) - point(t) of the curve of panel k (the segments' displacement).  On a spline: the
+ * point at t from `an` when it holds t (NULL: none kept), and the interval of t + dt written to *iend
+ * (for the derivatives there). */
+static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double dt, double *ex, double *er,
+                                anchor_t *an, ptrdiff_t *iend)
 {
     if (P->kind[k] == 0) {
         *ex = P->c0[k] * dt;
@@ -509,9 +546,21 @@ static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double
         *ex = -s2 * sin(mid);
         *er = s2 * cos(mid);
     } else if (P->kind[k] == 3) {  /* SplineCurve.displacement: by difference */
-        double x0, r0, x1, r1;
-        spline_eval(P, t, 0, &x0, &r0);
-        spline_eval(P, t + dt, 0, &x1, &r1);
+        double x0, r0, x1, r1, te = t + dt;
+        if (an && an->ok && an->t == t) {
+            x0 = an->x;
+            r0 = an->r;
+        } else {
+            spline_at(P, spline_interval(P, t), t, 0, &x0, &r0);
+            if (an) {
+                an->t = t, an->x = x0, an->r = r0;
+                an->ok = 1;
+            }
+        }
+        ptrdiff_t i1 = spline_interval(P, te);
+        spline_at(P, i1, te, 0, &x1, &r1);
+        if (iend)
+            *iend = i1;
         *ex = x1 - x0;
         *er = r1 - r0;
     } else {
@@ -523,10 +572,12 @@ static inline void displacement(const panels_t *P, ptrdiff_t k, double t, double
 
 /* PanelSet.evaluate at one point: x, r, x_u, r_u (out[0..3]) at u on panel k, and the
  * displacement (ex, er) from the anchor. */
-static inline void point_first(const panels_t *P, ptrdiff_t k, double uu, double *out, double *ex, double *er)
+static inline void point_first(const panels_t *P, ptrdiff_t k, double uu, double *out, double *ex, double *er,
+                               anchor_t *an)
 {
     double dtdu, dt = param(P, k, uu, &dtdu), t = P->base[k], dx, dr, c0 = P->c0[k], c1 = P->c1[k];
-    displacement(P, k, t, dt, ex, er);
+    ptrdiff_t iend = -1;
+    displacement(P, k, t, dt, ex, er, an, &iend);
     if (P->kind[k] == 0) {  /* the derivative at t + dt */
         dx = c0;
         dr = c1;
@@ -534,7 +585,7 @@ static inline void point_first(const panels_t *P, ptrdiff_t k, double uu, double
         dx = -c0 * sin(t + dt);
         dr = c0 * cos(t + dt);
     } else if (P->kind[k] == 3) {
-        spline_eval(P, t + dt, 1, &dx, &dr);
+        spline_at(P, iend, t + dt, 1, &dx, &dr);
     } else {
         dx = -c0 * sin(t + dt);
         dr = c1 * cos(t + dt);
@@ -558,10 +609,11 @@ void ring_panel_points(ptrdiff_t n, const ptrdiff_t *panel, const double *u, con
 {
     panels_t P = {base, da, db, half, sign, ax, ar, cluster, power, c0, c1, kind, offset, nk, knots, cx, cr};
     double o[4];
+    anchor_t an = {0.0, 0.0, 0.0, 0};
     for (ptrdiff_t i = 0; i < n; i++) {
         ptrdiff_t k = panel[i];
         double ex, er;
-        point_first(&P, k, u[i], o, &ex, &er);
+        point_first(&P, k, u[i], o, &ex, &er, &an);
         x[i] = o[0];
         r[i] = o[1];
         xu[i] = o[2];
@@ -595,7 +647,7 @@ void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_fr
             t_from = base[k] + da[k] + half[k] * (uf + 1.0);
             step = half[k] * (ut - uf);
         }
-        displacement(&P, k, t_from, step, &ex, &er);
+        displacement(&P, k, t_from, step, &ex, &er, NULL, NULL);
         dx[i] = sign[k] * ex;
         dr[i] = er;
     }
@@ -604,7 +656,7 @@ void ring_panel_relative(ptrdiff_t n, const ptrdiff_t *panel, const double *u_fr
 /* PanelSet.evaluate(..., second=True) at one point: x, r, x_u, r_u, x_uu, r_uu (out[0..5]) at u
  * on panel k, the formulas of PanelSet._param (with its d2t) and _evaluate_segment's second
  * branch in numpy's order, the segments' second_derivative (line 0, arc -R (cos, sin), ellipse
- * (-a cos, -b sin), spline_eval with nu = 2).  On a corner panel w[0..2] are numpy's lo^q,
+ * (-a cos, -b sin), spline_at with nu = 2).  On a corner panel w[0..2] are numpy's lo^q,
  * lo^(q - 1) and lo^max(q - 2, 0) at the point (numpy's power differs from libm's pow by an
  * ulp at times, and this replicates the numpy path; w is read on corner panels only). */
 static inline void point_second(const panels_t *P, ptrdiff_t k, double uu, const double *w, double *out)
@@ -619,7 +671,8 @@ static inline void point_second(const panels_t *P, ptrdiff_t k, double uu, const
         d2t = c > 0 ? -span * d2w : span * d2w;
     }
     double t = P->base[k], ex, er, dx, dr, ddx, ddr, c0 = P->c0[k], c1 = P->c1[k];
-    displacement(P, k, t, dt, &ex, &er);
+    ptrdiff_t iend = -1;
+    displacement(P, k, t, dt, &ex, &er, NULL, &iend);
     if (P->kind[k] == 0) {
         dx = c0;
         dr = c1;
@@ -631,8 +684,8 @@ static inline void point_second(const panels_t *P, ptrdiff_t k, double uu, const
         ddx = -c0 * cos(t + dt);
         ddr = -c0 * sin(t + dt);
     } else if (P->kind[k] == 3) {
-        spline_eval(P, t + dt, 1, &dx, &dr);
-        spline_eval(P, t + dt, 2, &ddx, &ddr);
+        spline_at(P, iend, t + dt, 1, &dx, &dr);
+        spline_at(P, iend, t + dt, 2, &ddx, &ddr);
     } else {
         dx = -c0 * sin(t + dt);
         dr = c1 * cos(t + dt);
@@ -701,7 +754,7 @@ void ring_newton_step(ptrdiff_t n, const ptrdiff_t *pan, double *u, const double
         u[i] = newton_step(&P, pan[i], u[i], xq[i], rq[i], pw ? pw + 3 * i : NULL);
         if (ex) {
             double o[4], e1, e2;
-            point_first(&P, pan[i], u[i], o, &e1, &e2);
+            point_first(&P, pan[i], u[i], o, &e1, &e2, NULL);
             ex[i] = o[0] - xq[i];
             er[i] = o[1] - rq[i];
             xu[i] = o[2];
@@ -754,7 +807,7 @@ void ring_closest_points(ptrdiff_t n, const ptrdiff_t *pan, const double *xq, co
                 double o[4], e1, e2;
                 for (int it = 0; it < 2; it++)
                     uu = newton_step(&P, k, uu, X, R, NULL);
-                point_first(&P, k, uu, o, &e1, &e2);
+                point_first(&P, k, uu, o, &e1, &e2, NULL);
                 x = o[0];
                 r = o[1];
                 dx = o[2];

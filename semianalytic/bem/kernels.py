@@ -187,8 +187,12 @@ def compiled():
     if os.environ.get(KERNEL_ENV, "").strip().lower() == "numpy":
         return None
     lib = load_library(_SOURCE)
-    if lib is None:
-        return None
+    return None if lib is None else configured(lib)
+
+
+def configured(lib):
+    """The ctypes library ``lib`` of ``_ring.c`` with its functions' argument types declared and
+    its polynomials filled (a build with other flags goes through here too: the tests)."""
     lib.ring_set_coefficients.argtypes = [_P] * 6
     lib.ring_set_coefficients.restype = None
     lib.ring_single_double.argtypes = [_N] + [_P] * 10
