@@ -24,8 +24,8 @@
  * multiply-add (that is the separate FMA extension, and -ffp-contract=off forbids it anyway): the same
  * IEEE operations in the same order on wider registers, so the same numbers, bit for bit (compiled with
  * -DRING_BASELINE, the baseline code only: tests/test_ring_kernel_c.py compares the two builds). */
-#if !defined(RING_BASELINE) && defined(__x86_64__) && defined(__linux__) && defined(__GNUC__) && !defined(__clang__) \
-    && __GNUC__ >= 8
+#if !defined(RING_BASELINE) && defined(__x86_64__) && defined(__linux__) && defined(__GLIBC__) && defined(__GNUC__) \
+    && !defined(__clang__) && __GNUC__ >= 8  /* glibc: the ifunc that picks a clone (musl has none) */
 #define WIDE __attribute__((target_clones("avx2", "default")))
 #else
 #define WIDE
