@@ -22,7 +22,10 @@ poisson_ratio = 0.29
 [perforation]                  # all optional
 coefficients = "plate"         # the plate BEM table; "half-space": X(P) - X(P - H) of the half-space
                                # table (an approximation, no plate table to build)
-back_face = "finite-sphere"    # or "constant": R_t of eq. (16) up to the exit
+back_face = "auto"             # the default chosen by transfer; "finite-sphere" (Macek & Duffey 2000),
+                               # "constant" (R_t of eq. (16) to the exit), "cylindrical" (Forrestal et al.
+                               # 1987: sigma_s of the cylindrical cavity to the exit), "sphere-to-cylinder"
+                               # (finite sphere with the cylindrical sigma_s as its floor; ours)
 failure = "auto"               # "hole-growth", "plug" (auto: plug for a flat nose)
 shear_strength = "230 MPa"     # tau of the plug criterion (default Y/sqrt(3) of the resistance)
 tolerance = "0.05 m/s"         # bracket of the ballistic-limit bisection
@@ -95,7 +98,7 @@ class PerforationSection(Section):
     """``[perforation]``: options of the ``perforate`` command (module docstring)."""
 
     coefficients: Literal["plate", "half-space"] = "plate"  # "half-space": the stand-in approximation (fast)
-    back_face: Literal["finite-sphere", "constant"] = "finite-sphere"
+    back_face: Literal["auto", "finite-sphere", "constant", "cylindrical", "sphere-to-cylinder"] = "auto"
     failure: Literal["auto", "hole-growth", "plug"] = "auto"
     shear_strength: Pressure | None = None
     tolerance: Velocity = Field(default=0.05, description="bracket of the ballistic-limit bisection [m/s]")

@@ -23,7 +23,8 @@ __all__ = ["PerforationSetup", "plate_coefficients", "perforation_setup", "evalu
            "load_perforation_data", "shot_table_validation", "JSON_KEYS"]
 
 JSON_KEYS = ("striking_velocity_m_s", "perforated", "residual_velocity_m_s", "depth_m", "exit_time_s",
-             "ballistic_limit_m_s", "ballistic_limit_error_m_s", "lambert_jonas", "part4_v_cr_m_s")
+             "ballistic_limit_m_s", "ballistic_limit_error_m_s", "ballistic_limit_bound", "failure_mode",
+             "lambert_jonas", "part4_v_cr_m_s")
 
 PART4_NAMES = {"V_R1_m_s": "eq5_R1", "V_R2_m_s": "eq5_R2", "V_R3_m_s": "eq5_R3",
                "V_eq7_m_s": "eq7", "V_eq8_m_s": "eq8", "V_eq9_m_s": "eq9"}
@@ -80,7 +81,9 @@ def _half_space_stand_in(case, thickness: float, cache_dir=None, shift: str | No
 @dataclass(frozen=True, eq=False)
 class PerforationSetup:
     """The model's inputs for one case (SI): the layered coefficients, the projectile's mass,
-    length, density, diameter, the total target thickness and the notes for the output."""
+    length, density, diameter, the total target thickness and the notes for the output
+    (``failure_mode`` per layer with its reason, ``thin_plate`` notes, the validity limit
+    ``v_max`` [m/s] of the rigid-projectile model with its reason)."""
 
     coefficients: object
     mass: float
@@ -93,6 +96,19 @@ class PerforationSetup:
     approximate: bool
     back_face: str
     failure: str
+    failure_modes: tuple = ()
+    notes: tuple = ()
+    v_max: float = 3000.0
+    v_max_reason: str = ""
+
+
+BACK_FACE_DEFAULT = "sphere-to-cylinder"
+"""The back face of ``back_face = "auto"``, chosen by transfer (reports/validation_perforation.md,
+section "Back face by transfer": Part IV Table 3 with Y = HV/3 (Tabor) and nothing fitted)."""
+
+MIN_THICKNESS_DIAMETERS = 1e-3
+MAX_THICKNESS_DIAMETERS = 1e4
+NO_STRENGTH_V_MAX = 3000.0
 
 
 def _layer_inputs(case):
@@ -109,9 +125,30 @@ def _layer_inputs(case):
     return [("plate", 0.0, t.thickness, t.density, base)]
 
 
+def validity_limit(psec, layers) -> tuple[float, str]:
+    """(v_max [m/s], reason): the largest striking velocity at which the rigid-projectile model holds:
+    Tate's (1967) criterion with the nose as a constrained indenter, (1/2) rho_t V^2 + R_t = 3 Y_p
+    (:func:`semianalytic.penetration.regime.tate_erosion_velocity`, C = Tabor's 3), the lowest over the
+    layers; without a projectile yield stress, 3 km/s (the top of the rigid-projectile data of
+    Piekutowski et al. 1999)."""
+    from semianalytic.penetration.regime import TABOR_CONSTRAINT, tate_erosion_velocity
+
+    Y_p = getattr(psec, "yield_stress", None)
+    if Y_p is None:
+        return NO_STRENGTH_V_MAX, "no projectile yield stress given: 3 km/s, the top of the rigid-projectile data"
+    v = min(float(tate_erosion_velocity(Y_p, ly.resistance, ly.density, TABOR_CONSTRAINT)) for ly in layers)
+    return max(v, 1.0), (f"rigid projectile while (1/2) rho_t V^2 + R_t < 3 Y_p (Tate 1967 with Tabor's constraint), "
+                         f"Y_p = {Y_p / 1e6:.4g} MPa")
+
+
 def perforation_setup(case, cache_dir=None, shift: str | None = None) -> PerforationSetup:
-    """Build :class:`~semianalytic.perforation.model.LayeredCoefficients` from the case."""
+    """Build :class:`~semianalytic.perforation.model.LayeredCoefficients` from the case: per layer the
+    failure mode (:func:`semianalytic.perforation.thin_plate.failure_mode` with ``failure = "auto"``),
+    the back face (``back_face``; "auto" = :data:`BACK_FACE_DEFAULT`) and, where the plate is thinner
+    than the spherical plastic zone (:func:`~semianalytic.perforation.thin_plate.spherical_zone_fits`),
+    the cylindrical cavity expansion of the thin plate instead of Part I's spherical resistance."""
     from semianalytic.geometry import projectile_from_section
+    from semianalytic.perforation import thin_plate as tp
     from semianalytic.perforation.case import PerforationSection
     from semianalytic.perforation.model import LayeredCoefficients, PlateLayer
 
@@ -119,41 +156,79 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
     opts = case.section("perforation") or PerforationSection()
     proj = projectile_from_section(psec)
     d = float(psec.diameter)
-    failure = opts.failure
-    if failure == "auto":
-        failure = "plug" if psec.nose == "flat" else "hole-growth"
-    layers, descs, approx = [], [], False
+    a = 0.5 * d
+    back = BACK_FACE_DEFAULT if opts.back_face == "auto" else opts.back_face
+    layers, descs, approx, modes, notes = [], [], False, [], []
     front = 0.0
-    for k, (name, gap, H, rho, res) in enumerate(_layer_inputs(case)):
+    inputs = _layer_inputs(case)
+    for k, (name, gap, H, rho, res) in enumerate(inputs):
+        field = f"target.layers.{k}.thickness" if case.target.layers else "target.thickness"
+        if not (MIN_THICKNESS_DIAMETERS * d <= H <= MAX_THICKNESS_DIAMETERS * d):
+            raise InputError(field, f"{H * 1e3:.6g} mm is outside every model's validity ({MIN_THICKNESS_DIAMETERS:g} to "
+                             f"{MAX_THICKNESS_DIAMETERS:g} projectile diameters, {MIN_THICKNESS_DIAMETERS * d * 1e3:.3g} to "
+                             f"{MAX_THICKNESS_DIAMETERS * d:.3g} m): a foil (membrane) or a thickness no rigid rod model covers")
         front += gap
         R = float(res.pressure(d))
         where = f"target.layers.{k}.resistance" if case.target.layers else "target.resistance"
         if not R > 0:
             raise InputError(where, f"the resistance must be positive; got {R:g} Pa")
         Y, E = getattr(res, "yield_stress", None), getattr(res, "youngs_modulus", None)
-        ratio = None
-        if opts.back_face == "finite-sphere" and failure != "plug":  # a plug is the back face's failure itself
-            if Y is None or E is None or np.ndim(Y) or not (2 * E / (3 * Y)) > 1:
-                raise InputError("perforation.back_face", f"'finite-sphere' needs the yield stress and Young's modulus of "
-                                 f"{where} (models elastic-plastic, hardening, part4); use back_face = 'constant'")
-            ratio = (2.0 * E / (3.0 * Y)) ** (1.0 / 3.0)
-        tau = None
-        if failure == "plug":
+        has_YE = Y is not None and E is not None and not np.ndim(Y) and not np.ndim(E) and (2 * E / (3 * Y)) > 1
+        if opts.failure == "auto":
+            mode, why = tp.failure_mode(proj.nose, float(H))
+        elif opts.failure == "plug":
+            mode, why = "shear plugging", "failure = 'plug' (case)"
+        else:
+            mode, why = "ductile hole enlargement", "failure = 'hole-growth' (case)"
+        ratio, tau, floor = None, None, None
+        layer_back = back
+        if mode == "shear plugging":
             tau = opts.shear_strength
             if tau is None:
                 if Y is None:
                     raise InputError("perforation.shear_strength", "missing: the plug criterion needs the target's shear "
                                      "strength (e.g. '230 MPa') or a resistance model with a yield stress")
                 tau = float(Y) / math.sqrt(3.0)
+            layer_back = "plug"
+        elif back in ("finite-sphere", "cylindrical", "sphere-to-cylinder") and not has_YE:
+            if opts.back_face != "auto":
+                raise InputError("perforation.back_face", f"'{back}' needs the yield stress and Young's modulus of "
+                                 f"{where} (models elastic-plastic, hardening, part4); use back_face = 'constant'")
+            layer_back = "constant"
+            notes.append(f"layer {k}: no Y and E in {where}: back face 'constant' (R_t to the exit)")
+        if layer_back != "constant" and layer_back != "plug":
+            thin = not tp.spherical_zone_fits(float(H), a, float(Y), float(E))
+            sigma_s = tp.cylindrical_cavity_stress(float(Y), float(E))
+            if mode == "petalling":
+                R = 0.5 * float(Y)  # Thomson (1955): W = (pi/2) a^2 H Y = int (Y/2) C dP
+                layer_back = "petalling (Thomson 1955)"
+                notes.append(f"layer {k}: thin-plate model: petalling, Thomson (1955) work (pi/2) a^2 H Y (R = Y/2 on the "
+                             "nose inside the plate)")
+            elif thin or layer_back == "cylindrical":
+                R = sigma_s
+                if thin and layer_back != "cylindrical":
+                    c = tp.spherical_plastic_radius(a, float(Y), float(E))
+                    notes.append(f"layer {k}: thin-plate model: H = {H * 1e3:.4g} mm < c = (2E/3Y)^(1/3) d/2 = {c * 1e3:.4g} mm "
+                                 "(no spherical plastic zone fits): cylindrical cavity expansion, sigma_s = (Y/sqrt 3)"
+                                 "[1 + ln(E/(sqrt 3 Y))] (Forrestal, Rosenberg, Luk & Bless 1987) to the exit")
+                layer_back = "cylindrical"
+            else:
+                ratio = (2.0 * E / (3.0 * Y)) ** (1.0 / 3.0)
+                if layer_back == "sphere-to-cylinder":
+                    floor = sigma_s
+        modes.append({"layer": k, "failure_mode": mode, "reason": why, "back_face": layer_back})
         coef, desc, ap = plate_coefficients(case, H, cache_dir, shift)
         approx |= ap
         descs.append(desc)
-        layers.append(PlateLayer(front, float(H), float(rho), R, coef, ratio, tau))
+        layers.append(PlateLayer(front, float(H), float(rho), R, coef, ratio, tau, floor))
         front += H
     lc = LayeredCoefficients(layers, proj.nose.length, d)
     rho_p = psec.density if psec.density is not None else proj.mass / proj.volume()
+    v_max, v_why = validity_limit(psec, layers)
+    failure = "plug" if modes[0]["failure_mode"] == "shear plugging" else "hole-growth"
     return PerforationSetup(lc, float(proj.mass), float(proj.length), float(rho_p), d, front, tuple(layers),
-                            descs[0], approx, opts.back_face, failure)
+                            descs[0], approx, modes[0]["back_face"] if len(modes) == 1 else back, failure,
+                            tuple(modes), tuple(notes), v_max, v_why)
 
 
 def part4_limits(case, setup: PerforationSetup) -> dict:
@@ -233,7 +308,7 @@ def _reach_warning(setup: PerforationSetup, curve) -> None:
 def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = True, error_estimate: bool = True) -> dict:
     """The ``perforate`` JSON of one case (keys: :data:`JSON_KEYS` and the notes)."""
     from semianalytic.perforation.case import PerforationSection
-    from semianalytic.perforation.model import ballistic_limit, lambert_jonas_fit, perforation_curve
+    from semianalytic.perforation.model import ballistic_limit_search, lambert_jonas_fit, perforation_curve
 
     opts = case.section("perforation") or PerforationSection()
     setup = perforation_setup(case, cache_dir)
@@ -247,6 +322,10 @@ def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = Tr
                     "resistance_Pa": ly.resistance} for ly in setup.layers],
         "mass_kg": setup.mass, "exit_depth_m": curve.exit_depth,
         "back_face": setup.back_face, "failure": setup.failure,
+        "failure_mode": setup.failure_modes[0]["failure_mode"] if len(setup.failure_modes) == 1 else
+        [m["failure_mode"] for m in setup.failure_modes],
+        "failure_modes": list(setup.failure_modes), "model_notes": list(setup.notes),
+        "validity_limit_m_s": setup.v_max, "validity_limit_reason": setup.v_max_reason,
         "coefficients": setup.description, "coefficients_approximate": setup.approximate,
         "striking_velocity_m_s": U.tolist(),
         "perforated": [bool(v) for v in curve.perforated],
@@ -254,28 +333,35 @@ def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = Tr
         "depth_m": [None if not math.isfinite(v) else float(v) for v in curve.depth],
         "exit_time_s": [None if not math.isfinite(v) else float(v) for v in curve.exit_time],
         "plug_layer": [None if k < 0 else int(k) for k in curve.plug],
+        "energy_bounded": [bool(v) for v in curve.energy_bounded],
+        "resistance_work_J": curve.resistance_work,
     }
+    over = U > setup.v_max
+    if np.any(over):
+        warnings.warn(f"impact.striking_velocities: {int(over.sum())} above the model's validity limit {setup.v_max:.6g} m/s "
+                      f"({setup.v_max_reason}); computed anyway", ModelValidityWarning, stacklevel=2)
     out["ballistic_limit_m_s"] = None
     out["ballistic_limit_error_m_s"] = None
+    out["ballistic_limit_bound"] = None
     if ballistic:
-        if not curve.perforated.any():
-            i = int(np.argmax(U))
-            raise InputError("impact.striking_velocities",
-                             f"no velocity perforates, so the ballistic limit cannot be bracketed: the largest, "
-                             f"{U[i]:.6g} m/s, stops at depth {curve.depth[i] * 1e3:.6g} mm of the {setup.thickness * 1e3:.6g} mm "
-                             "target; add a higher velocity (m/s)")
-        upper = float(U[curve.perforated].min())
         shifted = []
         if error_estimate:
             for w in ("A", "B", "C"):
                 shifted.append(perforation_setup(case, cache_dir, shift=w).coefficients)
-        bl = ballistic_limit(setup.coefficients, setup.mass, upper, tolerance=opts.tolerance, shifted=shifted)
+        bl = ballistic_limit_search(setup.coefficients, setup.mass, setup.v_max, tolerance=opts.tolerance, shifted=shifted,
+                                    v_max_reason=setup.v_max_reason)
         out["ballistic_limit_m_s"] = bl.value
-        out["ballistic_limit_error_m_s"] = bl.error
+        out["ballistic_limit_error_m_s"] = bl.error if bl.bound == "exact" else None
+        out["ballistic_limit_bound"] = bl.bound
+        out["ballistic_limit_reason"] = bl.reason
+        out["ballistic_limit_converged"] = bl.converged
         out["ballistic_limit_estimate"] = {"bracket_m_s": bl.bracket, "integration_m_s": bl.integration,
                                            "coefficients_m_s": bl.coefficients, "tolerance_m_s": bl.tolerance,
                                            "iterations": bl.iterations}
-    V_ref = out["ballistic_limit_m_s"] or curve.ballistic_limit_estimate
+        if bl.bound == "lower":
+            warnings.warn(f"ballistic limit: above {bl.value:.6g} m/s, the model's validity limit ({setup.v_max_reason}); "
+                          "reported as a lower bound", ModelValidityWarning, stacklevel=2)
+    V_ref = out["ballistic_limit_m_s"] or curve.ballistic_limit_estimate or float(U.max())
     grid = np.linspace(0.5 * V_ref, max(float(U.max()), 2.0 * V_ref), 49)  # the figure's curve: 50 velocities
     grid = np.sort(np.append(grid, V_ref * (1 + 1e-9)))  # with the limit itself (V_r rises like a square root)
     dense = perforation_curve(setup.coefficients, setup.mass, grid)
@@ -328,7 +414,7 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
     from semianalytic.ballistic_limit.tables import load_shots
     from semianalytic.ballistic_limit.theory import resistance_R1
     from semianalytic.case import parse_case
-    from semianalytic.perforation.model import ballistic_limit
+    from semianalytic.perforation.model import ballistic_limit_search
 
     sec = case.section("ballistic_limit")
     if sec is None or sec.table is None:
@@ -357,7 +443,7 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
         except InputError as exc:
             rows.append({"name": shot.name, "skipped": exc.message})
             continue
-        bl = ballistic_limit(setup.coefficients, setup.mass, 5000.0, tolerance=0.05)
+        bl = ballistic_limit_search(setup.coefficients, setup.mass, 5000.0, tolerance=0.05)
         row = {"name": shot.name, "measured_V_m_s": shot.measured, "model_V_m_s": bl.value, "R1_Pa": R1}
         row.update({PART4_NAMES[k]: p4[k] for k in PART4_NAMES if p4.get(k) is not None})
         rows.append(row)

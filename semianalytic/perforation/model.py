@@ -80,11 +80,13 @@ __all__ = [
     "residual_velocity",
     "ballistic_limit",
     "BallisticLimit",
+    "ballistic_limit_search",
+    "resistance_work",
     "lambert_jonas",
     "lambert_jonas_fit",
 ]
 
-BACK_FACES = ("finite-sphere", "constant")
+BACK_FACES = ("auto", "finite-sphere", "constant", "cylindrical", "sphere-to-cylinder")
 FAILURES = ("auto", "hole-growth", "plug")
 
 
@@ -116,7 +118,9 @@ class PlateLayer:
     ``density`` rho [kg/m^3], ``resistance`` R_t [Pa], ``coefficients`` its plate table (A, B,
     C of the tip depth measured from ``front``, valid up to H + L_h), ``plastic_ratio``
     (2E/(3Y))^(1/3) for the finite-sphere back face (None: constant R_t), ``shear_strength``
-    tau [Pa] of the plug criterion (None: no plugging)."""
+    tau [Pa] of the plug criterion (None: no plugging), ``cylinder_resistance`` sigma_s of the
+    cylindrical cavity (:func:`~semianalytic.perforation.thin_plate.cylindrical_cavity_stress`), the
+    floor of the finite-sphere resistance (``back_face = "sphere-to-cylinder"``; None: no floor)."""
 
     front: float
     thickness: float
@@ -125,6 +129,7 @@ class PlateLayer:
     coefficients: object
     plastic_ratio: float | None = None
     shear_strength: float | None = None
+    cylinder_resistance: float | None = None
 
     @property
     def back(self) -> float:
@@ -183,6 +188,8 @@ class LayeredCoefficients:
                 R = ly.resistance
                 if ly.plastic_ratio is not None:
                     R = R * back_face_factor(ly.thickness - xs, 0.5 * self.diameter, ly.plastic_ratio)
+                    if ly.cylinder_resistance is not None:
+                        R = np.maximum(R, ly.cylinder_resistance)
                 v = R * np.asarray(coef.C(xs), float)
             out = out + np.where(inside, v, 0.0)
         if which == "C":
@@ -269,6 +276,8 @@ class PerforationCurve:
     exit_depth: float
     ballistic_limit_estimate: float
     profile: object = field(repr=False, default=None)
+    energy_bounded: np.ndarray | None = None
+    resistance_work: float = float("nan")
 
 
 def _gauss(n=16):
@@ -288,15 +297,40 @@ def _exit_time(profile, U, P_exit, edges):
     return t
 
 
-def perforation_curve(coefficients: LayeredCoefficients, mass: float, velocities, *, panel_scale: float = 1.0) -> PerforationCurve:
+def resistance_work(coefficients: LayeredCoefficients, upto: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+    """(P, W(P)): the work of the resistance alone, W(P) = int_0^P sum_k f_k R_k C_k dP [J] (no inertial
+    term), on a grid to ``upto`` (default the exit depth).  W(P_exit) is what the plate takes from the
+    projectile at the least; Gauss-Legendre (16 points) on the breakpoints refined to P_exit/256."""
+    Pe = coefficients.exit_depth if upto is None else float(upto)
+    edges = coefficients.depth[coefficients.depth < Pe]
+    edges = _refine(np.append(edges, Pe), Pe / 256.0)
+    x, w = _gauss()
+    a, b = edges[:-1], edges[1:]
+    P = a[:, None] + 0.5 * (b - a)[:, None] * (x[None, :] + 1.0)
+    C = np.asarray(coefficients.C(P.ravel()), float).reshape(P.shape)
+    cell = 0.5 * (b - a) * np.sum(w[None, :] * C, axis=1)
+    return edges, np.concatenate([[0.0], np.cumsum(cell)])
+
+
+def perforation_curve(coefficients: LayeredCoefficients, mass: float, velocities, *, panel_scale: float = 1.0,
+                      profile=None) -> PerforationCurve:
     """Residual velocity, depth and exit time for every striking velocity (Part I, eq. (11)
-    through the layers; one integration in P for all velocities, see the module docstring)."""
+    through the layers; one integration in P for all velocities, see the module docstring).
+
+    No energy from nowhere: V_r is at most sqrt(V_s^2 - 2 W / m), W = :func:`resistance_work` at the
+    exit (the resistance's work alone; eq. (11)'s inertial terms only take energy, but a reading of B
+    that is not dA/dP, or the stand-in coefficients, could return some); ``energy_bounded`` marks the
+    velocities where that bound decides.  ``profile``: the integration in P, if already done to at
+    least max(velocities) (reused)."""
     U = np.atleast_1d(np.asarray(velocities, float))
     if np.any(~np.isfinite(U)) or np.any(U <= 0):
         raise ValueError("striking velocities must be positive")
     m = float(mass)
     Pe = coefficients.exit_depth
-    prof = _profile_to_exit(coefficients, m, float(U.max()), panel_scale)
+    if profile is not None and getattr(profile, "U_max", 0.0) >= float(U.max()) and profile.P_end > Pe:
+        prof = profile
+    else:
+        prof = _profile_to_exit(coefficients, m, float(U.max()), panel_scale)
     F_e, G_e = float(prof.F(Pe)), float(prof.G(Pe))
     w_exit = np.exp(-F_e) * (U * U - G_e)
     perforated = w_exit > 0
@@ -334,10 +368,25 @@ def perforation_curve(coefficients: LayeredCoefficients, mass: float, velocities
         Vr[hit] = Vr_h
         depth[hit] = np.where(Vr_h > 0, np.nan, np.where(stuck, Pp[hit] + x_stop, ly.back))
         texit[hit] = t_h
+    # the energy bound (docstring): the resistance alone takes W from the projectile
+    Pw, Wc = resistance_work(coefficients)
+    W = float(Wc[-1])
+    bound2 = U * U - 2.0 * W / m
+    nop = plug < 0  # a plug path has its own energy balance (Recht & Ipson); the bound holds there too
+    bound = np.sqrt(np.maximum(bound2, 0.0))
+    bounded = nop & perforated & (Vr > bound)
+    Vr = np.where(bounded, bound, Vr)
+    stop = bounded & (bound2 <= 0)
+    if np.any(stop):  # the resistance alone stops it: where W(P) = m U^2 / 2
+        perforated = perforated & ~stop
+        depth[stop] = np.interp(0.5 * m * U[stop] ** 2, Wc, Pw)
+    Vr = np.minimum(Vr, U)  # V_r <= V_s also where a plug was pushed out
     ok = perforated & (plug < 0)
     if np.any(ok):
         texit[ok] = _exit_time(prof, U[ok], Pe, edges)
-    return PerforationCurve(U, perforated, Vr, depth, texit, plug, Pe, math.sqrt(max(G_e, 0.0)), prof)
+    texit[~perforated] = np.nan
+    return PerforationCurve(U, perforated, Vr, depth, texit, plug, Pe, max(math.sqrt(max(G_e, 0.0)), math.sqrt(2.0 * W / m)),
+                            prof, bounded, W)
 
 
 def _profile_to_exit(coefficients, m, U_max, panel_scale):
@@ -444,6 +493,9 @@ class BallisticLimit:
     coefficients: float
     tolerance: float
     iterations: int
+    bound: str = "exact"
+    reason: str = ""
+    converged: bool = True
 
 
 def _bisected(lo0, hi0, lo, hi, tol, n):
@@ -517,6 +569,105 @@ def _bisect_near(coef, mass, V, width, lower, upper, tol, panel_scale=1.0) -> fl
             if lo <= lower and hi >= upper:
                 raise
             width *= 2.0
+
+
+def _perforates(coef, mass, V, prof, panel_scale=1.0) -> bool:
+    return bool(perforation_curve(coef, mass, [V], profile=prof, panel_scale=panel_scale).perforated[0])
+
+
+def _bisect_curve(coef, mass, lo, hi, tol, prof, panel_scale=1.0):
+    """Bisection on :func:`perforation_curve`'s 'perforates' (energy bound and plugs included) between
+    lo (stops) and hi (perforates); (midpoint, half bracket, steps)."""
+    n = 0
+    while hi - lo > tol and n < 200:
+        mid = 0.5 * (lo + hi)
+        if _perforates(coef, mass, mid, prof, panel_scale):
+            hi = mid
+        else:
+            lo = mid
+        n += 1
+    return 0.5 * (lo + hi), 0.5 * (hi - lo), n
+
+
+def _bracket(coef, mass, v_max, prof, panel_scale=1.0, start=None):
+    """(lo, hi, status) of the ballistic-limit bracket found from the physics: start at the energy
+    estimate (the larger of sqrt(G(P_exit)) of eq. (11) and sqrt(2 W / m) of the resistance's work),
+    go down until a velocity stops, up (doubling) until one perforates, at most to ``v_max``.
+    status: "ok", "lower" (nothing perforates up to v_max) or "zero" (every velocity perforates)."""
+    if start is None:
+        start = perforation_curve(coef, mass, [min(1.0, v_max)], profile=prof, panel_scale=panel_scale).ballistic_limit_estimate
+    v0 = min(max(float(start), 1e-3), v_max)
+    lo = 0.5 * v0
+    while _perforates(coef, mass, lo, prof, panel_scale):
+        if lo < 1e-6:
+            return 0.0, lo, "zero"
+        lo *= 0.25
+    hi = max(1.25 * v0, 2.0 * lo)
+    while True:
+        hi = min(hi, v_max)
+        if _perforates(coef, mass, hi, prof, panel_scale):
+            return lo, hi, "ok"
+        if hi >= v_max:
+            return lo, v_max, "lower"
+        lo, hi = hi, 2.0 * hi
+
+
+def _limit_value(coef, m, panel_scale=1.0):
+    """V_bl without a plug: perforates <=> V^2 > G(P_exit) (eq. (11) in P) and V^2 > 2 W / m (the energy
+    bound of :func:`perforation_curve`), so V_bl = max(sqrt G(P_exit), sqrt(2 W / m)) exactly."""
+    Pe = coef.exit_depth
+    _, Wc = resistance_work(coef)
+    v_w = math.sqrt(2.0 * float(Wc[-1]) / m)
+    prof = _profile_to_exit(coef, m, max(v_w, 1.0), panel_scale)
+    return max(math.sqrt(max(float(prof.G(Pe)), 0.0)), v_w)
+
+
+def _closed_limit(coef, m, v_max, tolerance, shifted, v_max_reason):
+    V = _limit_value(coef, m)
+    if V > v_max:
+        return BallisticLimit(v_max, 0.0, 0.0, 0.0, 0.0, float(tolerance), 0, "lower",
+                              f"no velocity up to the model's validity limit {v_max:.6g} m/s perforates (eq. (11) gives "
+                              f"{V:.6g} m/s, outside it)" + (f"; {v_max_reason}" if v_max_reason else ""))
+    integ = abs(_limit_value(coef, m, 0.5) - V)
+    cpart = sum(abs(_limit_value(sc, m) - V) for sc in shifted or ())
+    return BallisticLimit(V, integ + cpart, 0.0, integ, cpart, float(tolerance), 0, "exact",
+                          "V_bl = max(sqrt G(P_exit), sqrt(2 W/m)) of eq. (11) through the plate (no plug: exact, no bisection)")
+
+
+def ballistic_limit_search(coefficients: LayeredCoefficients, mass: float, v_max: float, *, tolerance: float = 0.05,
+                           shifted=None, v_max_reason: str = "") -> BallisticLimit:
+    """V_bl found by the model itself: bracketed from the physics (:func:`_bracket`: the lowest
+    velocity that stops, widened until one perforates, up to the model's validity limit ``v_max``)
+    and bisected on :func:`perforation_curve` until the bracket is below ``tolerance`` [m/s];
+    independent of any listed velocities.  If nothing perforates up to ``v_max``, V_bl > v_max is
+    returned as a lower bound (``bound = "lower"``, ``reason`` says why).  The error estimate adds the
+    integration's part (panels halved) and the coefficients' parts (``shifted``) as
+    :func:`ballistic_limit`."""
+    m = float(mass)
+    v_max = float(v_max)
+    if not any(ly.shear_strength is not None for ly in coefficients.layers):
+        return _closed_limit(coefficients, m, v_max, tolerance, shifted, v_max_reason)
+    prof = _profile_to_exit(coefficients, m, v_max, 1.0)
+    lo, hi, status = _bracket(coefficients, m, v_max, prof)
+    if status == "lower":
+        return BallisticLimit(v_max, 0.0, 0.0, 0.0, 0.0, float(tolerance), 0, "lower",
+                              f"no velocity up to the model's validity limit {v_max:.6g} m/s perforates"
+                              + (f" ({v_max_reason})" if v_max_reason else ""))
+    if status == "zero":
+        return BallisticLimit(0.0, hi, hi, 0.0, 0.0, float(tolerance), 0, "exact",
+                              "every velocity perforates (the plate offers no resistance)")
+    V, half, n = _bisect_curve(coefficients, m, lo, hi, tolerance, prof)
+    converged = 2 * half <= tolerance
+
+    def near(coef, scale):
+        p2 = _profile_to_exit(coef, m, v_max, scale)
+        a, b, st = _bracket(coef, m, v_max, p2, scale, start=V)
+        return V if st != "ok" else _bisect_curve(coef, m, a, b, tolerance, p2, scale)[0]
+
+    integ = abs(near(coefficients, 0.5) - V)
+    cpart = sum(abs(near(sc, 1.0) - V) for sc in shifted or ())
+    return BallisticLimit(V, half + integ + cpart, half, integ, cpart, float(tolerance), n, "exact",
+                          "bracketed and bisected on eq. (11) through the plate", converged)
 
 
 def lambert_jonas(Vs, a: float, p: float, V_bl: float):
