@@ -31,8 +31,13 @@ def _text(r: dict) -> str:
     for i, U in enumerate(r["striking_velocity_m_s"]):
         lines.append(f"  {U:9.1f} | {str(r['perforated'][i]):>10} | {f(r['residual_velocity_m_s'][i]):>9} | "
                      f"{f(r['depth_m'][i], 1e3, 2):>9} | {f(r['exit_time_s'][i], 1e6, 2):>9}")
+    lines.insert(2, f"  failure mode: {r.get('failure_mode')}" + "".join(f"\n  model: {n}" for n in r.get("model_notes", [])))
     if r["ballistic_limit_m_s"] is not None:
-        lines.append(f"  ballistic limit (bisection on eq. (11)): {r['ballistic_limit_m_s']:.2f} +- {r['ballistic_limit_error_m_s']:.2f} m/s")
+        if r.get("ballistic_limit_bound") == "lower":
+            lines.append(f"  ballistic limit: > {r['ballistic_limit_m_s']:.2f} m/s (lower bound: {r.get('ballistic_limit_reason', '')})")
+        else:
+            lines.append(f"  ballistic limit (the command's own search on eq. (11)): {r['ballistic_limit_m_s']:.2f} +- "
+                         f"{r['ballistic_limit_error_m_s']:.2f} m/s")
     lj = r["lambert_jonas"]
     if lj:
         lines.append(f"  Lambert-Jonas fit: a = {lj['a']:.4f}, p = {lj['p']:.3f}, V_bl = {lj['V_bl_m_s']:.1f} m/s")
@@ -51,7 +56,13 @@ def run(args) -> int:
             c.require(sec)
     results = [evaluate_case(c, cache_dir=args.cache_dir, ballistic=not args.no_ballistic_limit) for c in cases]
     if args.report:
+        from semianalytic.perforation.evaluate import thickness_sweep
         from semianalytic.perforation.report import write_report
+
+        import numpy as np
+
+        sweep = [1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 2.63e-2, 6e-2, 0.2, 1.0, 2.0]
+        results[0]["thickness_sweep"] = thickness_sweep(cases[0], sweep, np.geomspace(20.0, 3000.0, 50), args.cache_dir)
 
         path = write_report(results, args.report, argv=["perforate", *args.cases, "--report", str(args.report)])
         print(f"wrote {path}")

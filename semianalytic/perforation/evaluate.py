@@ -375,7 +375,32 @@ def evaluate_case(case, *, cache_dir=None, velocities=None, ballistic: bool = Tr
     shots = shot_table_validation(case, cache_dir)
     if shots is not None:
         out["shot_table"] = shots
+        out["back_face_study"] = back_face_study(case, cache_dir)
     return out
+
+
+def thickness_sweep(case, thicknesses, velocities, cache_dir=None) -> list[dict]:
+    """Per thickness [m]: failure mode, V_bl (or its lower bound) and max(V_r - V_s) over ``velocities``
+    of the case's projectile with the half-space stand-in coefficients (the report's sweep)."""
+    import copy
+
+    from semianalytic.case import parse_case
+    from semianalytic.perforation.model import ballistic_limit_search, perforation_curve
+
+    rows = []
+    for H in thicknesses:
+        raw = copy.deepcopy(dict(case.raw))
+        raw.pop("ballistic_limit", None)
+        raw["target"] = dict(raw["target"], thickness=f"{float(H)!r} m")
+        raw["target"].pop("layers", None)
+        raw["perforation"] = dict(raw.get("perforation", {}), coefficients="half-space")
+        setup = perforation_setup(parse_case(raw, case.path), cache_dir)
+        cur = perforation_curve(setup.coefficients, setup.mass, velocities)
+        bl = ballistic_limit_search(setup.coefficients, setup.mass, setup.v_max)
+        rows.append({"thickness_mm": float(H) * 1e3, "failure_mode": setup.failure_modes[0]["failure_mode"],
+                     "V_bl": bl.value, "bound": bl.bound,
+                     "max_excess": float(np.max(cur.residual_velocity - cur.velocities))})
+    return rows
 
 
 def _compare_data(setup: PerforationSetup, rows: list[dict], opts) -> dict:
@@ -457,3 +482,81 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
                         "mean_abs_relative_error": float(np.mean([abs(r[n] / r["measured_V_m_s"] - 1) for r in used
                                                                   if r.get(n) is not None]))}
     return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats}
+
+
+TABLE1_E = {"Al-alloys": (71e9, 0.33), "Steels": (210e9, 0.29), "Ti-alloy": (110e9, 0.32)}
+"""E and nu of each target class as Part IV, Table 1 assumes them (cases/part4_table1.csv)."""
+
+STUDY_BACK_FACES = ("constant-R1", "constant", "finite-sphere", "cylindrical", "sphere-to-cylinder")
+
+
+def back_face_study(case, cache_dir=None) -> dict | None:
+    """The back face chosen by transfer: V_bl of every single-plate shot of the case's
+    ``[ballistic_limit] table`` (Part IV, Table 3) by eq. (11) through the plate with each back face
+    of :data:`STUDY_BACK_FACES`, nothing fitted on the table: Y = HV/3 (Tabor 1951, the constraint
+    factor 3 of a hardness indent), E and nu of Part IV Table 1's class (:data:`TABLE1_E`),
+    R_t = Part I eq. (16) from them ("constant-R1": Part IV's R(1) = HM delta_H instead, the
+    resistance of eq. (5)), the case's nose scaled to each core, half-space stand-in coefficients.
+    Returns rows and, per back face, the mean |relative error| and the mean signed error per class."""
+    import copy
+
+    from semianalytic.ballistic_limit.tables import load_rows, shot_from_row
+    from semianalytic.ballistic_limit.theory import resistance_R1
+    from semianalytic.case import parse_case
+    from semianalytic.perforation.model import ballistic_limit_search
+
+    sec = case.section("ballistic_limit")
+    if sec is None or sec.table is None:
+        return None
+    base = case.path.parent if case.path is not None else Path.cwd()
+    entries = load_rows((base / sec.table).resolve(), lambda c, row: (c.text("id"), c.text("material_class"), shot_from_row(c)),
+                        require="L_p_mm", what="a shot table")
+    rows = []
+    for sid, cls, shot in entries:
+        if (shot.is_composite or shot.measured is None or shot.measured_qualifier or shot.projectile_mass is None
+                or shot.projectile_diameter is None or shot.HVdelta_t is None or cls not in TABLE1_E):
+            continue
+        E, nu = TABLE1_E[cls]
+        Y = shot.target_hardness / 3.0
+        row = {"name": sid, "class": cls, "measured_V_m_s": shot.measured, "Y_Pa": Y, "E_Pa": E}
+        for bf in STUDY_BACK_FACES:
+            raw = copy.deepcopy(dict(case.raw))
+            raw.pop("ballistic_limit", None)
+            proj = raw["projectile"]
+            for key in ("shank_length", "length", "density", "mass"):
+                proj.pop(key, None)
+            proj.update(diameter=f"{shot.projectile_diameter!r} m", length=f"{shot.projectile_length!r} m",
+                        mass=f"{shot.projectile_mass!r} kg")
+            if bf == "constant-R1":
+                R1 = float(resistance_R1(shot.target_hardness, shot.target_delta_H, sec.hardness))
+                res = {"model": "constant", "value": f"{R1!r} Pa"}
+            else:
+                res = {"model": "elastic-plastic", "yield_stress": f"{Y!r} Pa", "youngs_modulus": f"{E!r} Pa",
+                       "poisson_ratio": nu}
+            raw["target"] = {"density": f"{shot.target_density!r} kg/m^3", "thickness": f"{shot.thickness!r} m",
+                             "resistance": res}
+            raw["perforation"] = {"coefficients": "half-space", "back_face": "constant" if bf == "constant-R1" else bf,
+                                  "failure": "hole-growth"}
+            try:
+                setup = perforation_setup(parse_case(raw, case.path), cache_dir)
+            except InputError as exc:
+                row[bf] = None
+                row["skipped"] = exc.message
+                continue
+            row[bf] = ballistic_limit_search(setup.coefficients, setup.mass, 5000.0, tolerance=0.05).value
+        rows.append(row)
+    stats = {}
+    for bf in STUDY_BACK_FACES:
+        used = [r for r in rows if r.get(bf) is not None]
+        if not used:
+            continue
+        rel = [r[bf] / r["measured_V_m_s"] - 1.0 for r in used]
+        per = {}
+        for cls in sorted({r["class"] for r in used}):
+            e = [r[bf] / r["measured_V_m_s"] - 1.0 for r in used if r["class"] == cls]
+            per[cls] = float(np.mean(e))
+        stats[bf] = {"n": len(used), "mean_abs_relative_error": float(np.mean(np.abs(rel))),
+                     "mean_relative_error": float(np.mean(rel)), "class_mean_relative_error": per,
+                     "worst_class_bias": max(abs(v) for v in per.values())}
+    best = min(stats, key=lambda k: stats[k]["mean_abs_relative_error"]) if stats else None
+    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats, "best": best}
