@@ -181,14 +181,17 @@ def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
     if problem.objective == "residual_velocity":
         vr = np.asarray(residual_velocity(setup.coefficients, setup.mass, np.asarray(problem.velocities, float)), float)
         out["residual_velocities_m_s"] = vr.tolist()
+        if not np.any(vr > 0):  # issue 37: a design not perforated is infeasible, never a number
+            raise Infeasible("residual_velocity", "the plate stops the projectile at every striking velocity "
+                             "(no residual velocity to minimise)")
         out["objective"] = -float(np.mean(vr))
         return out
-    from semianalytic.sweep.perforation import MAX_UPPER, plate_ballistic_limit
+    from semianalytic.perforation.model import ballistic_limit_search
 
-    value, error = plate_ballistic_limit(setup, max(list(problem.velocities) + [500.0]))
-    if not np.isfinite(value):
-        raise InputError("--objective", f"ballistic_limit: the plate is not perforated below {MAX_UPPER / 1e3:g} km/s")
-    out.update(objective=value, ballistic_limit_m_s=value, ballistic_limit_error_m_s=error)
+    bl = ballistic_limit_search(setup.coefficients, setup.mass, setup.v_max)
+    if bl.bound == "lower":  # issue 37: not perforated inside the model's range
+        raise Infeasible("ballistic_limit", f"not perforated inside the model's range: {bl.reason}")
+    out.update(objective=bl.value, ballistic_limit_m_s=bl.value, ballistic_limit_error_m_s=bl.error)
     return out
 
 
@@ -459,7 +462,12 @@ def optimise(
     # the optimum: the best design the search evaluated (the optimiser's own answer is one of them)
     searched = [r for r in ev.history if r["phase"] in ("search", "grid") and r["status"] == "ok"]
     if not searched:
-        raise InputError("--vary", "no design within the bounds could be evaluated (see history: all invalid)")
+        why = sorted({r["message"] for r in ev.history if r["status"] == "infeasible"})[:1]
+        raise InputError("--vary", "no design within the bounds could be evaluated (see history: all invalid)"
+                         + (f"; every design infeasible, e.g. {why[0]}" if why else ""))
+    if problem.objective in PLATE_OBJECTIVES and len(searched) > 1 and len({r["objective"] for r in searched}) == 1:
+        raise InputError("--objective", f"{problem.objective} is the same ({searched[0]['objective']:.6g}) for every design "
+                         "evaluated: flat over the bounds, no optimum to report (change the striking velocities or the bounds)")
     best_x = np.asarray(min(searched, key=lambda r: r["objective"])["x"])
     best = ev.map([problem.overrides(best_x)], "optimum", gen["n"], [best_x])[0]
     search_seconds = time.perf_counter() - t0
