@@ -422,6 +422,17 @@ def _compare_data(setup: PerforationSetup, rows: list[dict], opts) -> dict:
     }
 
 
+def _fitting_ogive(proj: dict, shot) -> dict:
+    """The ASSUMED ogive of a Table 3 core, shortened where the case's CRH would be longer than the
+    core: psi = min(psi_case, 1/4 + (0.9 L/d)^2), so that L_h = d sqrt(psi - 1/4) <= 0.9 L (this
+    project's own assumption: the table gives no nose; the three short cores of 12-12.5 mm)."""
+    if proj.get("nose") != "ogive" or shot.projectile_length is None:
+        return {}
+    psi = float(proj.get("crh", 3.0))
+    fit = 0.25 + (0.9 * shot.projectile_length / shot.projectile_diameter) ** 2
+    return {"crh": min(psi, fit)} if fit < psi else {}
+
+
 def shot_table_validation(case, cache_dir=None) -> dict | None:
     """Measured ballistic limits of a Part IV shot table (the case's ``[ballistic_limit] table``,
     e.g. Table 3) against eq. (11) through the plate, beside Part IV's formulas.
@@ -458,7 +469,7 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
         for key in ("shank_length", "length", "density", "mass"):
             proj.pop(key, None)
         proj.update(diameter=f"{shot.projectile_diameter!r} m", length=f"{shot.projectile_length!r} m",
-                    mass=f"{shot.projectile_mass!r} kg")
+                    mass=f"{shot.projectile_mass!r} kg", **_fitting_ogive(proj, shot))
         R1 = float(resistance_R1(shot.target_hardness, shot.target_delta_H, sec.hardness))
         raw["target"] = {"density": f"{shot.target_density!r} kg/m^3", "thickness": f"{shot.thickness!r} m",
                          "resistance": {"model": "constant", "value": f"{R1!r} Pa"}}
@@ -518,7 +529,8 @@ def back_face_study(case, cache_dir=None) -> dict | None:
             continue
         E, nu = TABLE1_E[cls]
         Y = shot.target_hardness / 3.0
-        row = {"name": sid, "class": cls, "measured_V_m_s": shot.measured, "Y_Pa": Y, "E_Pa": E}
+        row = {"name": sid, "class": cls, "measured_V_m_s": shot.measured, "Y_Pa": Y, "E_Pa": E,
+               "nose_shortened": bool(_fitting_ogive(dict(case.raw["projectile"]), shot))}
         for bf in STUDY_BACK_FACES:
             raw = copy.deepcopy(dict(case.raw))
             raw.pop("ballistic_limit", None)
@@ -526,7 +538,7 @@ def back_face_study(case, cache_dir=None) -> dict | None:
             for key in ("shank_length", "length", "density", "mass"):
                 proj.pop(key, None)
             proj.update(diameter=f"{shot.projectile_diameter!r} m", length=f"{shot.projectile_length!r} m",
-                        mass=f"{shot.projectile_mass!r} kg")
+                        mass=f"{shot.projectile_mass!r} kg", **_fitting_ogive(proj, shot))
             if bf == "constant-R1":
                 R1 = float(resistance_R1(shot.target_hardness, shot.target_delta_H, sec.hardness))
                 res = {"model": "constant", "value": f"{R1!r} Pa"}
@@ -545,11 +557,17 @@ def back_face_study(case, cache_dir=None) -> dict | None:
                 continue
             row[bf] = ballistic_limit_search(setup.coefficients, setup.mass, 5000.0, tolerance=0.05).value
         rows.append(row)
-    stats = {}
+    stats, stats_long = {}, {}
     for bf in STUDY_BACK_FACES:
-        used = [r for r in rows if r.get(bf) is not None]
-        if not used:
-            continue
+        _face_stats(stats, bf, [r for r in rows if r.get(bf) is not None])
+        _face_stats(stats_long, bf, [r for r in rows if r.get(bf) is not None and not r["nose_shortened"]])
+    best = min(stats, key=lambda k: stats[k]["mean_abs_relative_error"]) if stats else None
+    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats,
+            "statistics_case_nose": stats_long, "best": best}
+
+
+def _face_stats(stats: dict, bf: str, used: list) -> None:
+    if used:
         rel = [r[bf] / r["measured_V_m_s"] - 1.0 for r in used]
         per = {}
         for cls in sorted({r["class"] for r in used}):
@@ -558,5 +576,3 @@ def back_face_study(case, cache_dir=None) -> dict | None:
         stats[bf] = {"n": len(used), "mean_abs_relative_error": float(np.mean(np.abs(rel))),
                      "mean_relative_error": float(np.mean(rel)), "class_mean_relative_error": per,
                      "worst_class_bias": max(abs(v) for v in per.values())}
-    best = min(stats, key=lambda k: stats[k]["mean_abs_relative_error"]) if stats else None
-    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats, "best": best}
