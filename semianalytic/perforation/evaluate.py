@@ -125,6 +125,47 @@ def _layer_inputs(case):
     return [("plate", 0.0, t.thickness, t.density, base)]
 
 
+# CPU seconds of eq. (11) through n layers, lower bounds measured on this project's machine (half-space
+# stand-in, 0.1 mm layers of 6061 and the 3-CRH ogive: 100 layers 24 s, 30 layers 3.5 s, each including the
+# error estimate's four integrations): the evaluation of the layered coefficients sums every layer at
+# every depth of an integration whose depths grow with n, so the work grows like n^2
+LAYER_PAIR_SECONDS = 1e-3
+PLATE_TABLE_SECONDS = 3.0  # one plate BEM table, the cheapest measured (demo plate: 10 s CPU at tolerance 1e-5)
+
+
+def check_layer_work(case, inputs, nose, cache_dir=None) -> float:
+    """Refuse, before any work, a target whose estimated time exceeds the time budget
+    (:func:`semianalytic.guards.check_work`, exit 2 naming ``target.layers`` or ``target.thickness``
+    with the estimate and what to change): n^2 LAYER_PAIR_SECONDS for the integration through n
+    layers plus PLATE_TABLE_SECONDS per plate table not in the cache.  Returns the estimate [s]."""
+    from semianalytic.guards import check_work
+    from semianalytic.perforation.case import PerforationSection
+
+    opts = case.section("perforation") or PerforationSection()
+    n = len(inputs)
+    seconds = LAYER_PAIR_SECONDS * n * n
+    new_tables = 0
+    if opts.coefficients == "plate":
+        try:
+            from semianalytic.cache import plate_table_key, table_dir
+
+            cs = case.coefficients
+            kw = dict(order=case.bem.order, tolerance=cs.tolerance)
+            if case.bem.refinement is not None:
+                kw["refinement"] = case.bem.refinement
+            for H in {float(x[2]) for x in inputs}:
+                if not (table_dir(cache_dir) / f"{plate_table_key(nose, H, **kw)}.npz").is_file():
+                    new_tables += 1
+        except Exception:  # noqa: BLE001 - the estimate only; a key that cannot be formed counts every table
+            new_tables = len({float(x[2]) for x in inputs})
+    seconds += PLATE_TABLE_SECONDS * new_tables
+    field = "target.layers" if case.target.layers else "target.thickness"
+    check_work(field, f"perforation of {n} layer(s) ({new_tables} new plate table(s))", seconds=seconds,
+               hint="use fewer, thicker layers (layers of one material and no gap can be one plate), or "
+                    "[perforation] coefficients = 'half-space' (no plate tables), or raise the time budget")
+    return seconds
+
+
 def validity_limit(psec, layers) -> tuple[float, str]:
     """(v_max [m/s], reason): the largest striking velocity at which the rigid-projectile model holds:
     Tate's (1967) criterion with the nose as a constrained indenter, (1/2) rho_t V^2 + R_t = 3 Y_p
@@ -161,6 +202,8 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
     layers, descs, approx, modes, notes = [], [], False, [], []
     front = 0.0
     inputs = _layer_inputs(case)
+    tables: dict = {}
+    check_layer_work(case, inputs, proj.nose, cache_dir)
     for k, (name, gap, H, rho, res) in enumerate(inputs):
         field = f"target.layers.{k}.thickness" if case.target.layers else "target.thickness"
         if not (MIN_THICKNESS_DIAMETERS * d <= H <= MAX_THICKNESS_DIAMETERS * d):
@@ -217,7 +260,9 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
                 if layer_back == "sphere-to-cylinder":
                     floor = sigma_s
         modes.append({"layer": k, "failure_mode": mode, "reason": why, "back_face": layer_back})
-        coef, desc, ap = plate_coefficients(case, H, cache_dir, shift)
+        if float(H) not in tables:  # one table per distinct thickness (layers of one thickness share it)
+            tables[float(H)] = plate_coefficients(case, H, cache_dir, shift)
+        coef, desc, ap = tables[float(H)]
         approx |= ap
         descs.append(desc)
         layers.append(PlateLayer(front, float(H), float(rho), R, coef, ratio, tau, floor))
@@ -480,7 +525,8 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
             rows.append({"name": shot.name, "skipped": exc.message})
             continue
         bl = ballistic_limit_search(setup.coefficients, setup.mass, 5000.0, tolerance=0.05)
-        row = {"name": shot.name, "measured_V_m_s": shot.measured, "model_V_m_s": bl.value, "R1_Pa": R1}
+        row = {"name": shot.name, "measured_V_m_s": shot.measured, "model_V_m_s": bl.value, "R1_Pa": R1,
+               "assumed_crh": float(proj.get("crh", float("nan")))}
         row.update({PART4_NAMES[k]: p4[k] for k in PART4_NAMES if p4.get(k) is not None})
         rows.append(row)
     used = [r for r in rows if "model_V_m_s" in r]

@@ -170,15 +170,31 @@ class LayeredCoefficients:
     def deep_limit(self):
         return self._deep
 
+    def _groups(self):
+        """Layers grouped by everything but their front (one table evaluation per group)."""
+        g = getattr(self, "_group_cache", None)
+        if g is None:
+            d: dict = {}
+            for ly in self.layers:
+                key = (id(ly.coefficients), ly.thickness, ly.density, ly.resistance, ly.plastic_ratio,
+                       ly.cylinder_resistance)
+                d.setdefault(key, []).append(ly)
+            g = [(lys[0], np.array([ly.front for ly in lys])) for lys in d.values()]
+            self._group_cache = g
+        return g
+
     def _sum(self, P, which: str):
         P = np.asarray(P, float)
-        out = np.zeros(P.shape)
-        for ly in self.layers:
-            x = P - ly.front
-            inside = (x > 0) & (x < ly.thickness + self.nose_length)
+        flat = P.ravel()
+        out = np.zeros(flat.shape)
+        span = None
+        for ly, fronts in self._groups():
+            span = ly.thickness + self.nose_length
+            x = flat[None, :] - fronts[:, None]
+            inside = (x > 0) & (x < span)
             if not np.any(inside):
                 continue
-            xs = np.where(inside, x, 0.0)
+            xs = x[inside]
             coef = ly.coefficients
             if which == "A":
                 v = ly.density * np.asarray(coef.A(xs), float)
@@ -191,7 +207,10 @@ class LayeredCoefficients:
                     if ly.cylinder_resistance is not None:
                         R = np.maximum(R, ly.cylinder_resistance)
                 v = R * np.asarray(coef.C(xs), float)
-            out = out + np.where(inside, v, 0.0)
+            contrib = np.zeros(x.shape)
+            contrib[inside] = np.broadcast_to(v, xs.shape)
+            out = out + contrib.sum(axis=0)
+        out = out.reshape(P.shape)
         if which == "C":
             out = np.where(P >= self.exit_depth, self.continuation, out)
         return out[()]
