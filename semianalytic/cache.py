@@ -100,7 +100,7 @@ def cached_plate_table(nose, thickness: float, cache_dir: str | os.PathLike | No
     from semianalytic.io import CacheWarning, read_cache_entry, write_cache_entry
 
     reading = options.pop("reading", "body")
-    key = plate_table_key(nose, thickness, **options)
+    key = plate_table_key(nose, thickness, **{k: v for k, v in options.items() if k != "progress"})
     path = table_dir(cache_dir) / f"{key}.npz"
     payload = read_cache_entry(path, key, "plate-table cache")  # key and checksum verified
     if payload is not None:

@@ -425,11 +425,14 @@ class _Builder:
         self.solved: dict = {}
         self.solves = 0
         self.noise_limited = 0
+        self.bar = None  # a tqdm bar of the depths solved (progress = True)
 
     def solve(self, P: float):
         if P not in self.solved:
             r = plate_depth_coefficients(self.nose, self.H, P, self.opts, self.kinks)
             self.solves += 1
+            if self.bar is not None:
+                self.bar.update(1)
             self.solved[P] = (_row(r, self.H), r.nodes, r.unknowns)
         row, nodes, n = self.solved[P]
         return dict(row), nodes, n
@@ -570,11 +573,13 @@ def plate_coefficient_table(
     depths=None,
     max_solves: int = MAX_SOLVES,
     bem_error: bool = True,
+    progress: bool = False,
 ) -> PlateCoefficientTable:
     """Tabulate A, B, C of a nose perforating a plate of thickness H [m], 0 <= P <= H + L_h
     (zero beyond), with error estimates (module docstring).  ``tolerance``: relative
     interpolation tolerance (default 1e-5 of each coefficient's largest magnitude);
-    ``depths``: fixed knots instead (error estimates from dropping every other knot)."""
+    ``depths``: fixed knots instead (error estimates from dropping every other knot); ``progress``:
+    a progress line of the depths solved on stderr (when it is a terminal)."""
     from semianalytic.bem.panels import LayoutOptions
 
     thickness = check_thickness(nose, thickness)
@@ -583,6 +588,13 @@ def plate_coefficient_table(
     tol = check_tolerance(DEFAULT_TOLERANCE if tolerance is None else tolerance)
     opts = LayoutOptions(order, refinement, levels)
     b = _Builder(nose, float(thickness), opts, tol, max_solves)
+    if progress:
+        import sys
+
+        from tqdm import tqdm
+
+        b.bar = tqdm(desc=f"plate BEM depths (H = {thickness * 1e3:.4g} mm)", unit="depth", leave=False, file=sys.stderr,
+                     disable=not sys.stderr.isatty())
     options = {"order": order, "refinement": refinement, "levels": levels}
     if depths is not None:
         for pk in b.knots:
@@ -598,4 +610,6 @@ def plate_coefficient_table(
         options["tolerance"] = tol
         options["noise_limited_intervals"] = b.noise_limited
     bem_err = b.bem_errors() if bem_error else {}
+    if b.bar is not None:
+        b.bar.close()
     return b.table(options, bem_err, tol).with_reading(reading)

@@ -54,7 +54,10 @@ def plate_coefficients(case, thickness: float, cache_dir=None, shift: str | None
     kwargs = dict(order=case.bem.order, tolerance=cs.tolerance, reading=cs.reading)
     if case.bem.refinement is not None:
         kwargs["refinement"] = case.bem.refinement
-    table = cached_plate_table(nose_from_section(case.require("projectile")), float(thickness), cache_dir, **kwargs)
+    import sys
+
+    table = cached_plate_table(nose_from_section(case.require("projectile")), float(thickness), cache_dir,
+                               progress=sys.stderr.isatty(), **kwargs)
     desc = (f"plate BEM table (phi = 0 on the back face; order {case.bem.order}, {len(table.depth)} knots, tolerance "
             f"{cs.tolerance:g}, 0 <= P <= H + L_h; B reading '{cs.reading}')")
     if shift is not None:
