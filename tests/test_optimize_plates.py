@@ -99,3 +99,25 @@ def test_optimize_a_plate_objective(plate_case, tmp_path, objective):
     else:  # 800 m/s is one of the case's striking velocities
         Vr = ref["residual_velocity_m_s"][ref["striking_velocity_m_s"].index(800.0)]
         assert res["optimum"]["residual_velocities_m_s"][0] == pytest.approx(Vr, rel=1e-9)
+
+
+def test_plate_objectives_refuse_nonsense(plate_case, tmp_path):
+    """Issue 37: a 2 m plate that nothing perforates inside the model's range: every design is
+    infeasible (never a number) and optimize exits 2 with the reason; residual_velocity at 50 m/s,
+    below every design's V_bl (the demo plate: ~330 m/s): every design stops, exit 2."""
+    import contextlib
+    import io
+
+    from semianalytic.cli import main
+
+    thick = tmp_path / "thick.toml"
+    thick.write_text(plate_case.read_text().replace('thickness = "26.3 mm"', 'thickness = "2 m"'))
+    for case, objective, extra in ((thick, "ballistic_limit", []),
+                                   (plate_case, "residual_velocity", ["--striking-velocity", "50 m/s"])):
+        err = io.StringIO()
+        with contextlib.redirect_stderr(err):
+            rc = main(["optimize", str(case), "--out", str(tmp_path / objective), "--vary", "projectile.crh=1.5:4.5",
+                       "--objective", objective, "--constraint", "mass", "--coarse", "3", "--maxfev", "2", "--confirm", "0",
+                       "--scheduler", "inline", "--no-progress", *extra])
+        assert rc == 2, err.getvalue()
+        assert "infeasible" in err.getvalue() and ("model's range" in err.getvalue() or "stops" in err.getvalue())

@@ -157,3 +157,20 @@ def test_thickness_outside_every_model_is_refused(tmp_path):
     r = _main("perforate", _case(tmp_path, "ogive", "0.001 mm"))
     assert r.returncode == 2
     assert "target.thickness" in r.stderr
+
+
+def test_layer_list_past_the_budget_is_refused_before_work(tmp_path):
+    """1000 layers of 0.1 mm: the estimate n^2 x 1e-3 s = 1000 s is above the 10 min budget, so exit 2
+    naming target.layers with the estimate and what to change, in well under the time the work would
+    take (measured: 100 layers take 16-24 s CPU, so 1000 would take ~30 min)."""
+    import time
+
+    text = _case(tmp_path, "ogive").read_text().replace('thickness = "12 mm"\n', "")
+    layers = "".join('[[target.layers]]\nthickness = "0.1 mm"\n' for _ in range(1000))
+    p = tmp_path / "layers.toml"
+    p.write_text(text.replace("[target.resistance]", layers + "[target.resistance]"))
+    t0 = time.perf_counter()
+    r = _main("perforate", p)
+    assert r.returncode == 2
+    assert r.stderr.startswith("error: target.layers:") and "min" in r.stderr and "fewer, thicker layers" in r.stderr
+    assert time.perf_counter() - t0 < 60.0

@@ -168,11 +168,11 @@ def depth_record(problem: Problem, case, nose, cache_dir=None, per_piece: int | 
 
 
 def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
-    """``ballistic_limit``: V_bl by bisection on Part I, eq. (11) through the plate
-    (:func:`semianalytic.sweep.perforation.plate_ballistic_limit`, the sweep's: the upper bracket
-    doubled from the largest striking velocity, or 500 m/s, until it perforates, at most 20 km/s), minimised;
-    ``residual_velocity``: minus the mean V_r over the striking velocities
-    (:func:`semianalytic.perforation.residual_velocity`)."""
+    """``ballistic_limit``: V_bl of Part I, eq. (11) through the plate found by the model itself
+    (:func:`semianalytic.perforation.ballistic_limit_search`, up to the rigid-projectile limit),
+    minimised; ``residual_velocity``: minus the mean V_r over the striking velocities
+    (:func:`semianalytic.perforation.residual_velocity`).  A design not perforated inside the model's
+    range (or stopped at every velocity) raises :class:`Infeasible` (issue 37: never a number)."""
     from semianalytic.perforation import residual_velocity
     from semianalytic.perforation.evaluate import perforation_setup
 
@@ -465,8 +465,10 @@ def optimise(
         why = sorted({r["message"] for r in ev.history if r["status"] == "infeasible"})[:1]
         raise InputError("--vary", "no design within the bounds could be evaluated (see history: all invalid)"
                          + (f"; every design infeasible, e.g. {why[0]}" if why else ""))
-    if problem.objective in PLATE_OBJECTIVES and len(searched) > 1 and len({r["objective"] for r in searched}) == 1:
-        raise InputError("--objective", f"{problem.objective} is the same ({searched[0]['objective']:.6g}) for every design "
+    objs = [r["objective"] for r in searched]
+    if (problem.objective in PLATE_OBJECTIVES and len(objs) > 1
+            and max(objs) - min(objs) <= 1e-6 * max(max(abs(v) for v in objs), 1e-300)):
+        raise InputError("--objective", f"{problem.objective} is the same ({objs[0]:.6g}, within 1e-6) for every design "
                          "evaluated: flat over the bounds, no optimum to report (change the striking velocities or the bounds)")
     best_x = np.asarray(min(searched, key=lambda r: r["objective"])["x"])
     best = ev.map([problem.overrides(best_x)], "optimum", gen["n"], [best_x])[0]

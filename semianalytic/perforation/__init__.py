@@ -1,5 +1,7 @@
 """Perforation of finite and layered targets (issue 23): Part I, eq. (11) through plates with
-a back face, residual velocity, the ballistic limit by bisection, the Lambert-Jonas fit.
+a back face, residual velocity, the ballistic limit found by the model itself
+(``ballistic_limit_search``), the thin-plate models and failure modes (:mod:`.thin_plate`), the
+Lambert-Jonas fit.
 
 Models: :mod:`.model` (pure; ``ballistic_limit`` and ``residual_velocity`` are the entry points
 for sweeps and the optimiser); case layer: :mod:`.case`; the ``perforate`` command:
@@ -7,7 +9,7 @@ for sweeps and the optimiser); case layer: :mod:`.case`; the ``perforate`` comma
 on first use (the case layer imports :mod:`.case` at start-up).
 """
 
-__all__ = ["ballistic_limit", "residual_velocity"]
+__all__ = ["ballistic_limit", "ballistic_limit_search", "residual_velocity"]
 
 
 def __getattr__(name):

@@ -32,18 +32,15 @@ def has_plate(case: Case) -> bool:
 
 def plate_ballistic_limit(setup, start: float):
     """(V_bl, its error) [m/s] of a :class:`~semianalytic.perforation.evaluate.PerforationSetup`:
-    the upper bracket doubled from ``start`` until the plate is perforated (NaN beyond MAX_UPPER)."""
-    from semianalytic.perforation import ballistic_limit
+    the model's own search (:func:`semianalytic.perforation.ballistic_limit_search`, up to the
+    rigid-projectile limit ``setup.v_max``); NaN where nothing perforates inside the model's range
+    (issue 37: never a number for an unperforated design).  ``start`` is kept for the callers."""
+    from semianalytic.perforation import ballistic_limit_search
 
-    upper = max(float(start), 100.0)
-    while True:
-        try:
-            bl = ballistic_limit(setup.coefficients, setup.mass, upper)
-            return float(bl.value), float(bl.error)
-        except ValueError:  # the upper bracket does not perforate
-            if upper >= MAX_UPPER:
-                return float("nan"), float("nan")
-            upper = min(2.0 * upper, MAX_UPPER)
+    bl = ballistic_limit_search(setup.coefficients, setup.mass, setup.v_max)
+    if bl.bound == "lower":
+        return float("nan"), float("nan")
+    return float(bl.value), float(bl.error)
 
 
 @dataclass(frozen=True)
