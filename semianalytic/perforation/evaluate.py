@@ -548,6 +548,7 @@ TABLE1_E = {"Al-alloys": (71e9, 0.33), "Steels": (210e9, 0.29), "Ti-alloy": (110
 """E and nu of each target class as Part IV, Table 1 assumes them (cases/part4_table1.csv)."""
 
 STUDY_BACK_FACES = ("constant-R1", "constant", "finite-sphere", "cylindrical", "sphere-to-cylinder")
+STUDY_CLOSED_FORMS = ("recht-ipson", "hole (quasi-static)")  # thin_plate closed forms beside them
 
 
 def back_face_study(case, cache_dir=None) -> dict | None:
@@ -580,6 +581,11 @@ def back_face_study(case, cache_dir=None) -> dict | None:
         Y = shot.target_hardness / 3.0
         row = {"name": sid, "class": cls, "measured_V_m_s": shot.measured, "Y_Pa": Y, "E_Pa": E,
                "nose_shortened": bool(_fitting_ogive(dict(case.raw["projectile"]), shot))}
+        from semianalytic.perforation import thin_plate as tp
+
+        d, H, m = shot.projectile_diameter, shot.thickness, shot.projectile_mass
+        row["recht-ipson"] = tp.plugging_limit(m, d, H, Y / math.sqrt(3.0), shot.target_density)
+        row["hole (quasi-static)"] = tp.hole_enlargement_limit(m, 0.5 * d, H, tp.cylindrical_cavity_stress(Y, E))
         for bf in STUDY_BACK_FACES:
             raw = copy.deepcopy(dict(case.raw))
             raw.pop("ballistic_limit", None)
@@ -607,10 +613,11 @@ def back_face_study(case, cache_dir=None) -> dict | None:
             row[bf] = ballistic_limit_search(setup.coefficients, setup.mass, 5000.0, tolerance=0.05).value
         rows.append(row)
     stats, stats_long = {}, {}
-    for bf in STUDY_BACK_FACES:
+    for bf in STUDY_BACK_FACES + STUDY_CLOSED_FORMS:
         _face_stats(stats, bf, [r for r in rows if r.get(bf) is not None])
         _face_stats(stats_long, bf, [r for r in rows if r.get(bf) is not None and not r["nose_shortened"]])
-    best = min(stats, key=lambda k: stats[k]["mean_abs_relative_error"]) if stats else None
+    faces = [k for k in stats if k in STUDY_BACK_FACES]
+    best = min(faces, key=lambda k: stats[k]["mean_abs_relative_error"]) if faces else None
     return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats,
             "statistics_case_nose": stats_long, "best": best}
 

@@ -157,7 +157,10 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
                       "E and nu of Part IV Table 1's class, R_t of Part I eq. (16) from them (`constant-R1`: Part IV's R(1) = "
                       "HM delta_H, the resistance of eq. (5)), the nose ASSUMED (" + str(bs["nose"]) + ") and the half-space "
                       "stand-in coefficients. Most of these plates are thinner than the spherical plastic zone, so "
-                      "`cylindrical` and `sphere-to-cylinder` coincide there; they differ on Steel 40 (40.5 mm).", "",
+                      "`cylindrical` and `sphere-to-cylinder` coincide there; they differ on Steel 40 (40.5 mm). Beside them "
+                      "the closed forms of `semianalytic.perforation.thin_plate` with the same Y and E: `recht-ipson` "
+                      "(shear plugging, Recht & Ipson 1963, tau = Y/sqrt 3) and `hole (quasi-static)` (sqrt(2 pi a^2 H "
+                      "sigma_s / m), Forrestal et al. 1987).", "",
                       "| shot | class | measured [m/s] | " + " | ".join(faces) + " |", "|---|---|---|" + "---|" * len(faces)]
             for row in bs["rows"]:
                 if all(row.get(f) is None for f in faces):
@@ -175,7 +178,14 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
                         f"{v['class_mean_relative_error'].get(c, float('nan')):+.1%}" for c in classes) + " |")
             lines += ["", "(`all`: every single plate with a measured V_bl; `case's nose`: without the three 12-12.5 mm "
                       "cores, whose ASSUMED ogive is shortened to fit them, psi = 1/4 + (0.9 L/d)^2. P2 (3 mm, HV 3.22 GPa, "
-                      "328 m/s) is below P1 (HV 1.81 GPa, 470 m/s) with the same core, which no model here can follow.)"]
+                      "328 m/s) is below P1 (HV 1.81 GPa, 470 m/s) with the same core, which no model here can follow.)", "",
+                      "Finding: shear plugging (Recht & Ipson) predicts the high-strength aluminium alloys 8112 and 8312 "
+                      "(435, 447 m/s against 438, 456) and the titanium alloy (562 against 490) better than hole enlargement "
+                      "(606-671 m/s), while hole enlargement predicts the soft alloys (6112, AMG 5) and the steels; the "
+                      "failure mode therefore depends on the material (adiabatic shear of high-strength Al and Ti), which "
+                      "the nose-and-thickness criterion here does not see. The minimum-work rule (the cheaper of the two, "
+                      "Woodward 1978) would choose plugging for every plate but Steel 40 and miss the soft alloys by "
+                      "-42 to -63 %: not adopted."]
             lines += ["", f"Lowest mean |error|: `{bs['best']}` (Part IV's own resistance R(1)); of the back faces that take "
                       "Y and E, `cylindrical` = `sphere-to-cylinder` lowest, the default `auto` (`sphere-to-cylinder` keeps "
                       "Part I's spherical resistance where its plastic zone fits, so a thick plate tends to the half-space); "
