@@ -174,3 +174,23 @@ def test_layer_list_past_the_budget_is_refused_before_work(tmp_path):
     assert r.returncode == 2
     assert r.stderr.startswith("error: target.layers:") and "min" in r.stderr and "fewer, thicker layers" in r.stderr
     assert time.perf_counter() - t0 < 60.0
+
+
+@pytest.mark.slow
+def test_one_mm_plate_on_the_plate_table_creates_no_energy(tmp_path):
+    """Issue 37's report: a 1 mm plate on the plate BEM table gave V_r = 300.1, 600.2, 1000.3 m/s at
+    300, 600, 1000 m/s and V_bl = 1.15 m/s.  Now V_r < V_s at every velocity, the thin-plate model
+    (petalling, 1 mm < d/2) says so, and V_bl is at least Thomson's sqrt(pi a^2 H Y / m) by hand:
+    sqrt(pi 3.555e-3^2 1e-3 400e6 / m) with m the demo rod's mass (a plate table build: ~30 s)."""
+    from tests.test_perforation import DEMO
+
+    text = DEMO.read_text().replace('thickness = "26.3 mm"', 'thickness = "1 mm"')
+    text = text.replace('striking_velocities = [', 'striking_velocities = ["300 m/s", "600 m/s", "1000 m/s"] #')
+    p = tmp_path / "one_mm.toml"
+    p.write_text(text)
+    r = _json(p)
+    assert "plate BEM table" in r["coefficients"]
+    assert all(vr < vs for vr, vs in zip(r["residual_velocity_m_s"], r["striking_velocity_m_s"]))
+    assert r["failure_mode"] == "petalling"
+    m = r["mass_kg"]
+    assert r["ballistic_limit_m_s"] >= math.sqrt(math.pi * 3.555e-3**2 * 1e-3 * 400e6 / m) * (1 - 1e-3)
