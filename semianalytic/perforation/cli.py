@@ -1,8 +1,8 @@
 """``python -m semianalytic perforate CASE.toml [--json]``: perforation of the case's plate or
 layered target (``[target] thickness`` or ``[[target.layers]]``) by the rigid projectile of
 Part I, eq. (11): per striking velocity ``perforated``, ``residual_velocity_m_s`` (0 where it
-stops; then ``depth_m``), ``exit_time_s``; ``ballistic_limit_m_s`` by bisection with its error
-estimate; the Lambert-Jonas fit ``lambert_jonas``; Part IV's V_cr formulas ``part4_v_cr_m_s``.
+stops; then ``depth_m``), ``exit_time_s``; ``failure_mode``; ``ballistic_limit_m_s`` found by the
+command itself with its error estimate (``ballistic_limit_bound``: "lower" above the validity limit); the Lambert-Jonas fit ``lambert_jonas``; Part IV's V_cr formulas ``part4_v_cr_m_s``.
 ``--report DIR`` writes ``validation_perforation.md`` (:mod:`semianalytic.perforation.report`)
 for one or more cases."""
 
@@ -17,7 +17,7 @@ def add_arguments(parser) -> None:
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target] thickness or layers, [impact]")
     parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
-    parser.add_argument("--no-ballistic-limit", action="store_true", help="skip the bisection for the ballistic limit")
+    parser.add_argument("--no-ballistic-limit", action="store_true", help="skip the ballistic-limit search")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
     parser.add_argument("--report", metavar="DIR", default=None, type=output_dir,
                         help="write validation_perforation.md (and its figure and CSV) into DIR")
@@ -37,7 +37,7 @@ def _text(r: dict) -> str:
             lines.append(f"  ballistic limit: > {r['ballistic_limit_m_s']:.2f} m/s (lower bound: {r.get('ballistic_limit_reason', '')})")
         else:
             lines.append(f"  ballistic limit (the command's own search on eq. (11)): {r['ballistic_limit_m_s']:.2f} +- "
-                         f"{r['ballistic_limit_error_m_s']:.2f} m/s")
+                         f"{r['ballistic_limit_error_m_s']:.2g} m/s")
     lj = r["lambert_jonas"]
     if lj:
         lines.append(f"  Lambert-Jonas fit: a = {lj['a']:.4f}, p = {lj['p']:.3f}, V_bl = {lj['V_bl_m_s']:.1f} m/s")

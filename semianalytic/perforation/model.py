@@ -316,13 +316,13 @@ def _exit_time(profile, U, P_exit, edges):
     return t
 
 
-def resistance_work(coefficients: LayeredCoefficients, upto: float | None = None) -> tuple[np.ndarray, np.ndarray]:
+def resistance_work(coefficients: LayeredCoefficients, upto: float | None = None, panels: int = 256) -> tuple[np.ndarray, np.ndarray]:
     """(P, W(P)): the work of the resistance alone, W(P) = int_0^P sum_k f_k R_k C_k dP [J] (no inertial
     term), on a grid to ``upto`` (default the exit depth).  W(P_exit) is what the plate takes from the
-    projectile at the least; Gauss-Legendre (16 points) on the breakpoints refined to P_exit/256."""
+    projectile at the least; Gauss-Legendre (16 points) on the breakpoints refined to P_exit/``panels``."""
     Pe = coefficients.exit_depth if upto is None else float(upto)
     edges = coefficients.depth[coefficients.depth < Pe]
-    edges = _refine(np.append(edges, Pe), Pe / 256.0)
+    edges = _refine(np.append(edges, Pe), Pe / float(panels))
     x, w = _gauss()
     a, b = edges[:-1], edges[1:]
     P = a[:, None] + 0.5 * (b - a)[:, None] * (x[None, :] + 1.0)
@@ -633,9 +633,10 @@ def _bracket(coef, mass, v_max, prof, panel_scale=1.0, start=None):
 
 def _limit_value(coef, m, panel_scale=1.0):
     """V_bl without a plug: perforates <=> V^2 > G(P_exit) (eq. (11) in P) and V^2 > 2 W / m (the energy
-    bound of :func:`perforation_curve`), so V_bl = max(sqrt G(P_exit), sqrt(2 W / m)) exactly."""
+    bound of :func:`perforation_curve`), so V_bl = max(sqrt G(P_exit), sqrt(2 W / m)) exactly.
+    ``panel_scale`` < 1 refines both integrations (the error estimate's second evaluation)."""
     Pe = coef.exit_depth
-    _, Wc = resistance_work(coef)
+    _, Wc = resistance_work(coef, panels=int(round(256 / panel_scale)))
     v_w = math.sqrt(2.0 * float(Wc[-1]) / m)
     prof = _profile_to_exit(coef, m, max(v_w, 1.0), panel_scale)
     return max(math.sqrt(max(float(prof.G(Pe)), 0.0)), v_w)

@@ -107,7 +107,7 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
                              f"{r.get('ballistic_limit_reason', '')}).")
             else:
                 lines.append(f"Ballistic limit (the command's own search on eq. (11)): **{r['ballistic_limit_m_s']:.1f} m/s**, "
-                             f"numerical error estimate {r['ballistic_limit_error_m_s']:.2f} m/s.")
+                             f"numerical error estimate {r['ballistic_limit_error_m_s']:.2g} m/s.")
         lj = r.get("lambert_jonas")
         if lj:
             lines.append(f"Lambert-Jonas fit of the computed curve: a = {lj['a']:.4f}, p = {lj['p']:.3f}, "
