@@ -194,3 +194,22 @@ def test_one_mm_plate_on_the_plate_table_creates_no_energy(tmp_path):
     assert r["failure_mode"] == "petalling"
     m = r["mass_kg"]
     assert r["ballistic_limit_m_s"] >= math.sqrt(math.pi * 3.555e-3**2 * 1e-3 * 400e6 / m) * (1 - 1e-3)
+
+
+@pytest.mark.parametrize("nose, thickness", [("ogive", "12 mm"), ("sphere", "100 mm"), ("cone", "1 mm")])
+def test_closed_form_limit_equals_the_bisection_on_the_curve(tmp_path, nose, thickness):
+    """Without a plug the search takes V_bl = max(sqrt G(P_exit), sqrt(2W/m)) in closed form; a second
+    method, the bracket from the physics and bisection on perforation_curve's 'perforated' flags (the
+    path plugs take), finds the same V_bl within its bracket (0.05 m/s)."""
+    from semianalytic.case import load_case
+    from semianalytic.perforation.evaluate import perforation_setup
+    from semianalytic.perforation.model import (_bisect_curve, _bracket, _profile_to_exit, ballistic_limit_search)
+
+    setup = perforation_setup(load_case(_case(tmp_path, nose, thickness)))
+    c, m = setup.coefficients, setup.mass
+    closed = ballistic_limit_search(c, m, setup.v_max).value
+    prof = _profile_to_exit(c, m, setup.v_max, 1.0)
+    lo, hi, status = _bracket(c, m, setup.v_max, prof)
+    assert status == "ok" and lo < closed <= hi
+    V, half, _ = _bisect_curve(c, m, lo, hi, 0.05, prof)
+    assert abs(V - closed) <= half + 1e-9

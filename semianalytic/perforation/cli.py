@@ -61,7 +61,7 @@ def run(args) -> int:
 
         import numpy as np
 
-        sweep = [1e-4, 3e-4, 1e-3, 3e-3, 1e-2, 2.63e-2, 6e-2, 0.2, 1.0, 2.0]
+        sweep = [1e-4, 3e-4, 1e-3, 3e-3, 3.5e-3, 3.6e-3, 1e-2, 2.63e-2, 6e-2, 0.2, 1.0, 2.0]
         results[0]["thickness_sweep"] = thickness_sweep(cases[0], sweep, np.geomspace(20.0, 3000.0, 50), args.cache_dir)
 
         path = write_report(results, args.report, argv=["perforate", *args.cases, "--report", str(args.report)])
