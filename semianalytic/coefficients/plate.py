@@ -415,6 +415,60 @@ class PlateCoefficientTable(CoefficientAccessors):
                        tolerance=meta["tolerance"], kinks=tuple(meta["kinks"]))
 
 
+SCALE_POWERS = {"A": 3, "B": 2, "C": 2, "phi_tip": 1, "dA_dP": 2}
+"""Powers of the length scale of each coefficient (A [m^3], B and C [m^2], phi_tip [m])."""
+
+
+class ScaledPlateTable:
+    """The plate table of a nose scaled by ``scale`` s (lengths x s): the potential problem has no
+    length of its own, so X(P) = s^k X_1(P / s) with k of :data:`SCALE_POWERS` (A: 3, B, C: 2,
+    phi_tip: 1), errors alike.  One table per nose shape and thickness ratio H/d serves every
+    calibre (the cache holds the table of the nose of unit diameter)."""
+
+    def __init__(self, table, scale: float):
+        self.table, self.scale = table, float(scale)
+        s = self.scale
+        self.diameter = table.diameter * s
+        self.nose_length = table.nose_length * s
+        self.thickness = table.thickness * s
+        self.depth = np.asarray(table.depth) * s
+        self.reading = table.reading
+        self.tolerance = table.tolerance
+        self.options = dict(table.options, scale=s)
+        self.bem_errors = {k: v * s ** SCALE_POWERS.get(k.split("_")[0] if k.startswith("B_") else k, 2)
+                           for k, v in table.bem_errors.items()}
+        self.kinks = tuple(k * s for k in table.kinks)
+
+    @property
+    def end(self) -> float:
+        return self.table.end * self.scale
+
+    def _p(self, P):
+        return np.asarray(P, float) / self.scale if not isinstance(P, float) else P / self.scale
+
+    def A(self, P):
+        return self.table.A(self._p(P)) * self.scale**3
+
+    def B(self, P, reading: str | None = None):
+        return self.table.B(self._p(P), reading) * self.scale**2
+
+    def C(self, P):
+        return self.table.C(self._p(P)) * self.scale**2
+
+    def phi_tip(self, P):
+        return self.table.phi_tip(self._p(P)) * self.scale
+
+    def dA_dP(self, P):
+        return self.table.dA_dP(self._p(P)) * self.scale**2
+
+    def error(self, name: str, P):
+        k = SCALE_POWERS["B"] if name.startswith("B") else SCALE_POWERS.get(name, 2)
+        return self.table.error(name, self._p(P)) * self.scale**k
+
+    def with_reading(self, reading: str) -> "ScaledPlateTable":
+        return ScaledPlateTable(self.table.with_reading(reading), self.scale)
+
+
 class _Builder:
     def __init__(self, nose: Nose, thickness: float, opts, tol: float, max_solves: int):
         self.nose, self.H, self.opts, self.tol, self.max_solves = nose, thickness, opts, tol, max_solves

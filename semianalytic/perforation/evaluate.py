@@ -56,8 +56,12 @@ def plate_coefficients(case, thickness: float, cache_dir=None, shift: str | None
         kwargs["refinement"] = case.bem.refinement
     import sys
 
-    table = cached_plate_table(nose_from_section(case.require("projectile")), float(thickness), cache_dir,
-                               progress=sys.stderr.isatty(), **kwargs)
+    from semianalytic.coefficients.plate import ScaledPlateTable
+
+    nose, H_key, scale = plate_table_request(case, float(thickness))
+    table = cached_plate_table(nose, H_key, cache_dir, progress=sys.stderr.isatty(), **kwargs)
+    if scale != 1.0:
+        table = ScaledPlateTable(table, scale)
     desc = (f"plate BEM table (phi = 0 on the back face; order {case.bem.order}, {len(table.depth)} knots, tolerance "
             f"{cs.tolerance:g}, 0 <= P <= H + L_h; B reading '{cs.reading}')")
     if shift is not None:
@@ -65,6 +69,29 @@ def plate_coefficients(case, thickness: float, cache_dir=None, shift: str | None
 
         table = ShiftedCoefficients(table, shift)
     return table, desc, False
+
+
+def plate_table_request(case, thickness: float):
+    """(nose, H, scale) of the cached plate table that serves the case's nose in a plate of
+    ``thickness``: for the ogive, sphere, cone and flat noses (shapes fixed by the diameter and
+    dimensionless parameters) the nose of unit diameter in a plate of H/d, scaled back by d
+    (:class:`semianalytic.coefficients.plate.ScaledPlateTable`: one table per thickness ratio serves
+    every calibre); other noses as they are (scale 1)."""
+    from semianalytic.geometry import cone_nose, flat_nose, nose_from_section, ogive_nose
+
+    sec = case.require("projectile")
+    d = float(sec.diameter)
+    meplat = (getattr(sec, "meplat_diameter", None) or 0.0) / d
+    tip = (getattr(sec, "tip_radius", None) or 0.0) / d
+    if sec.nose == "ogive":
+        return ogive_nose(1.0, sec.crh, meplat, tip), thickness / d, d
+    if sec.nose == "sphere":
+        return ogive_nose(1.0, 0.5), thickness / d, d
+    if sec.nose == "cone":
+        return cone_nose(1.0, sec.half_angle, meplat, tip), thickness / d, d
+    if sec.nose == "flat":
+        return flat_nose(1.0, (getattr(sec, "corner_radius", None) or 0.0) / d), thickness / d, d
+    return nose_from_section(sec), thickness, 1.0
 
 
 def _half_space_stand_in(case, thickness: float, cache_dir=None, shift: str | None = None):
@@ -157,7 +184,8 @@ def check_layer_work(case, inputs, nose, cache_dir=None) -> float:
             if case.bem.refinement is not None:
                 kw["refinement"] = case.bem.refinement
             for H in {float(x[2]) for x in inputs}:
-                if not (table_dir(cache_dir) / f"{plate_table_key(nose, H, **kw)}.npz").is_file():
+                knose, kH, _ = plate_table_request(case, H)
+                if not (table_dir(cache_dir) / f"{plate_table_key(knose, kH, **kw)}.npz").is_file():
                     new_tables += 1
         except Exception:  # noqa: BLE001 - the estimate only; a key that cannot be formed counts every table
             new_tables = len({float(x[2]) for x in inputs})
