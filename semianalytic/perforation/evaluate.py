@@ -561,15 +561,21 @@ def shot_table_validation(case, cache_dir=None) -> dict | None:
         row.update({PART4_NAMES[k]: p4[k] for k in PART4_NAMES if p4.get(k) is not None})
         rows.append(row)
     used = [r for r in rows if "model_V_m_s" in r]
-    names = ["model_V_m_s", *PART4_NAMES.values()]
-    stats = {}
-    for n in names:
-        errs = [abs(r[n] - r["measured_V_m_s"]) for r in used if r.get(n) is not None]
-        if errs:
-            stats[n] = {"n": len(errs), "mean_abs_error_m_s": float(np.mean(errs)),
-                        "mean_abs_relative_error": float(np.mean([abs(r[n] / r["measured_V_m_s"] - 1) for r in used
-                                                                  if r.get(n) is not None]))}
-    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": stats}
+    crh = float(case.raw.get("projectile", {}).get("crh", float("nan")))
+    own = [r for r in used if not r.get("assumed_crh", crh) < crh]  # the case's nose (not shortened)
+
+    def table_stats(subset):
+        out = {}
+        for n in ["model_V_m_s", *PART4_NAMES.values()]:
+            errs = [abs(r[n] - r["measured_V_m_s"]) for r in subset if r.get(n) is not None]
+            if errs:
+                out[n] = {"n": len(errs), "mean_abs_error_m_s": float(np.mean(errs)),
+                          "mean_abs_relative_error": float(np.mean([abs(r[n] / r["measured_V_m_s"] - 1) for r in subset
+                                                                    if r.get(n) is not None]))}
+        return out
+
+    return {"table": sec.table, "nose": case.projectile.nose, "rows": rows, "statistics": table_stats(used),
+            "statistics_case_nose": table_stats(own)}
 
 
 TABLE1_E = {"Al-alloys": (71e9, 0.33), "Steels": (210e9, 0.29), "Ti-alloy": (110e9, 0.32)}
