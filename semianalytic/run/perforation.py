@@ -40,8 +40,13 @@ def _run(ctx: Context) -> None:
     doc.para(f"Target {res['thickness_m'] * 1e3:.4g} mm in {len(res['layers'])} layer(s); back face "
              f"`{res['back_face']}`, failure `{res['failure']}`. Coefficients: {res['coefficients']}.")
     if res["ballistic_limit_m_s"] is not None:
-        doc.para(f"Ballistic limit by bisection: {res['ballistic_limit_m_s']:.1f} m/s (error estimate "
-                 f"{res['ballistic_limit_error_m_s']:.2f} m/s).")
+        if res.get("ballistic_limit_bound") == "lower":
+            doc.para(f"Ballistic limit: above {res['ballistic_limit_m_s']:.1f} m/s (a lower bound: "
+                     f"{res.get('ballistic_limit_reason', '')}).")
+        else:
+            doc.para(f"Ballistic limit (the command's own search on eq. (11)): {res['ballistic_limit_m_s']:.1f} m/s "
+                     f"(error estimate {res['ballistic_limit_error_m_s']:.2g} m/s); failure mode "
+                     f"{res.get('failure_mode')}.")
     f = lambda v, s=1.0: "-" if v is None else f"{v * s:.1f}"  # noqa: E731
     doc.table(["V_s [m/s]", "perforated", "V_r [m/s]", "depth [mm]", "exit time [us]"],
               [[f"{U:.0f}", str(p), f(v), f(d, 1e3), f(t, 1e6)] for U, p, v, d, t in zip(
