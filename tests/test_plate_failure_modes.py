@@ -140,8 +140,8 @@ def test_no_energy_from_nowhere(tmp_path, nose):
     """V_r <= V_s for every thickness from 0.1 mm to 1 m and velocity from 20 m/s to 3 km/s, every
     nose kind (exactly: the energy bound caps V_r at sqrt(V_s^2 - 2W/m) <= V_s), each with a V_bl."""
     from semianalytic.case import load_case
-    from semianalytic.perforation.model import ballistic_limit_search, perforation_curve
     from semianalytic.perforation.evaluate import perforation_setup
+    from semianalytic.perforation.model import ballistic_limit_search, perforation_curve
 
     U = np.geomspace(20.0, 3000.0, 25)
     for H in ("0.1 mm", "1 mm", "12 mm", "100 mm", "1 m"):
@@ -203,7 +203,12 @@ def test_closed_form_limit_equals_the_bisection_on_the_curve(tmp_path, nose, thi
     path plugs take), finds the same V_bl within its bracket (0.05 m/s)."""
     from semianalytic.case import load_case
     from semianalytic.perforation.evaluate import perforation_setup
-    from semianalytic.perforation.model import (_bisect_curve, _bracket, _profile_to_exit, ballistic_limit_search)
+    from semianalytic.perforation.model import (
+        _bisect_curve,
+        _bracket,
+        _profile_to_exit,
+        ballistic_limit_search,
+    )
 
     setup = perforation_setup(load_case(_case(tmp_path, nose, thickness)))
     c, m = setup.coefficients, setup.mass

@@ -58,9 +58,21 @@ import math
 
 import numpy as np
 
-__all__ = ["cylindrical_cavity_stress", "hole_enlargement_work", "hole_enlargement_limit", "energy_residual",
-           "plugging_work", "plugging_limit", "recht_ipson_residual", "petalling_work", "spherical_plastic_radius",
-           "spherical_zone_fits", "is_blunt", "failure_mode", "FAILURE_MODES"]
+__all__ = [
+    "FAILURE_MODES",
+    "cylindrical_cavity_stress",
+    "energy_residual",
+    "failure_mode",
+    "hole_enlargement_limit",
+    "hole_enlargement_work",
+    "is_blunt",
+    "petalling_work",
+    "plugging_limit",
+    "plugging_work",
+    "recht_ipson_residual",
+    "spherical_plastic_radius",
+    "spherical_zone_fits",
+]
 
 FAILURE_MODES = ("shear plugging", "ductile hole enlargement", "petalling")
 
