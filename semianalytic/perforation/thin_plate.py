@@ -152,10 +152,13 @@ def failure_mode(nose, thickness: float) -> tuple[str, str]:
     """(mode, reason) of a rigid nose through a ductile plate of thickness H (module docstring)."""
     d = float(nose.diameter)
     if is_blunt(nose):
-        return ("shear plugging", "blunt nose (flat, or a meplat >= d/2): shear plugging, Recht & Ipson 1963 with the "
-                "onset criterion of Chen & Li 2003")
+        why = ("blunt nose (flat, or a meplat >= d/2): shear plugging, Recht & Ipson 1963 with the "
+               "onset criterion of Chen & Li 2003")
+        return "shear plugging", why
     if thickness < 0.5 * d:
-        return ("petalling", f"pointed nose and H = {thickness * 1e3:.4g} mm < d/2 = {0.5 * d * 1e3:.4g} mm (threshold ours; "
-                "petalling of thin plates: Backman & Goldsmith 1978; work: Thomson 1955)")
-    return ("ductile hole enlargement", "pointed nose: ductile hole enlargement by cylindrical cavity expansion "
-            "(Forrestal, Rosenberg, Luk & Bless 1987; Forrestal, Luk & Brar 1990)")
+        why = (f"pointed nose and H = {thickness * 1e3:.4g} mm < d/2 = {0.5 * d * 1e3:.4g} mm (threshold ours; "
+               "petalling of thin plates: Backman & Goldsmith 1978; work: Thomson 1955)")
+        return "petalling", why
+    why = ("pointed nose: ductile hole enlargement by cylindrical cavity expansion "
+           "(Forrestal, Rosenberg, Luk & Bless 1987; Forrestal, Luk & Brar 1990)")
+    return "ductile hole enlargement", why
