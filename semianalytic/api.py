@@ -611,7 +611,8 @@ def cavity(case, method: str | None = None) -> Result:
     from semianalytic.cavity import BrittleMaterial, solve_cavity
 
     section = case.require("material")
-    result = solve_cavity(BrittleMaterial.from_section(section), method or section.solver, warn=True)
+    result = solve_cavity(BrittleMaterial.from_section(section), method or section.solver, warn=False)
+    _issue([f"warning: {w}" for w in result.warnings], "cavity")
     return Result({"case": case.title, **result.to_json()}, "cavity", rows_key=None)
 
 
@@ -626,14 +627,28 @@ def nanostrength(case) -> Result:
     Returns
     -------
     Result
-        The analysis JSON (crystals, studies, printed values compared); ``.to_frame()``: one row
-        per crystal (``crystals``) when the case has any.
+        The analysis JSON (``crystals``, ``studies`` with the printed values compared);
+        ``.to_frame()``: one row per study row (material and geometry).
     """
     from semianalytic.nanostrength.analysis import analyse_section
 
-    data = analyse_section(case.require("nanostrength")).to_json()
-    key = next((k for k in ("crystals", "results", "rows") if isinstance(data.get(k), list)), None)
-    return TableResult(data, "nanostrength", rows_key=key) if key else Result(data, "nanostrength", rows_key=None)
+    return NanostrengthResult(analyse_section(case.require("nanostrength")).to_json(), "nanostrength", rows_key=None)
+
+
+@dataclass(frozen=True)
+class NanostrengthResult(Result):
+    """The ``nanostrength`` analysis; :meth:`to_frame` has one row per (study, material,
+    geometry) with the strengths in GPa (``sigma1_compression_GPa``, ...)."""
+
+    def to_frame(self):
+        import pandas as pd
+
+        rows = [{"study": st.get("name"), **{k: v for k, v in r.items() if not isinstance(v, (dict, list))}}
+                for st in self.data.get("studies", []) for r in st.get("rows", [])]
+        if not rows:  # crystals only
+            rows = [{"material": m, **{k: v for k, v in c.items() if not isinstance(v, (dict, list))}}
+                    for m, c in self.data.get("crystals", {}).items()]
+        return pd.DataFrame(rows)
 
 
 def optimize(case, vary: Sequence[str], objective: str = "depth", *, constraint: Sequence[str] = (),

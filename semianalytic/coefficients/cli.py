@@ -43,7 +43,7 @@ def run(args) -> int:
     out = coefficients_output(case, at=args.at, interpolated=args.interpolated, reading=args.reading,
                               depths=args.depths, max_depth=args.max_depth, tolerance=args.tolerance,
                               order=args.order, refinement=args.refinement, cache_dir=args.cache_dir,
-                              progress=not args.json and sys.stderr.isatty())
+                              progress=True)  # semianalytic.progress decides: bar, log lines or off
     if args.json:
         print(json.dumps(out))
     elif case.body is not None:
