@@ -55,7 +55,7 @@ class ExtrapolationWarning(ModelValidityWarning):
     """A value read outside the range a table or a fit was built on."""
 
 
-def summarise(values, fmt: str = "{:.0f}", limit: int = 8) -> str:
+def summarise(values, fmt: str = "{:.0f}", limit: int = 12) -> str:
     """``values`` as a short text: all of them up to ``limit``, else their count and range with
     the first and last few (``"1000 values, 400 to 1800 (400, 401, 403, ..., 1799, 1800)"``)."""
     vals = list(values)

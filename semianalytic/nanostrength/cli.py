@@ -88,5 +88,5 @@ def run(args: argparse.Namespace) -> int:
     else:
         print(_summary(analysis, case.title))
         if args.report:
-            print(f"\nreport: {written[-1]} (+ {len(written) - 1} figures)")
+            print(f"\nreport: {written[-2]} and {written[-1]} (+ {len(written) - 2} figures)")
     return 0
