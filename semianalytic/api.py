@@ -122,6 +122,13 @@ class Result(Mapping):
     def __repr__(self) -> str:
         return f"<{type(self).__name__} of {self.command or 'semianalytic'}: {', '.join(list(self.data)[:8])}, ...>"
 
+    def _repr_html_(self) -> str:
+        """A notebook shows the frame."""
+        try:
+            return self.to_frame()._repr_html_()
+        except Exception:  # a result without a table
+            return f"<pre>{self!r}</pre>"
+
     @property
     def warnings(self) -> list[str]:
         """The notices the command prints on stderr (also issued as Python warnings)."""
@@ -207,6 +214,31 @@ def _issue(lines, command: str) -> None:
         text = str(line)
         if text.startswith("warning: "):
             warnings.warn(f"{command}: {text[len('warning: '):]}", ValidityWarning, stacklevel=level)
+
+
+class _Reissue:
+    """Collect the validity warnings the models issue inside an API call and issue them again
+    from the caller's line (a model's own ``stacklevel`` points inside the package)."""
+
+    def __init__(self, command: str):
+        self.command = command
+
+    def __enter__(self):
+        self._cm = warnings.catch_warnings(record=True)
+        self._seen = self._cm.__enter__()
+        warnings.simplefilter("always")
+        return self
+
+    def __exit__(self, *exc):
+        self._cm.__exit__(*exc)
+        from semianalytic.errors import ValidityWarning
+
+        for w in self._seen:
+            if issubclass(w.category, ValidityWarning):
+                _issue([f"warning: {w.message}"], self.command)
+            else:
+                warnings.warn_explicit(w.message, w.category, w.filename, w.lineno)
+        return False
 
 
 def _quantities(value, kind: str, field: str) -> np.ndarray:
@@ -318,7 +350,8 @@ def coefficients(case, source: str = "bem", cache_dir: str | os.PathLike | None 
     """
     from semianalytic.cache import coefficients_for_case
 
-    table, _desc, _fallback = coefficients_for_case(case, source, cache_dir)
+    # a new table takes seconds: progress by the commands' rule (semianalytic.progress)
+    table, _desc, _fallback = coefficients_for_case(case, source, cache_dir, progress=True)
     return table
 
 
@@ -558,10 +591,12 @@ def perforate(case, velocities: Sequence[float] | None = None, *, ballistic: boo
 
     for sec in ("projectile", "target", "impact"):
         case.require(sec)
+    U = _velocities(velocities)
     bar = stages(1, "perforate", quiet=quiet)
     bar.step(f"plate tables and eq. (11) for {case.title}")
     try:
-        out = evaluate_case(case, cache_dir=cache_dir, velocities=_velocities(velocities), ballistic=ballistic)
+        with _Reissue("perforate"):
+            out = evaluate_case(case, cache_dir=cache_dir, velocities=U, ballistic=ballistic)
     finally:
         bar.close()
     return Result(out, "perforate")
@@ -696,10 +731,12 @@ def optimize(case, vary: Sequence[str], objective: str = "depth", *, constraint:
         path, case = str(case), load_case(case)
     elif case.path is not None:
         path = str(case.path)
-    result = optimize_case(path, list(vary), objective, case=case, constraint=list(constraint), method=method,
-                           depth_model=depth_model, workers=workers, scheduler="inline" if workers == 1 else None,
-                           out=None if out is None else str(out), cache_dir=None if cache_dir is None else str(cache_dir),
-                           progress=not quiet, command="semianalytic.api.optimize", **options)
+    with _Reissue("optimize"):
+        result = optimize_case(path, list(vary), objective, case=case, constraint=list(constraint), method=method,
+                               depth_model=depth_model, workers=workers, scheduler="inline" if workers == 1 else None,
+                               out=None if out is None else str(out),
+                               cache_dir=None if cache_dir is None else str(cache_dir),
+                               progress=not quiet, command="semianalytic.api.optimize", **options)
     return Result(result, "optimize", rows_key=None)
 
 
@@ -743,9 +780,10 @@ def sweep(case: str | os.PathLike, out: str | os.PathLike, vary: Sequence[str] =
     """
     from semianalytic.sweep.cli import sweep_case
 
-    summary, stats = sweep_case(str(case), str(out), list(vary), list(sample), samples=samples, seed=seed,
-                                analysis=analysis, scheduler=scheduler, workers=workers, force=force,
-                                cache_dir=None if cache_dir is None else str(cache_dir), progress=not quiet)
+    with _Reissue("sweep"):
+        summary, stats = sweep_case(str(case), str(out), list(vary), list(sample), samples=samples, seed=seed,
+                                    analysis=analysis, scheduler=scheduler, workers=workers, force=force,
+                                    cache_dir=None if cache_dir is None else str(cache_dir), progress=not quiet)
     return SweepResult({**summary.to_json(), "statistics": stats}, "sweep", rows_key=None)
 
 
