@@ -1,7 +1,7 @@
 """Progress on stderr, by one rule for every command and API call that may take more than
 about 2 s: a tqdm bar with a total when stderr is a terminal; one line per stage when stderr is
 a file (a log: ``cmd 2> log``); nothing with ``--quiet`` (``quiet=True``) or when stderr is a
-pipe (tests, ``| tee``).  ``SEMIANALYTIC_PROGRESS=bar|lines|off`` overrides the choice."""
+pipe (tests, ``| tee``).  In a Jupyter notebook (stderr is the kernel's stream) the bar.  ``SEMIANALYTIC_PROGRESS=bar|lines|off`` overrides the choice."""
 
 from __future__ import annotations
 
@@ -24,8 +24,8 @@ def mode(quiet: bool = False) -> str:
         if sys.stderr.isatty():
             return "bar"
         return "lines" if stat.S_ISREG(os.fstat(sys.stderr.fileno()).st_mode) else "off"
-    except (AttributeError, OSError, ValueError):  # a replaced stderr (pytest capture, StringIO)
-        return "off"
+    except (AttributeError, OSError, ValueError):  # a replaced stderr: a notebook's, pytest's capture, StringIO
+        return "bar" if "ipykernel" in sys.modules and type(sys.stderr).__name__ == "OutStream" else "off"
 
 
 class _Off:

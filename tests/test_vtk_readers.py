@@ -55,21 +55,22 @@ UNITS = {"velocity_m_s": "m/s", "speed_m_s": "m/s", "phi_m": "m", "Phi_m2_s": "m
 COMPONENTS = {"velocity_m_s": 3}
 
 
-@pytest.fixture(scope="module")
-def exported(tmp_path_factory):
+@pytest.fixture(scope="module", params=["m", "mm"])
+def exported(tmp_path_factory, request):
     pytest.importorskip("skfem")
     d = tmp_path_factory.mktemp("readers")
-    (d / "case.toml").write_text(CASE)
+    (d / "case.toml").write_text(CASE + f'vtk_coordinates = "{request.param}"\n')
     env = {**os.environ, "SEMIANALYTIC_CACHE_DIR": str(d / "cache"), "PYTHONPATH": str(ROOT)}
     proc = subprocess.run([sys.executable, "-m", "semianalytic", "run", "case.toml", "--out", "out", "--no-render",
                            "--quiet"], cwd=d, env=env, capture_output=True, text=True, timeout=900)
     assert proc.returncode == 0, proc.stderr[-3000:]
     files = sorted((d / "out").rglob("*.vtu"))
     assert len(files) == 4  # meridian, revolved, projectile surface, FEM potential
-    return files
+    return files, request.param
 
 
 def test_meshio_and_pyvista_open_every_file(exported):
+    exported, unit = exported
     for f in exported:
         # meshio 5.3 raises SystemExit on a VTK string array: catch it as a failure of this test
         try:
@@ -81,7 +82,8 @@ def test_meshio_and_pyvista_open_every_file(exported):
         np.testing.assert_array_equal(m.points, np.asarray(p.points))
         assert set(m.point_data) == set(p.point_data.keys())
         side = json.loads((f.parent / (f.stem + ".units.json")).read_text())
-        assert side["file"] == f.name and side["coordinates_unit"] == "m"
+        assert side["file"] == f.name and side["coordinates_unit"] == unit
+        assert float(m.field_data["coordinates_unit_m"][0]) == {"m": 1.0, "mm": 1e-3}[unit]
         for name in m.point_data:
             assert name in UNITS, (f.name, name)  # every array names its unit
             assert side["arrays"][name]["unit"] == UNITS[name]
@@ -95,6 +97,7 @@ def test_meshio_and_pyvista_open_every_file(exported):
 
 
 def test_the_field_files_hold_the_field(exported):
+    exported, unit = exported
     fields = [f for f in exported if not f.name.startswith("projectile_")]
     assert {f.name.split("_")[0] for f in fields} == {"velocity", "fem"}
     for f in fields:
@@ -103,5 +106,6 @@ def test_the_field_files_hold_the_field(exported):
         # speed is |v| of the same file (both written from one array: round-off only)
         np.testing.assert_allclose(m.point_data["speed_m_s"], np.linalg.norm(v, axis=1), rtol=1e-12, atol=1e-9)
         assert float(m.field_data["speed_u_m_s"][0]) > 0
-        # a projectile at a depth of 30 mm: the points span millimetres, written in metres
-        assert 1e-3 < np.ptp(m.points[:, 0]) < 1.0
+        # a projectile at a depth of 30 mm: the window spans some 10-100 mm, in the unit asked for
+        span_mm = np.ptp(m.points[:, 0]) * (1e3 if unit == "m" else 1.0)
+        assert 10.0 < span_mm < 1000.0, span_mm
