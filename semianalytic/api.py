@@ -107,6 +107,11 @@ class Result(Mapping):
     command: str = ""
     rows_key: str | None = "striking_velocity_m_s"
 
+    def __post_init__(self):
+        import types
+
+        object.__setattr__(self, "data", types.MappingProxyType(dict(self.data)))  # read-only at the top
+
     def __getitem__(self, key: str):
         value = self.data[key]
         if key == "depth_quantiles_m" and isinstance(value, Mapping):
@@ -432,9 +437,11 @@ def penetrate(case, velocities: Sequence[float] | None = None, *, source: str = 
 def _penetrate(case, velocities, *, source="bem", w1="neglect", part1_model=None, cache_dir=None) -> dict:
     from semianalytic.penetration.evaluate import evaluate_case
 
+    from semianalytic.cache import coefficients_for_case
+
     U = _velocities(velocities)
-    table = coefficients(case, source, cache_dir)
-    return evaluate_case(case, table, w1=w1, velocities=U, part1_model=part1_model)
+    table, desc, _fallback = coefficients_for_case(case, source, cache_dir, progress=True)
+    return dict(evaluate_case(case, table, w1=w1, velocities=U, part1_model=part1_model), coefficients=desc)
 
 
 def depth(case, velocity: float | Sequence[float], model: str = "regime_aware", **options: Any):

@@ -57,9 +57,12 @@ def test_penetrate_result_is_tidy_and_is_the_command_json():
     assert r["depth_rigid_m"] == pytest.approx(cli["depth_rigid_m"], rel=1e-9)  # the old mapping access
     d = r.to_dict()
     assert json.loads(json.dumps(d)) == d  # strict JSON
-    assert set(cli) - {"coefficients"} <= set(d)
+    assert set(cli) == set(d) and d["coefficients"] == cli["coefficients"]
+    assert d["regime"] == cli["regime"] and d["valid"] == cli["valid"]
     with pytest.raises((TypeError, AttributeError)):
         r.data = {}  # frozen
+    with pytest.raises(TypeError):
+        r.data["depth_m"] = []  # read-only
 
 
 def test_every_result_makes_a_frame(tmp_path):
