@@ -83,8 +83,10 @@ def optimize_case(case_path: str | None, vary: list[str], objective: str = "dept
             search = (popsize * n_var * (maxiter + 1) if method == "de"
                       else coarse**n_var + min(maxfev, 15) * (2 * n_var if method == "grid-pattern" else 1))
             total = search + confirm**n_var + 4
-            bar = tqdm(total=total, unit="design", file=sys.stderr, dynamic_ncols=True, mininterval=0.5,
-                       desc="optimize")
+            from semianalytic.progress import counter, mode
+
+            bar = (tqdm(total=total, unit="design", file=sys.stderr, dynamic_ncols=True, mininterval=0.5, desc="optimize")
+                   if mode() == "bar" else counter(total, "optimize", "design"))  # a log: start and end lines
         n_workers = 1 if client is None else max(1, len(client.scheduler_info().get("workers", {})))
         result = optimise(
             problem, client=client, cache_dir=cache_dir, method=method, coarse=coarse, maxfev=maxfev,
