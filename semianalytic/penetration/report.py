@@ -112,14 +112,21 @@ def write_report(out_dir, cases, args=None, *, name: str | None = None, force: b
         "(dimensionless formula, two-term cavity law with the Part I static resistance A Y = R_t and the "
         "incompressible B = 3/2)."
     )
-    _coefficients_section(doc, ctx)
-    _validation_section(doc, ctx, w)
-    _regimes_section(doc, ctx, w, getattr(args, "part1_model", None) or "elastic_exact_rod")
-    _histories_section(doc, ctx, w)
-    _curves_section(doc, ctx, w)
-    _appendix_section(doc, ctx)
-    _numerics_section(doc, ctx, w)
-    _closing_section(doc, ctx)
+    from semianalytic.progress import stages
+
+    sections = [("coefficient tables", lambda: _coefficients_section(doc, ctx)),
+                ("validation against the shots", lambda: _validation_section(doc, ctx, w)),
+                ("regimes", lambda: _regimes_section(doc, ctx, w, getattr(args, "part1_model", None) or "elastic_exact_rod")),
+                ("histories", lambda: _histories_section(doc, ctx, w)),
+                ("depth curves", lambda: _curves_section(doc, ctx, w)),
+                ("appendix", lambda: _appendix_section(doc, ctx)),
+                ("numerics", lambda: _numerics_section(doc, ctx, w)),
+                ("closing", lambda: _closing_section(doc, ctx))]
+    bar = stages(len(sections), "penetrate --report", quiet=getattr(args, "quiet", False))
+    for what, section in sections:
+        bar.step(what)
+        section()
+    bar.close()
     atomic_write_text(md_path, to_markdown(doc), overwrite=True)
     from semianalytic.report.html import html_beside
 
