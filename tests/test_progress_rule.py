@@ -46,6 +46,7 @@ def test_perforate_tells_a_log_what_it_does(tmp_path):
     case = str(ROOT / "cases" / "perforation_ogive_6061T651_constant.toml")
     log = _run_to_log(tmp_path, ["semianalytic", "perforate", case, "--no-ballistic-limit"])
     assert "perforate: [1/1]" in log and "perforate: done in" in log
+    assert "plate table: [1/1] BEM plate table" in log and "plate table: done in" in log  # built on first use
     quiet = _run_to_log(tmp_path, ["semianalytic", "perforate", case, "--no-ballistic-limit", "--quiet"], "quiet")
     assert "perforate: [" not in quiet
 
