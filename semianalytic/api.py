@@ -427,8 +427,6 @@ def penetrate(case, velocities: Sequence[float] | None = None, *, source: str = 
     semianalytic.errors.ValidityWarning
         For every velocity outside a model's validity (the lines ``penetrate`` prints on stderr).
     """
-    from semianalytic.penetration.evaluate import evaluate_case
-
     out = _penetrate(case, velocities, source=source, w1=w1, part1_model=part1_model, cache_dir=cache_dir)
     _issue(out.get("warnings"), "penetrate")
     return Result(out, "penetrate")

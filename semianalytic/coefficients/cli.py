@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import sys
-
 
 from semianalytic.case import load_case
 from semianalytic.coefficients import READINGS
