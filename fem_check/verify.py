@@ -287,10 +287,54 @@ def verify_command(args) -> str:
     return " ".join(shlex.quote(w) for w in words)
 
 
+def verify_case(case, depths=DEFAULT_DEPTHS, *, h: float = 0.04, quick: bool = False,
+                study_h=(0.16, 0.08, 0.04, 0.02), grading: float | None = None, quiet: bool = False) -> dict:
+    """The FEM-BEM verification of a loaded case (``fem_check verify`` without its report): the
+    added mass of a ``[body]``, or A, B, C of a ``[projectile]`` nose at ``depths`` (in nose
+    lengths) with the convergence, refinement and far-field studies unless ``quick``.  Returns
+    the payload the command prints with ``--json``."""
+    from semianalytic.geometry import body_from_section, nose_from_section
+    from semianalytic.progress import stages
+
+    bar = stages(1 if quick else 2, "fem_check verify", quiet=quiet)
+    if case.body is not None:
+        meridian = body_from_section(case.body)
+        exact = exact_added_mass(case.body)
+        bar.step("added mass, FEM (P1, P2) against BEM" + ("" if quick else " and convergence"))
+        res = body_verification(meridian, exact, h_main=min(h, 0.1), convergence=not quick)
+        if not quick and exact is not None:
+            bar.step("far-field study")
+            res["far_field"] = body_far_field_study(meridian, exact)
+        payload = {"case": case.title, "kind": "body", **res}
+    else:
+        from fem_check.refinement import has_singular_corners, refinement_study
+
+        nose = nose_from_section(case.projectile)
+        memo: dict = {}  # solves shared by the comparison and the convergence study
+        bar.step(f"A, B, C by FEM and BEM at {len(depths)} depths")
+        rows = compare_depths(nose, depths, h=h, grading=grading, memo=memo)
+        scale = depth_scale(nose)
+        payload = {"case": case.title, "kind": "halfspace", "nose": nose.kind, "diameter_m": nose.diameter,
+                   "nose_length_m": nose.length, "depth_scale": "L_h" if scale == nose.length else "radius",
+                   "depth_scale_m": scale, "h_over_d": h, "depths": rows,
+                   "max_rel_diff": max(r["max_rel_diff"] for r in rows)}
+        cornered = has_singular_corners(nose, np.asarray(depths) * scale)
+        if not quick:
+            bar.step("refinement study (cornered nose)" if cornered else "convergence and far-field studies")
+        if not quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
+            payload["refinement"] = refinement_study(nose, depths, study_h, grading=grading, memo=memo)
+        elif not quick:
+            payload["convergence"] = convergence_study(nose, memo=memo)
+            if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
+                payload["far_field"] = halfspace_far_field_study()
+                payload["hemisphere_exact"] = hemisphere_check()
+    bar.close()
+    return payload
+
+
 def run(args) -> int:
     from fem_check.report import Report, emit_json
     from semianalytic.case import load_case
-    from semianalytic.geometry import body_from_section, nose_from_section
 
     case = load_case(args.case)
     if not 0.005 <= args.h <= 0.5:
@@ -309,41 +353,8 @@ def run(args) -> int:
     report = None if args.no_report else Report(Path(args.out), name, args.force)
     if report:
         report.check()
-    from semianalytic.progress import stages
-
-    bar = stages(1 if args.quick else 2, "fem_check verify", quiet=getattr(args, "quiet", False))
-    if case.body is not None:
-        meridian = body_from_section(case.body)
-        exact = exact_added_mass(case.body)
-        bar.step("added mass, FEM (P1, P2) against BEM" + ("" if args.quick else " and convergence"))
-        res = body_verification(meridian, exact, h_main=min(args.h, 0.1), convergence=not args.quick)
-        if not args.quick and exact is not None:
-            bar.step("far-field study")
-            res["far_field"] = body_far_field_study(meridian, exact)
-        payload = {"case": case.title, "kind": "body", **res}
-    else:
-        from fem_check.refinement import has_singular_corners, refinement_study
-
-        nose = nose_from_section(case.projectile)
-        memo: dict = {}  # solves shared by the comparison and the convergence study
-        bar.step(f"A, B, C by FEM and BEM at {len(depths)} depths")
-        rows = compare_depths(nose, depths, h=args.h, grading=args.grading, memo=memo)
-        scale = depth_scale(nose)
-        payload = {"case": case.title, "kind": "halfspace", "nose": nose.kind, "diameter_m": nose.diameter,
-                   "nose_length_m": nose.length, "depth_scale": "L_h" if scale == nose.length else "radius",
-                   "depth_scale_m": scale, "h_over_d": args.h, "depths": rows,
-                   "max_rel_diff": max(r["max_rel_diff"] for r in rows)}
-        cornered = has_singular_corners(nose, np.asarray(depths) * scale)
-        if not args.quick:
-            bar.step("refinement study (cornered nose)" if cornered else "convergence and far-field studies")
-        if not args.quick and cornered:  # no exact solution: FEM self-convergence, BEM beside it
-            payload["refinement"] = refinement_study(nose, depths, study_h, grading=args.grading, memo=memo)
-        elif not args.quick:
-            payload["convergence"] = convergence_study(nose, memo=memo)
-            if nose.kind == "sphere":  # the far-field study is of the hemisphere at P = R (exact series)
-                payload["far_field"] = halfspace_far_field_study()
-                payload["hemisphere_exact"] = hemisphere_check()
-    bar.close()
+    payload = verify_case(case, depths, h=args.h, quick=args.quick, study_h=study_h, grading=args.grading,
+                          quiet=getattr(args, "quiet", False))
     if report:
         from fem_check.verify_report import write_verify_report
 

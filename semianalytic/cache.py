@@ -109,7 +109,14 @@ def cached_plate_table(nose, thickness: float, cache_dir: str | os.PathLike | No
         except Exception as exc:  # noqa: BLE001 - an unreadable entry is rebuilt, never trusted
             warnings.warn(f"plate-table cache: discarded the entry {path.name!r}: unreadable ({type(exc).__name__}); "
                           "it is rebuilt", CacheWarning, stacklevel=2)
-    table = plate_coefficient_table(nose, thickness, **options)
+    from semianalytic.progress import stages
+
+    bar = stages(1, "plate table")  # seconds per table: a line in a log, a bar on a terminal
+    bar.step(f"BEM plate table of the {nose.kind} nose, H = {thickness * 1e3:.4g} mm (built once, then cached)")
+    try:
+        table = plate_coefficient_table(nose, thickness, **options)
+    finally:
+        bar.close()
     try:
         write_cache_entry(path, key, table.to_npz_bytes(), thickness=float(thickness))
     except OSError:

@@ -353,6 +353,14 @@ class Case:
     sections: Mapping[str, Section] = field(default_factory=dict)
     raw: Mapping[str, Any] = field(default_factory=dict, repr=False)
 
+    @property
+    def geometry(self):
+        """The projectile's derived geometry (:class:`semianalytic.geometry.ProjectileGeometry`:
+        ``nose_length_m``, ``length_m``, ``length_over_diameter``, ``volume_m3``, ``mass_kg``)."""
+        from semianalytic.geometry import derived_geometry
+
+        return derived_geometry(self.require("projectile"))
+
     def section(self, name: str) -> Any:
         """Any section by name (core or registered); ``None`` if the case has none."""
         if name in _CORE:

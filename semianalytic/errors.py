@@ -43,7 +43,27 @@ class ConvergenceError(ModelError):
 
 
 class ModelValidityWarning(UserWarning):
-    """An input the model accepts but that lies outside its stated validity."""
+    """An input the model accepts but that lies outside its stated validity (also
+    :data:`ValidityWarning`): ``warnings.simplefilter("ignore", ValidityWarning)`` silences
+    them, ``"error"`` turns them into exceptions; the commands print them on stderr."""
+
+
+ValidityWarning = ModelValidityWarning
+
+
+class ExtrapolationWarning(ModelValidityWarning):
+    """A value read outside the range a table or a fit was built on."""
+
+
+def summarise(values, fmt: str = "{:.0f}", limit: int = 12) -> str:
+    """``values`` as a short text: all of them up to ``limit``, else their count and range with
+    the first and last few (``"1000 values, 400 to 1800 (400, 401, 403, ..., 1799, 1800)"``)."""
+    vals = list(values)
+    if len(vals) <= limit:
+        return ", ".join(fmt.format(v) for v in vals)
+    head = ", ".join(fmt.format(v) for v in vals[:3])
+    tail = ", ".join(fmt.format(v) for v in vals[-2:])
+    return f"{len(vals)} values, {fmt.format(min(vals))} to {fmt.format(max(vals))} ({head}, ..., {tail})"
 
 
 def exit_status(main) -> int:

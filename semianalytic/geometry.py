@@ -807,6 +807,36 @@ def nose_from_section(sec) -> Nose:
     return table_nose(sec.points_si(), sec.diameter)
 
 
+@dataclass(frozen=True)
+class ProjectileGeometry:
+    """The projectile's derived geometry (SI): what the case implies but does not state."""
+
+    diameter_m: float
+    nose_length_m: float
+    shank_length_m: float
+    length_m: float
+    length_over_diameter: float
+    volume_m3: float
+    mass_kg: float | None
+
+    def to_dict(self) -> dict:
+        """The fields as a dict (JSON-ready)."""
+        from dataclasses import asdict
+
+        return asdict(self)
+
+
+def derived_geometry(sec) -> ProjectileGeometry:
+    """The derived geometry of a ``[projectile]`` section (nose length, length, L/D, volume, mass)."""
+    pr = projectile_from_section(sec)
+    try:
+        mass = float(pr.mass)
+    except (TypeError, ValueError):  # neither a density nor a measured mass
+        mass = None
+    return ProjectileGeometry(float(pr.diameter), float(pr.nose_length), float(pr.shank_length), float(pr.length),
+                              float(pr.length / pr.diameter), float(pr.volume()), mass)
+
+
 def projectile_from_section(sec) -> Projectile:
     """Build the projectile of a ``[projectile]`` case section."""
     return Projectile(nose_from_section(sec), sec.shank, sec.density, sec.mass)

@@ -323,3 +323,184 @@ def check_brittle_constants(section: str, youngs_modulus: float, poisson_ratio: 
             warnings.warn(
                 f"{section}.bulk_modulus: {bulk_modulus / 1e9:.4g} GPa is {apart:.0%} away from E / (3 (1 - 2 nu)) = "
                 f"{implied / 1e9:.4g} GPa; check the elastic constants", ModelValidityWarning, stacklevel=2)
+
+
+# --------------------------------------------------------------------------------------
+# one-line descriptions of the case-file keys (the case-file reference page is generated from
+# them, tools/docs_hooks.py): ``"Model.key"`` first, then the key alone; a description set on a
+# field (``Field(description=...)``) or a comment beside it in the source wins.  The SI unit of
+# a quantity is appended by :func:`key_description`.
+
+KEY_HELP: dict[str, str] = {
+    # shared names
+    "youngs_modulus": "Young's modulus E",
+    "poisson_ratio": "Poisson's ratio nu (dimensionless)",
+    "yield_stress": "yield stress Y (uniaxial)",
+    "density": "mass density",
+    "tensile_strength": "uniaxial tensile strength sigma_f",
+    "compressive_strength": "uniaxial compressive strength Y_s",
+    "bulk_modulus": "bulk modulus K (default E / (3 (1 - 2 nu)))",
+    "initial_porosity": "initial porosity theta_0 (volume fraction of voids, dimensionless)",
+    "eroding_resistance": "target resistance R_t of the eroding rod (Alekseevskii-Tate); default the model's R_t",
+    "model": "which model of the section (the other keys depend on it)",
+    "name": "identifier (letters, digits, _ - .), used in tables and file names",
+    "points": "meridian points [[x, r], ...] from the tip (0, 0) back, in points_unit",
+    "points_unit": "length unit of points",
+    "thickness": "thickness of the plate or layer",
+    "title": "title of the study in the report",
+    "materials": "materials analysed (names of Tables 1-2 or of [[nanostrength.crystal]])",
+    # [body]
+    "BodySection.shape": "closed body: sphere, spheroid, cylinder, double cone or a table of points",
+    "BodySection.length": "length of the body along its axis",
+    "BodySection.diameter": "largest diameter of the body",
+    # [projectile]
+    "ProjectileSection.nose": "nose shape (each kind has its own keys, see the section text)",
+    "ProjectileSection.diameter": "shank diameter d",
+    "ProjectileSection.shank_length": "length of the cylindrical shank (total length = shank + nose)",
+    "ProjectileSection.density": "density of the projectile material rho_p (for the mass when mass is absent)",
+    "ProjectileSection.mass": "measured mass m (instead of density x volume)",
+    "ProjectileSection.half_angle": "cone half-angle of the nose",
+    "ProjectileSection.corner_radius": "radius of the rounded corner of a flat nose",
+    "ProjectileSection.poisson_ratio": "Poisson's ratio of the projectile nu_p (dimensionless)",
+    "ProjectileSection.yield_stress": "dynamic yield stress of the projectile Y_p (Part I, eqs. (33), (36))",
+    "ProjectileSection.dynamic_factor": "dynamic over static yield stress, with hardness (dimensionless)",
+    "ProjectileSection.buckling": "buckling reduction of the critical velocity: none, johnson-euler or table",
+    "ProjectileSection.buckling_table": "buckling factor against L/d as [[L/d, factor], ...] (with buckling = table)",
+    # [target] and its resistance
+    "TargetSection.density": "density of the target rho_t",
+    "TargetSection.resistance": "the target resistance table [target.resistance] (a model and its keys)",
+    "ElasticPlasticInput.yield_stress": "target yield stress Y (R_t of Part I, eq. (16))",
+    "HardeningInput.yield_stress": "target yield stress Y of the power-law hardening (Part I, eq. (18))",
+    "Part4Input.yield_stress": "target yield stress Y (Part IV, eq. (6))",
+    "LimestoneInput.psi": "constant Psi of the limestone resistance R_t = Psi + phi a_0 / a (Frew; Part I, eq. (19))",
+    "LimestoneInput.phi": "size-effect constant phi of R_t = Psi + phi a_0 / a (Part I, eq. (19))",
+    "LimestoneInput.reference_diameter": "reference diameter 2 a_0 of the size effect (Part I, eq. (19))",
+    "ConstantInput.value": "the constant target resistance R_t",
+    "CavityInput.compressive_strength": "compressive strength Y_s of the brittle target (Part II cavity)",
+    "BrittleInput.compressive_strength": "compressive strength Y_s of the brittle target",
+    # [[target.layers]]
+    "TargetLayerSection.thickness": "thickness of the layer",
+    "TargetLayerSection.gap": "air gap in front of the layer",
+    "TargetLayerSection.density": "density of the layer",
+    "TargetLayerSection.resistance": "the layer's resistance table (as [target.resistance])",
+    "TargetLayerSection.name": "name of the layer in tables",
+    # [impact], [coefficients]
+    "ImpactSection.striking_velocities": "striking velocities U_s of the projectile",
+    "CoefficientsSection.max_depth_nose_lengths": "deepest BEM solve of the table, in nose lengths L_h (dimensionless)",
+    "CoefficientsSection.reading": "which B of Part I, eq. (12): body (default), literal or bernoulli",
+    # [material] (cavity)
+    "MaterialSection.solver": "root finder of the front stress: bracket (robust) or fixed-point (Part II, eq. (22))",
+    # [ballistic_limit]
+    "BallisticLimitSection.table": "CSV file of shots next to the case file (Part IV tables)",
+    "BallisticLimitSection.shots": "shots given inline ([[ballistic_limit.shots]])",
+    "BallisticLimitSection.hardness": "rule of the hardness resistance R(1) = H_M delta_H (Part IV, eq. (5))",
+    "BallisticLimitSection.areal_mass": "rule of the projectile's areal mass P in eqs. (7)-(9)",
+    "BallisticLimitSection.projectile_density": "projectile density rho_p for the areal mass",
+    "BallisticLimitSection.C1": "empirical constant C1 of Part IV, eq. (7) [m^2/s^2]",
+    "BallisticLimitSection.C2": "empirical constant C2 of Part IV, eq. (8) [(m/s)^2/GPa]",
+    "BallisticLimitSection.C3": "empirical constant C3 of Part IV, eq. (9) [m^2/s^2]",
+    "BallisticLimitSection.critical_velocities": "velocities of the critical areal density and thickness (Table 4)",
+    "ShotSection.name": "shot identifier",
+    "ShotSection.projectile_length": "projectile length L_p",
+    "ShotSection.projectile_density": "projectile density rho_p",
+    "ShotSection.projectile_diameter": "projectile diameter d",
+    "ShotSection.projectile_mass": "projectile mass",
+    "ShotSection.projectile_hardness": "projectile hardness H (Meyer)",
+    "ShotSection.projectile_delta_h": "projectile hardness factor delta_H (dimensionless)",
+    "ShotSection.target_density": "target density rho_t",
+    "ShotSection.thickness": "target plate thickness h",
+    "ShotSection.target_hardness": "target hardness H_M (Meyer)",
+    "ShotSection.target_delta_h": "target hardness factor delta_H of R(1) = H_M delta_H (dimensionless)",
+    "ShotSection.yield_stress": "target yield stress Y for R(3) of Part IV, eq. (6)",
+    "ShotSection.youngs_modulus": "target Young's modulus E for R(3) of Part IV, eq. (6)",
+    "ShotSection.measured": "measured ballistic limit",
+    "ShotSection.layers": "layers of a layered target ([[...layers]])",
+    "LayerSection.name": "layer name",
+    "LayerSection.density": "layer density",
+    "LayerSection.thickness": "layer thickness",
+    "LayerSection.hardness": "layer hardness H_M (Meyer)",
+    "LayerSection.delta_h": "layer hardness factor delta_H (dimensionless)",
+    # [nanostrength]
+    "NanostrengthSection.crystal": "crystals beyond the built-in ones ([[nanostrength.crystal]], Tables 1-2 quantities)",
+    "NanostrengthSection.law": "interplanar law: cutoff (the paper's) or uber (universal binding energy)",
+    "NanostrengthSection.stress_measure": "stress per current or reference area",
+    "NanostrengthSection.surface_energy": "surface energy by Part III, eq. (15) or eq. (16)",
+    "NanostrengthSection.deformation_energy": "deformation energy from the law or as printed (Table 3)",
+    "NanostrengthSection.odd_surface_ratio": "surface-energy ratio of the odd surfaces (dimensionless)",
+    "NanostrengthSection.study": "grids of nanoparticle geometries ([[nanostrength.study]])",
+    "CrystalSpec.interlayer_energy": "interlayer (surface) energy Phi_0",
+    "CrystalSpec.spacing": "interplanar spacing",
+    "CrystalSpec.youngs_modulus": "Young's modulus normal to the planes",
+    "CrystalSpec.compressive_strength": "theoretical compressive strength sigma_1 of the bulk crystal",
+    "CrystalSpec.compressive_strain": "strain at the compressive strength (dimensionless)",
+    "CrystalSpec.tensile_strength": "theoretical tensile strength sigma_2 of the bulk crystal",
+    "CrystalSpec.tensile_strain": "strain at the tensile strength (dimensionless)",
+    "CrystalSpec.deformation_energy_tension": "printed deformation energy in tension (Table 3)",
+    "CrystalSpec.deformation_energy_compression": "printed deformation energy in compression (Table 3)",
+    "StudySection.name": "study id (names its figure file)",
+    "StudySection.basis": "particle basis: parallelogram, rectangle or none",
+    "StudySection.l": "number of planes l (integers or \"inf\")",
+    "StudySection.mn": "particle sizes m = n (integers or \"inf\")",
+    "StudySection.i": "mesolayer index i: all, centre or a list",
+    "StudySection.compare": "compare with the printed Table 4 or Table 5",
+    "StudySection.plot": "variable on the figure's horizontal axis: i, mn or l",
+    # [data]
+    "DataSection.file": "CSV of shots, relative to the case file ('#' lines skipped)",
+    "DataSection.source": "where the data come from (paper, table)",
+    "DataSection.id_column": "column of the shot id",
+    "DataSection.velocity_column": "column of the striking velocity",
+    "DataSection.velocity_unit": "unit of the velocity column (e.g. m/s)",
+    "DataSection.depth_column": "column of the measured depth of penetration",
+    "DataSection.depth_unit": "unit of the depth column (e.g. mm)",
+    "DataSection.mass_column": "column of each shot's measured projectile mass (optional)",
+    "DataSection.mass_unit": "unit of the mass column (e.g. g)",
+    "DataSection.select": "keep only rows with these values, {column = [values]}",
+    "DataSection.cavity_yield_stress": "the data authors' Y of their cavity-expansion fit (Forrestal peer model)",
+    "DataSection.cavity_A": "constant A of sigma_r/Y = A + B sqrt(rho/Y) V + C (rho/Y) V^2 (dimensionless)",
+    "DataSection.cavity_B": "constant B of the cavity-expansion fit (dimensionless)",
+    "DataSection.cavity_C": "constant C of the cavity-expansion fit (dimensionless)",
+    "DataSection.critical_velocity": "measured critical impact velocity U_sC (the Appendix's inverse problem)",
+    # [run]
+    "RunSection.analyses": "analyses of run (default: what the sections allow)",
+    "RunSection.field_depths": "tip depths of the velocity-field exports",
+    "RunSection.field_grid": "body-fitted grid of the field [rays, nodes per ray]",
+    "RunSection.field_segments": "azimuthal segments of the revolved 3D field",
+    "RunSection.field_velocity": "projectile speed u of the field (default from the penetration at that depth)",
+    "RunSection.render": "render the 3D field with pyvista (off-screen)",
+    "RunSection.vtk_dir": "folder of the .vtu files inside --out",
+    "RunSection.figures_dir": "folder of the figures inside --out",
+    # [calibration]
+    "CalibrationSection.models": "models calibrated (default all rigid-shot models)",
+    "CalibrationSection.parameters": "case keys calibrated (default the resistance's strength)",
+    "CalibrationSection.discrepancy": "prior of the relative model discrepancy, e.g. halfnormal(0.15)",
+    "CalibrationSection.walkers": "emcee walkers",
+    "CalibrationSection.steps": "emcee steps per walker",
+    "CalibrationSection.burn": "steps discarded as burn-in",
+    "CalibrationSection.seed": "seed of the sampler",
+    "CalibrationSection.transfer": "case files predicted by the posterior (transfer, not fitted)",
+    "CalibrationSection.prior": "priors per parameter, {key = \"normal(400 MPa, 50 MPa)\"}",
+    # [perforation]
+    "PerforationSection.back_face": "resistance near the back face: finite-sphere cavity expansion or constant",
+    "PerforationSection.failure": "plate failure: auto, hole-growth or plug",
+    "PerforationSection.shear_strength": "shear strength of the plug's cylinder (failure = plug)",
+    "PerforationSection.data": "CSV of perforation shots (striking and residual velocities), relative to the case",
+    "PerforationSection.data_source": "where the perforation data come from",
+    "PerforationSection.target_hardness": "target hardness H_M for Part IV's V_cr",
+    "PerforationSection.target_delta_h": "target hardness factor delta_H (dimensionless)",
+    "PerforationSection.projectile_hardness": "projectile hardness for Part IV's V_cr",
+    "PerforationSection.projectile_delta_h": "projectile hardness factor delta_H (dimensionless)",
+    "PerforationSection.youngs_modulus": "target E for R(3) of Part IV, eq. (6)",
+}
+
+
+def key_description(model, key: str, si: str = "", comment: str = "") -> str:
+    """The one-line description of ``key`` in the section ``model`` (a pydantic model class):
+    the field's own description, else its source ``comment``, else :data:`KEY_HELP`
+    (``"Model.key"``, then ``key``), with the SI unit ``si`` of a quantity appended as
+    ``[unit]`` unless the text names it already."""
+    field = model.model_fields.get(key)
+    text = (field.description if field is not None else None) or comment or KEY_HELP.get(f"{model.__name__}.{key}") \
+        or KEY_HELP.get(key, "")
+    if text and si and f"[{si}]" not in text:
+        text = f"{text} [{si}]"
+    return text

@@ -151,3 +151,42 @@ def test_python_snippets_of_the_pages_run(page, tmp_path):
         proc = subprocess.run([sys.executable, "-c", code], cwd=ROOT, env=_env(tmp_path), capture_output=True, text=True,
                               timeout=300)
         assert proc.returncode == 0, (code, proc.stderr[-2000:])
+
+
+def test_every_case_key_has_a_description_with_its_unit():
+    """Every key of every section (nested tables included) has a one-line description on the
+    generated reference page, and a quantity's description names its SI unit."""
+    import typing
+
+    from pydantic import BaseModel
+
+    sys.path.insert(0, str(ROOT / "tools"))
+    try:
+        import docs_hooks
+    finally:
+        sys.path.pop(0)
+    from semianalytic.case import _CORE, SECTIONS, _section_model
+    from semianalytic.schema import _models_in, key_description
+    from semianalytic.units import KINDS
+
+    missing, seen = [], set()
+
+    def walk(name, model):
+        if model in seen:
+            return
+        seen.add(model)
+        comments = docs_hooks.source_comments(model)
+        for key, field in model.model_fields.items():
+            ann = typing.Annotated[(field.annotation, *field.metadata)] if field.metadata else field.annotation
+            q = docs_hooks._quantity(ann)
+            si = KINDS[q[0]][1] if q else ""
+            text = key_description(model, key, si, comments.get(key, ""))
+            if not text or "\n" in text or (si and f"[{si}]" not in text and si not in text):
+                missing.append(f"{name}.{key}")
+            for m in _models_in(field.annotation):
+                if isinstance(m, type) and issubclass(m, BaseModel):
+                    walk(f"{name}.{key}", m)
+
+    for n in [*_CORE, *SECTIONS]:
+        walk(n, _section_model(n))
+    assert not missing, missing

@@ -55,17 +55,17 @@ def sphere_files(tmp_path_factory):
 def test_meridian_file_holds_the_exact_field(sphere_files):
     mesh = pv.read(sphere_files[0])
     p = np.asarray(mesh.points)
-    v = np.asarray(mesh.point_data["velocity"])
+    v = np.asarray(mesh.point_data["velocity_m_s"])
     ref = _exact_velocity_3d(p)  # z = 0: (v_x, v_r, 0)
     np.testing.assert_allclose(v, ref, rtol=1e-12, atol=1e-14)
     assert np.all(p[:, 0] ** 2 + p[:, 1] ** 2 > A**2)  # no node inside the sphere
-    np.testing.assert_allclose(mesh.point_data["phi"], exact.sphere_potential(p[:, 0], p[:, 1], A), rtol=1e-12)
+    np.testing.assert_allclose(mesh.point_data["phi_m"], exact.sphere_potential(p[:, 0], p[:, 1], A), rtol=1e-12)
 
 
 def test_revolved_file_holds_the_exact_field(sphere_files):
     mesh = pv.read(sphere_files[1])
     p = np.asarray(mesh.points)
-    np.testing.assert_allclose(np.asarray(mesh.point_data["velocity"]), _exact_velocity_3d(p), rtol=1e-12, atol=1e-14)
+    np.testing.assert_allclose(np.asarray(mesh.point_data["velocity_m_s"]), _exact_velocity_3d(p), rtol=1e-12, atol=1e-14)
     # every cell has positive volume (correct hexahedron/wedge node order)
     assert float(np.min(mesh.compute_cell_sizes()["Volume"])) > 0
 
@@ -79,7 +79,7 @@ def test_probe_between_nodes_matches_the_exact_field(sphere_files):
     pts = np.column_stack([R * np.cos(th), R * np.sin(th) * np.cos(az), R * np.sin(th) * np.sin(az)])
     probed = pv.PolyData(pts).sample(mesh)
     assert np.all(np.asarray(probed["vtkValidPointMask"]) == 1)
-    got = np.asarray(probed["velocity"])
+    got = np.asarray(probed["velocity_m_s"])
     ref = _exact_velocity_3d(pts)
     err = np.linalg.norm(got - ref, axis=1) / np.linalg.norm(ref, axis=1)
     # Linear interpolation error: (h^2/8)|v''|/|v| ~ (0.15^2/8) * 12/R^2 ~ 1.3% at R = 1.6 a, plus the
@@ -97,7 +97,7 @@ def test_bem_field_in_the_file(tmp_path):
     path = vtk.write_vtu(vtk.revolved_mesh(field, 8), tmp_path / "f.vtu")
     mesh = pv.read(path)
     p = np.asarray(mesh.points)
-    v = np.asarray(mesh.point_data["velocity"])
+    v = np.asarray(mesh.point_data["velocity_m_s"])
     assert np.all(np.isfinite(v))
     pick = np.random.default_rng(1).choice(len(p), 25, replace=False)
     r = np.hypot(p[pick, 1], p[pick, 2])
@@ -134,9 +134,9 @@ def test_fem_field_file(tmp_path):
     vert = sol.basis.nodal_dofs[0]
     shift = np.array([getattr(sol, "shift", 0.0), 0.0])  # fem_check may work in tip-centred x
     np.testing.assert_allclose(np.asarray(mesh.points)[:, :2], sol.basis.doflocs[:, vert].T + shift, rtol=0, atol=1e-15)
-    np.testing.assert_array_equal(np.asarray(mesh.point_data["phi"]), sol.phi[vert])
-    p, diff = np.asarray(mesh.points), np.asarray(mesh.point_data["phi_difference"])
-    ref = np.asarray(mesh.point_data["phi_bem"])
+    np.testing.assert_array_equal(np.asarray(mesh.point_data["phi_m"]), sol.phi[vert])
+    p, diff = np.asarray(mesh.points), np.asarray(mesh.point_data["phi_difference_m"])
+    ref = np.asarray(mesh.point_data["phi_bem_m"])
     near = (np.hypot(p[:, 0] - P, p[:, 1]) < 3 * 7.11e-3) & np.isfinite(diff)
     assert near.sum() > 20
     # fem_check's own BEM-FEM agreement target is 1e-3 (A, C); the coarse h = 0.16 d mesh here gives ~3e-4
@@ -144,15 +144,48 @@ def test_fem_field_file(tmp_path):
 
 
 def test_every_array_and_the_coordinates_carry_their_unit(sphere_files):
-    """Field data ``units`` names the unit of the coordinates and of every point-data array
-    (written by hand here: velocity and speed in m/s, the potential at unit speed in m, Phi =
-    u phi in m^2/s); the striking speed of the field survives as field data."""
-    expected = {"coordinates": "m", "velocity": "m/s", "speed": "m/s", "Phi": "m^2/s"}
+    """Every point-data array names its unit (written by hand here: velocity and speed in m/s,
+    the potential at unit speed in m, Phi = u phi in m^2/s); the sidecar JSON repeats each
+    array's unit and shape and the coordinates' unit; the striking speed of the field survives
+    as numeric field data."""
+    import json
+
+    expected = {"velocity_m_s": "m/s", "speed_m_s": "m/s", "phi_m": "m", "Phi_m2_s": "m^2/s"}
     for f in sphere_files:
         mesh = pv.read(f)
-        units = dict(u.split(": ", 1) for u in mesh.field_data["units"])
-        assert {k: units[k] for k in expected} == expected
-        assert units["phi"].startswith("m ")
-        assert set(mesh.point_data.keys()) <= set(units)
-        assert list(mesh.field_data["coordinates_unit"]) == ["m"]
+        assert set(mesh.point_data.keys()) == set(expected)
+        side = json.loads(vtk.sidecar_path(f).read_text())
+        assert side["file"] == f.name and side["coordinates_unit"] == "m"
+        assert {k: side["arrays"][k]["unit"] for k in expected} == expected
+        assert side["arrays"]["velocity_m_s"]["shape"] == [mesh.n_points, 3]
         assert float(mesh.field_data["speed_u_m_s"][0]) == U
+        assert float(mesh.field_data["coordinates_unit_m"][0]) == 1.0
+
+
+def test_meshio_reads_the_files(sphere_files):
+    """meshio (the other reader the project names) opens every file: no string arrays (meshio
+    5.3 exits the interpreter on them), the same points and arrays as pyvista reads."""
+    import meshio
+
+    for f in sphere_files:
+        m = meshio.read(f)
+        p = pv.read(f)
+        np.testing.assert_array_equal(m.points, np.asarray(p.points))
+        for name in p.point_data.keys():
+            np.testing.assert_array_equal(m.point_data[name], np.asarray(p.point_data[name]))
+        assert float(m.field_data["speed_u_m_s"][0]) == U
+
+
+def test_coordinates_in_mm(sphere_files, tmp_path):
+    """``coordinates="mm"``: the points are 1000 times the metre file's, the arrays unchanged
+    (SI, named with their unit), and ``read_in_mm`` gives the same mm points from both files."""
+    import meshio
+
+    m = meshio.read(sphere_files[0])
+    mm = vtk.write_vtu(m, tmp_path / "mm.vtu", coordinates="mm")
+    got = meshio.read(mm)
+    np.testing.assert_allclose(got.points, m.points * 1e3, rtol=1e-15)
+    np.testing.assert_array_equal(got.point_data["velocity_m_s"], m.point_data["velocity_m_s"])
+    assert float(got.field_data["coordinates_unit_m"][0]) == 1e-3
+    np.testing.assert_allclose(np.asarray(vtk.read_in_mm(mm).points), np.asarray(vtk.read_in_mm(sphere_files[0]).points),
+                               rtol=1e-15)

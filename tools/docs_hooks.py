@@ -249,7 +249,7 @@ def section_table(name: str, model, heading: str | None = None) -> list[str]:
     """Markdown of one section: its docstring, then one row per key (nested tables after it)."""
     from pydantic import BaseModel
 
-    from semianalytic.schema import _models_in, allowed_values
+    from semianalytic.schema import _models_in, allowed_values, key_description
 
     lines = [heading or f"## `[{name}]`", ""]
     para = _doc_paragraph(model)
@@ -265,7 +265,7 @@ def section_table(name: str, model, heading: str | None = None) -> list[str]:
         q = _quantity(annotation)
         si = KINDS[q[0]][1] if q else ""
         lines.append(f"| `{key}` | {type_text(annotation)} | {_default_text(field, si)} | {_allowed_text(field)} | "
-                     f"{_md_escape(field.description or comments.get(key, ''))} |")
+                     f"{_md_escape(key_description(model, key, si, comments.get(key, '')))} |")
         members = [m for m in _models_in(field.annotation) if issubclass(m, BaseModel)]
         if members:
             nested.append((key, members))

@@ -73,10 +73,17 @@ def run_calibration(args: argparse.Namespace, command: str) -> dict:
             tcase = load_case(p)
             transfer.append((tcase, coefficients_for_case(tcase, args.coefficients, args.cache_dir)[0]))
     coefficients = coefficients_for_case(case, args.coefficients, args.cache_dir)[0]
-    progress = not args.quiet
+    from semianalytic.progress import mode, stages
+
+    progress = mode(args.quiet) == "bar"  # tqdm bars on a terminal only; one line per stage in a log
+    stage = stages(2 if args.cross_validate else 1, "calibrate", quiet=args.quiet or progress)
+    stage.step("sampling the posterior (emcee)")
     result = calibrate_case(case, coefficients, models=args.model, parameters=args.parameter, progress=progress,
                             steps=args.steps)
+    if args.cross_validate:
+        stage.step("leave-one-out refits")
     cv = cross_validate(case, coefficients, result, transfer, progress=progress) if args.cross_validate else None
+    stage.close()
     diag = None
     if args.diagnose:
         from semianalytic.calibration.diagnose import diagnose

@@ -9,8 +9,6 @@ from __future__ import annotations
 
 import json
 import math
-import sys
-
 
 from semianalytic.case import load_case
 from semianalytic.coefficients import READINGS
@@ -43,7 +41,7 @@ def run(args) -> int:
     out = coefficients_output(case, at=args.at, interpolated=args.interpolated, reading=args.reading,
                               depths=args.depths, max_depth=args.max_depth, tolerance=args.tolerance,
                               order=args.order, refinement=args.refinement, cache_dir=args.cache_dir,
-                              progress=not args.json and sys.stderr.isatty())
+                              progress=True)  # semianalytic.progress decides: bar, log lines or off
     if args.json:
         print(json.dumps(out))
     elif case.body is not None:
@@ -85,6 +83,27 @@ def _print_table(case, out) -> None:
     ea, eb = max(out["A_err_m3"]) / max(map(abs, out["A_m3"])), max(out["B_err_m2"]) / max(map(abs, out["B_m2"]))
     print(f"{out['knots']} knots; estimated error (interpolation + BEM) at most {ea:.1e} of max |A|, {eb:.1e} of max |B|"
           + (f" (tolerance {out['tolerance']:g})" if out["tolerance"] else ""))
+    where = _largest_error_note(out, L)
+    if where:
+        print(where)
+
+
+def _largest_error_note(out, L) -> str:
+    """Where the largest B error sits when it is at a corner breakpoint (a cone's shoulder entering
+    the target: B jumps there, and the estimate of the knot beside the jump spans the jump), and
+    the largest error away from the breakpoints."""
+    P, eb = out["depth_m"], out["B_err_m2"]
+    big = max(map(abs, out["B_m2"]))
+    k = max(range(len(eb)), key=lambda i: eb[i])
+    breaks = [b for b in out.get("breakpoints_m") or [] if b > 0]
+    near = lambda x: any(abs(x - b) <= 1e-3 * b for b in breaks)  # noqa: E731
+    if not near(P[k]):
+        return ""
+    away = [e for x, e in zip(P, eb) if not near(x)]
+    rest = f"; away from the breakpoints at most {max(away) / big:.1e} of max |B|" if away else ""
+    return (f"  largest B error: the knot at P = {P[k] * 1e3:.4f} mm (P/L_h = {P[k] / max(L, 1e-300):.6f}) beside the "
+            "corner breakpoint where the shoulder enters the target and B jumps; the estimate there spans the jump, "
+            f"it is not the interpolation error between knots{rest}")
 
 
 def _print_rows(case, out) -> None:

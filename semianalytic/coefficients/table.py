@@ -1121,9 +1121,10 @@ def coefficient_table(
     opts = LayoutOptions(order, refinement, levels)
     bar = None
     if progress:
-        from tqdm import tqdm
+        from semianalytic.progress import counter
 
-        bar = tqdm(desc="BEM depths", unit="depth", leave=False)
+        # the adaptive knots: about 70 (ogive) to 140 (cornered noses), bench_bem.md
+        bar = counter(len(depths) if depths is not None else 90, "BEM depths of the coefficient table", "depth")
     import contextlib
 
     from semianalytic.bem.solve import _single_threaded_blas

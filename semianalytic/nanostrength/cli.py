@@ -74,19 +74,25 @@ def run(args: argparse.Namespace) -> int:
     stem = Path(args.case).stem
     if args.report:
         check_report_target(Path(args.report) / f"{stem}.md", args.force)
+    from semianalytic.progress import stages
+
+    bar = stages(2 if args.report else 1, "nanostrength")
+    bar.step("Part III analyses (crystals, studies)")
     analysis = analyse_section(section)
     if args.report:
+        bar.step("report figures")
         from semianalytic.nanostrength.report import build_report, write_report
 
         command = f"python -m semianalytic nanostrength {args.case} --report {args.report}" + (" --force" if args.force else "")
         text, figs = build_report(analysis, case_path=str(args.case), stem=stem,
                                   elapsed=time.perf_counter() - t0, command=command)
         written = write_report(args.report, stem, text, figs, args.force)
+    bar.close()
     if args.json:
         json.dump(analysis.to_json(), sys.stdout, indent=2, allow_nan=False)
         sys.stdout.write("\n")
     else:
         print(_summary(analysis, case.title))
         if args.report:
-            print(f"\nreport: {written[-1]} (+ {len(written) - 1} figures)")
+            print(f"\nreport: {written[-2]} and {written[-1]} (+ {len(written) - 2} figures)")
     return 0

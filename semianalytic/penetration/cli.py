@@ -140,6 +140,8 @@ def _print_text(result: dict, desc: str, file=None) -> None:
     )
     p(head)
     p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8} | {'':>9} | {'P mm':>7} |")
+    p("  (P: final depth; t: time to rest, eq. (11); t*: the elastic projectile's stop, eq. (30'), where "
+      "m ubar^2 = 2 (W1 + W2); yields: U_s at or above the critical velocity U_sC, eq. (33))")
     n = len(result["striking_velocity_m_s"])
     for i in range(n):
         r = {k: result[k][i] for k in (

@@ -115,7 +115,9 @@ def eroding_inputs(case, setup) -> ErodingInputs:
 
 
 def _velocities(U, mask) -> str:
-    return ", ".join(f"{u:.0f}" for u in np.asarray(U)[mask])
+    from semianalytic.errors import summarise
+
+    return summarise(np.asarray(U)[mask].tolist())  # 1000 velocities: count, range, ends
 
 
 REGIME_RULES = ("meyer", "tate_tabor", "nose_length")

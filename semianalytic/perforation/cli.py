@@ -19,6 +19,7 @@ def add_arguments(parser) -> None:
     parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
     parser.add_argument("--no-ballistic-limit", action="store_true", help="skip the ballistic-limit search")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
+    parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
     parser.add_argument("--report", metavar="DIR", default=None, type=output_dir,
                         help="write validation_perforation.md (and its figure and CSV) into DIR")
 
@@ -54,7 +55,14 @@ def run(args) -> int:
     for c in cases:
         for sec in ("projectile", "target", "impact"):
             c.require(sec)
-    results = [evaluate_case(c, cache_dir=args.cache_dir, ballistic=not args.no_ballistic_limit) for c in cases]
+    from semianalytic.progress import stages
+
+    bar = stages(len(cases), "perforate", quiet=args.quiet)  # 20-40 s per case with new plate tables
+    results = []
+    for c in cases:
+        bar.step(f"{c.title}: plate tables, eq. (11), ballistic limit")
+        results.append(evaluate_case(c, cache_dir=args.cache_dir, ballistic=not args.no_ballistic_limit))
+    bar.close()
     if args.report:
         from semianalytic.perforation.evaluate import thickness_sweep
         from semianalytic.perforation.report import write_report

@@ -95,3 +95,103 @@ def to_html(doc: Document, images: Callable[[str], bytes | None] | None = None) 
         + "\n".join(body)
         + "\n</body>\n</html>\n"
     )
+
+
+def markdown_to_html(text: str, images: Callable[[str], bytes | None] | None = None) -> str:
+    """A report written as Markdown text (the subset the reports use: ``#`` headings, pipe
+    tables, ``![alt](file.png)`` figures, fenced code, ``-`` lists, ``>`` notes, paragraphs,
+    inline `code` and **bold**) as one self-contained page: figures embedded from
+    ``images(relative path)`` as :func:`to_html` does."""
+    lines = text.splitlines()
+    title = next((ln[2:].strip() for ln in lines if ln.startswith("# ")), "report")
+    body: list[str] = []
+    para: list[str] = []
+    i = 0
+
+    def flush():
+        if para:
+            body.append(f"<p>{_inline(' '.join(para))}</p>")
+            para.clear()
+
+    while i < len(lines):
+        ln = lines[i]
+        s = ln.strip()
+        if s.startswith("```"):
+            flush()
+            j = i + 1
+            while j < len(lines) and not lines[j].strip().startswith("```"):
+                j += 1
+            body.append(f"<pre>{html.escape(chr(10).join(lines[i + 1:j]))}</pre>")
+            i = j + 1
+            continue
+        m = re.match(r"^(#{1,6})\s+(.*)$", s)
+        img = re.match(r"^!\[(.*)\]\(([^)\s]+)\)\s*$", s)  # the alt text may hold [ ] and ( )
+        if m:
+            flush()
+            lvl = len(m.group(1))
+            body.append(f"<h{lvl}>{_inline(m.group(2))}</h{lvl}>")
+        elif img:
+            flush()
+            src = _image_src(img.group(2), images)
+            body.append(f'<figure><img src="{src}" data-file="{html.escape(img.group(2), quote=True)}" '
+                        f'alt="{html.escape(img.group(1), quote=True)}"><figcaption>{_inline(img.group(1))}'
+                        "</figcaption></figure>")
+        elif s.startswith("|"):
+            flush()
+            rows = []
+            while i < len(lines) and lines[i].strip().startswith("|"):
+                cells = [c.strip() for c in lines[i].strip().strip("|").split("|")]
+                if not all(re.fullmatch(r":?-{2,}:?", c) for c in cells if c):
+                    rows.append(cells)
+                i += 1
+            out = ["<table>"]
+            for k, cells in enumerate(rows):
+                tag = "th" if k == 0 else "td"
+                out.append("<tr>" + "".join(f"<{tag}>{_inline(c)}</{tag}>" for c in cells) + "</tr>")
+            out.append("</table>")
+            body.append("\n".join(out))
+            continue
+        elif re.match(r"^[-*] ", s):
+            flush()
+            items = []
+            while i < len(lines) and re.match(r"^\s*[-*] ", lines[i]):
+                items.append(f"<li>{_inline(lines[i].strip()[2:])}</li>")
+                i += 1
+            body.append("<ul>" + "".join(items) + "</ul>")
+            continue
+        elif s.startswith(">"):
+            flush()
+            body.append(f'<div class="note">{_inline(s.lstrip("> "))}</div>')
+        elif not s:
+            flush()
+        elif not (s == f"# {title}"):
+            para.append(s)
+        i += 1
+    flush()
+    return (
+        "<!DOCTYPE html>\n<html lang=\"en\">\n<head>\n<meta charset=\"utf-8\">\n"
+        f"<title>{html.escape(title)}</title>\n<style>{_CSS}</style>\n</head>\n<body>\n"
+        + "\n".join(body)
+        + "\n</body>\n</html>\n"
+    )
+
+
+def html_beside(md_path, text: str | None = None):
+    """Write ``NAME.html`` beside ``NAME.md``: the Markdown as a self-contained page (figures
+    embedded from the files beside it; a figure that is not there stays a relative link)."""
+    from pathlib import Path
+
+    from semianalytic.io import atomic_write_text, contained_path
+
+    md_path = Path(md_path)
+    text = md_path.read_text(encoding="utf-8") if text is None else text
+    root = md_path.parent
+
+    def images(rel: str) -> bytes | None:
+        try:
+            p = contained_path(root, rel, "report figure")
+        except Exception:
+            return None
+        return p.read_bytes() if p.is_file() else None
+
+    return atomic_write_text(md_path.with_suffix(".html"), markdown_to_html(text, images), overwrite=True)

@@ -27,7 +27,10 @@ __all__ = [
     "revolved_mesh",
     "revolved_surface",
     "write_vtu",
+    "sidecar_path",
+    "in_coordinates",
     "fem_meridian_mesh",
+    "read_in_mm",
     "render_png",
 ]
 
@@ -39,7 +42,7 @@ def _quad_cells(fluid: np.ndarray) -> np.ndarray:
 
 
 def _field_data(field) -> dict:
-    fd = {"speed_u_m_s": np.array([field.speed_u])}
+    fd = {"speed_u_m_s": np.array([float(field.speed_u)])}
     if field.depth is not None:
         fd["depth_m"] = np.array([field.depth])
     return fd
@@ -67,8 +70,8 @@ def _as_quads(field):
 
 
 def meridian_mesh(field):
-    """The meridian plane as a meshio mesh: quads in z = 0, point data velocity (m/s),
-    speed |v| (m/s), phi (m, unit speed) and Phi = u phi (m^2/s)."""
+    """The meridian plane as a meshio mesh: quads in z = 0, point data ``velocity_m_s``,
+    ``speed_m_s`` (|v|), ``phi_m`` (the potential at unit speed) and ``Phi_m2_s`` (u phi)."""
     import meshio
 
     pts2, quads, vx, vr, phi = _as_quads(field)
@@ -79,10 +82,10 @@ def meridian_mesh(field):
     new[used] = np.arange(used.sum())
     pts = np.column_stack([pts2, np.zeros(n)])[used]
     vel = np.column_stack([vx, vr, np.zeros(n)])[used]
-    pdata = {"velocity": vel, "speed": np.hypot(vel[:, 0], vel[:, 1])}
+    pdata = {"velocity_m_s": vel, "speed_m_s": np.hypot(vel[:, 0], vel[:, 1])}
     if phi is not None:
-        pdata["phi"] = phi[used]
-        pdata["Phi"] = field.speed_u * pdata["phi"]
+        pdata["phi_m"] = phi[used]
+        pdata["Phi_m2_s"] = field.speed_u * pdata["phi_m"]
     return meshio.Mesh(pts, [("quad", new[quads])], point_data=pdata, field_data=_field_data(field))
 
 
@@ -160,10 +163,10 @@ def revolved_mesh(field, segments: int = 24):
     new[used] = np.arange(used.sum())
     blocks = [(t, new[c]) for t, c in blocks]
     vel = vel[used]
-    pdata = {"velocity": vel, "speed": np.linalg.norm(vel, axis=1)}
+    pdata = {"velocity_m_s": vel, "speed_m_s": np.linalg.norm(vel, axis=1)}
     if phi is not None:
-        pdata["phi"] = ph[used]
-        pdata["Phi"] = field.speed_u * ph[used]
+        pdata["phi_m"] = ph[used]
+        pdata["Phi_m2_s"] = field.speed_u * ph[used]
     return meshio.Mesh(pts[used], blocks, point_data=pdata, field_data=_field_data(field))
 
 
@@ -183,34 +186,31 @@ def revolved_surface(profile: np.ndarray, segments: int = 48):
     return meshio.Mesh(pts, [("quad", quads)])
 
 
-# The unit of every array the writers here produce (point data and field data), and of the
-# coordinates; written into each .vtu as string field data (``units``, ``coordinates_unit``).
-UNITS = {
-    "coordinates": "m",
-    "velocity": "m/s",
-    "speed": "m/s",
-    "phi": "m (potential at unit striking speed)",
-    "Phi": "m^2/s",
-    "phi_bem": "m (potential at unit striking speed)",
-    "phi_difference": "m (potential at unit striking speed)",
-    "speed_u_m_s": "m/s",
-    "depth_m": "m",
+# The unit and meaning of every array the writers here produce (point data and field data).
+# The unit is also the suffix of the array's name (``velocity_m_s``), so every VTK reader
+# (meshio, pyvista, ParaView) shows it; the sidecar JSON beside each file (:func:`sidecar_path`)
+# repeats it with the coordinates' unit.  Only numeric arrays go into the files: meshio 5.3
+# rejects VTK string arrays ("Illegal data type 'String'").
+ARRAYS = {
+    "velocity_m_s": ("m/s", "target velocity v = -u grad(phi), Part I eq. (8); 3 components (x, y, z)"),
+    "speed_m_s": ("m/s", "|v|"),
+    "phi_m": ("m", "velocity potential at unit striking speed"),
+    "Phi_m2_s": ("m^2/s", "velocity potential Phi = u phi"),
+    "phi_bem_m": ("m", "BEM potential at unit speed at the FEM vertices (NaN on the body and the wall)"),
+    "phi_difference_m": ("m", "FEM minus BEM potential at unit speed"),
+    "speed_u_m_s": ("m/s", "projectile speed u of the field (field data)"),
+    "depth_m": ("m", "depth of the tip P below the free surface (field data)"),
+    "coordinates_unit_m": ("m", "length of one coordinate unit in metres (1 for m, 0.001 for mm; field data)"),
 }
+COORDINATE_UNITS = {"m": 1.0, "mm": 1e-3}
 
 
 def _field_data_xml(mesh) -> str:
-    """A VTK XML ``<FieldData>`` block: the mesh's field data (meshio's VTU writer drops it)
-    and, as strings, the unit of the coordinates and of every array (:data:`UNITS`)."""
+    """A VTK XML ``<FieldData>`` block of the mesh's (numeric) field data: meshio's VTU writer
+    drops field data, and meshio and pyvista both read Float64 arrays back."""
     from xml.sax.saxutils import quoteattr
 
-    def strings(name: str, values: list[str]) -> str:
-        codes = " ".join(" ".join(str(b) for b in v.encode("utf-8")) + " 0" for v in values)
-        return (f'<DataArray type="String" Name={quoteattr(name)} NumberOfTuples="{len(values)}" format="ascii">'
-                f"{codes}</DataArray>")
-
-    names = ["coordinates", *mesh.point_data, *(mesh.field_data or {})]
-    arrays = [strings("units", [f"{n}: {UNITS.get(n, 'dimensionless')}" for n in names]),
-              strings("coordinates_unit", [UNITS["coordinates"]])]
+    arrays = []
     for name, value in (mesh.field_data or {}).items():
         v = np.atleast_1d(np.asarray(value, float))
         arrays.append(f'<DataArray type="Float64" Name={quoteattr(name)} NumberOfTuples="{v.size}" format="ascii">'
@@ -218,17 +218,71 @@ def _field_data_xml(mesh) -> str:
     return "<FieldData>\n" + "\n".join(arrays) + "\n</FieldData>\n"
 
 
-def write_vtu(mesh, path: str | os.PathLike) -> Path:
-    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename),
-    with the units of its coordinates and arrays as field data (:data:`UNITS`)."""
+def sidecar_path(path: str | os.PathLike) -> Path:
+    """The JSON beside a ``.vtu`` (``name.vtu`` -> ``name.units.json``) naming the unit and the
+    meaning of the coordinates and of every array in it."""
+    path = Path(path)
+    return path.with_name(path.stem + ".units.json")
+
+
+def sidecar(mesh, filename: str, coordinates: str = "m") -> dict:
+    """The sidecar's content: the file name (no folder), the coordinates' unit and, per array,
+    its unit, meaning and shape."""
+    def entry(name, value, where):
+        unit, what = ARRAYS.get(name, ("1", "dimensionless"))
+        return {"unit": unit, "description": what, "association": where, "shape": list(np.shape(value))}
+
+    arrays = {n: entry(n, v, "point") for n, v in mesh.point_data.items()}
+    arrays.update({n: entry(n, np.atleast_1d(v), "field") for n, v in (mesh.field_data or {}).items()})
+    return {"file": filename, "coordinates_unit": coordinates,
+            "coordinates": "x along the axis from the free surface into the target, (y, z) across it",
+            "arrays": arrays}
+
+
+def in_coordinates(mesh, coordinates: str = "m"):
+    """``mesh`` with its coordinates in ``coordinates`` (``"m"`` or ``"mm"``): the points are
+    scaled, the arrays keep their SI units (named in their names), and field data
+    ``coordinates_unit_m`` records one coordinate unit in metres."""
     import meshio
 
+    if coordinates not in COORDINATE_UNITS:
+        from semianalytic.errors import InputError
+
+        raise InputError("coordinates", f"{coordinates!r} is not one of {', '.join(COORDINATE_UNITS)}")
+    scale = COORDINATE_UNITS[coordinates]
+    fd = dict(mesh.field_data or {})
+    fd["coordinates_unit_m"] = np.array([scale])
+    return meshio.Mesh(np.asarray(mesh.points, float) / scale, mesh.cells, point_data=dict(mesh.point_data),
+                       field_data=fd)
+
+
+def write_vtu(mesh, path: str | os.PathLike, coordinates: str = "m") -> Path:
+    """Write ``mesh`` as binary ``.vtu`` atomically (temporary file in the folder, then rename),
+    its numeric field data included, and its sidecar JSON (:func:`sidecar_path`).
+
+    Parameters
+    ----------
+    mesh : meshio.Mesh
+        Coordinates in metres; arrays named with their unit (:data:`ARRAYS`).
+    path : str or os.PathLike
+        The ``.vtu`` file.
+    coordinates : {"m", "mm"}
+        Unit of the coordinates written (``"mm"`` gives readable axis ticks at projectile scale).
+
+    Returns
+    -------
+    pathlib.Path
+        ``path``.
+    """
+    import meshio
+
+    from semianalytic.io import _umask, atomic_write_json
+
+    mesh = in_coordinates(mesh, coordinates)
     path = Path(path)
     path.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{path.stem}.", suffix=".vtu", dir=path.parent)
     os.close(fd)
-    from semianalytic.io import _umask
-
     os.chmod(tmp, 0o666 & ~_umask())
     try:
         meshio.write(tmp, mesh, file_format="vtu", binary=True)
@@ -239,11 +293,8 @@ def write_vtu(mesh, path: str | os.PathLike) -> Path:
     except BaseException:
         Path(tmp).unlink(missing_ok=True)
         raise
+    atomic_write_json(sidecar_path(path), sidecar(mesh, path.name, coordinates))
     return path
-
-
-# --------------------------------------------------------------------------------------
-# FEM fields of fem_check
 
 
 # --------------------------------------------------------------------------------------
@@ -255,9 +306,9 @@ def fem_meridian_mesh(field, u: float, phi_reference=None):
 
     ``field``: vertex values of fem_check (:class:`fem_check.api.PotentialField`: ``points``
     (n, 2) in the target frame [m], ``triangles``, ``phi`` (unit speed) [m], ``gradient`` (n, 2)).
-    Point data: ``phi``, ``velocity`` = -u grad(phi) (Part I, eq. (8)) [m/s] and ``speed``;
+    Point data: ``phi_m``, ``velocity_m_s`` = -u grad(phi) (Part I, eq. (8)) and ``speed_m_s``;
     with ``phi_reference`` (n,) (e.g. the BEM potential at the same vertices, NaN where not
-    defined), also ``phi_bem`` and ``phi_difference`` = FEM - reference.
+    defined), also ``phi_bem_m`` and ``phi_difference_m`` = FEM - reference.
     """
     import meshio
 
@@ -265,14 +316,14 @@ def fem_meridian_mesh(field, u: float, phi_reference=None):
     phi = np.asarray(field.phi, float)
     grad = np.asarray(field.gradient, float)
     vel = np.column_stack([-u * grad[:, 0], -u * grad[:, 1], np.zeros(len(phi))])
-    pdata = {"phi": phi, "velocity": vel, "speed": np.hypot(vel[:, 0], vel[:, 1])}
+    pdata = {"phi_m": phi, "velocity_m_s": vel, "speed_m_s": np.hypot(vel[:, 0], vel[:, 1])}
     if phi_reference is not None:
         ref = np.asarray(phi_reference, float)
-        pdata["phi_bem"] = ref
-        pdata["phi_difference"] = phi - ref
+        pdata["phi_bem_m"] = ref
+        pdata["phi_difference_m"] = phi - ref
     pts = np.column_stack([pts2, np.zeros(len(phi))])
     return meshio.Mesh(pts, [("triangle", np.asarray(field.triangles))], point_data=pdata,
-                       field_data={"speed_u_m_s": np.array([u])})
+                       field_data={"speed_u_m_s": np.array([float(u)])})
 
 
 # --------------------------------------------------------------------------------------
@@ -290,6 +341,18 @@ def quiet_vtk_display_messages() -> None:
     vtkObject.GlobalWarningDisplayOff()
 
 
+def read_in_mm(path):
+    """A ``.vtu`` of :func:`write_vtu` read with pyvista, its coordinates in mm whatever unit
+    they were written in (field data ``coordinates_unit_m``; metres when absent), so that axis
+    ticks and a scale bar read in mm.  The arrays keep their SI units."""
+    import pyvista as pv
+
+    mesh = pv.read(str(path))
+    unit_m = float(np.asarray(mesh.field_data["coordinates_unit_m"])[0]) if "coordinates_unit_m" in mesh.field_data else 1.0
+    mesh.points = np.asarray(mesh.points, float) * (unit_m / 1e-3)
+    return mesh
+
+
 def render_png(volume_path, meridian_path, surface_path, png_path, title: str = "", window=(1000, 620)) -> Path:
     """Off-screen pyvista picture: the revolved body-fitted field cut in half at the meridian
     plane z = 0 (the volume conforms to the projectile, so the field is clipped at the body),
@@ -303,19 +366,19 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
 
     pv.OFF_SCREEN = True
     quiet_vtk_display_messages()
-    vol = pv.read(str(volume_path))
+    vol = read_in_mm(volume_path)
     half = vol.clip(normal=(0.0, 0.0, 1.0), origin=(0.0, 0.0, 0.0))
     p = pv.Plotter(off_screen=True, window_size=list(window))
     p.set_background("white")
-    speed_all = np.asarray(vol.point_data["speed"])
+    speed_all = np.asarray(vol.point_data["speed_m_s"])
     norm, extend, _ = speed_scale(speed_all)
     log = type(norm).__name__ == "LogNorm"
     # VTK's fonts lack '|': a plain title (the old "speed |v|" rendered as "speed ᵛ")
     bar = {"title": "speed [m/s]" + (", log scale" if log else ""), "color": "black", "vertical": True,
            "position_x": 0.86, "position_y": 0.15, "height": 0.7, "fmt": "%.3g"}
-    p.add_mesh(half, scalars="speed", cmap="viridis", show_scalar_bar=True, clim=[norm.vmin, norm.vmax],
+    p.add_mesh(half, scalars="speed_m_s", cmap="viridis", show_scalar_bar=True, clim=[norm.vmin, norm.vmax],
                log_scale=log, scalar_bar_args=bar)
-    mer = pv.read(str(meridian_path))
+    mer = read_in_mm(meridian_path)
     if mer.n_points:
         b = mer.bounds
         span = float(b[1] - b[0])
@@ -325,7 +388,7 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
         probed = lattice.sample(mer)
         ok = np.asarray(probed["vtkValidPointMask"]) == 1
         pts = np.asarray(probed.points)[ok]
-        vel = np.asarray(probed["velocity"])[ok]
+        vel = np.asarray(probed["velocity_m_s"])[ok]
         pts = np.vstack([pts, pts * [1.0, -1.0, 1.0]])
         vel = np.vstack([vel, vel * [1.0, -1.0, 1.0]])
         pts[:, 2] += 0.01 * span  # just above the cut face, towards the camera
@@ -335,24 +398,24 @@ def render_png(volume_path, meridian_path, surface_path, png_path, title: str = 
         p.add_mesh(arrows_src.glyph(orient="direction", scale=False, factor=0.6 * step), color="white")
     if surface_path is not None:
         # the whole projectile: in parallel projection it covers exactly its own cut section
-        p.add_mesh(pv.read(str(surface_path)), color="lightgrey", smooth_shading=True)
+        p.add_mesh(read_in_mm(surface_path), color="lightgrey", smooth_shading=True)
     if title:
         import textwrap
 
-        p.add_text("\n".join(textwrap.wrap(title, 70)) + "\naxes: x, depth [m] (horizontal); r, radius [m] (vertical)",
+        p.add_text("\n".join(textwrap.wrap(title, 70)) + "\naxes: x, depth [mm] (horizontal); r, radius [mm] (vertical)",
                    font_size=9, color="black")  # VTK drops the vertical axis title in a 2D view
-    # axes with their unit and a length scale (the coordinates are in metres; labelled in mm)
+    # axes with their unit and a length scale, both in mm (the meshes were read in mm)
     b = vol.bounds
-    x_lo = 0.0 if abs(b[0]) < 1e-12 else float(b[0])  # the free surface x = 0, not -3e-18
-    p.show_bounds(bounds=[x_lo, b[1], -b[3], b[3], 0.0, 0.0], xtitle="x, depth [m]", ytitle="r, radius [m]", ztitle="",
+    x_lo = 0.0 if abs(b[0]) < 1e-9 else float(b[0])  # the free surface x = 0, not -3e-15
+    p.show_bounds(bounds=[x_lo, b[1], -b[3], b[3], 0.0, 0.0], xtitle="x, depth [mm]", ytitle="r, radius [mm]", ztitle="",
                   location="outer", ticks="outside", font_size=9, color="black", fmt="%.3g", show_zaxis=False,
                   show_zlabels=False)
     span = float(b[1] - b[0])
-    bar_len = 10.0 ** math.floor(math.log10(max(span / 4.0, 1e-12)))  # 1, 10, 100 ... mm: about a quarter of the window
+    bar_len = 10.0 ** math.floor(math.log10(max(span / 4.0, 1e-9)))  # 1, 10, 100 ... mm: about a quarter of the window
     y0 = -0.92 * float(b[3])
     x0 = float(b[1]) - 1.1 * bar_len
     p.add_mesh(pv.Line((x0, y0, 0.02 * span), (x0 + bar_len, y0, 0.02 * span)), color="white", line_width=5)
-    p.add_point_labels([(x0 + 0.5 * bar_len, y0 + 0.09 * float(b[3]), 0.02 * span)], [f"{bar_len * 1e3:g} mm"], font_size=12,
+    p.add_point_labels([(x0 + 0.5 * bar_len, y0 + 0.09 * float(b[3]), 0.02 * span)], [f"{bar_len:g} mm"], font_size=12,
                        text_color="white", shape=None, show_points=False, always_visible=True)
     p.view_xy()
     p.enable_parallel_projection()

@@ -79,6 +79,9 @@ class RunSection(Section):
     render: bool = True
     coefficients: Literal["bem", "paper"] = "bem"  # "paper": the paper's quoted Abar, Bbar, Cbar (errata 2, 2c)
     vtk_dir: str = "vtk"
+    vtk_coordinates: Literal["m", "mm"] = Field(
+        default="m", description="unit of the .vtu coordinates (mm: readable axis ticks at projectile scale; the "
+                                 "arrays stay SI, named with their unit)")
     figures_dir: str = "figures"
 
     @field_validator("field_grid")

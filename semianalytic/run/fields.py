@@ -201,8 +201,9 @@ def _velocity_field_run(ctx: Context) -> None:
         f"of the meridian plane ({n_theta} rays x {n_rho} nodes from the projectile surface to a window reaching "
         f"{run.field_extent:g} diameters beyond the tip and the free surface x = 0), revolved into "
         f"{run.field_segments} azimuthal segments: the grid conforms to the body and to the free surface, so no "
-        "cell overlaps the projectile. Open the `.vtu` files in ParaView or pyvista (point data `velocity` [m/s], "
-        "`speed` [m/s], `phi` [m] at unit speed, `Phi` = u phi [m^2/s])."
+        f"cell overlaps the projectile. Open the `.vtu` files in ParaView, pyvista or meshio (coordinates in {run.vtk_coordinates}; point "
+        "data named with their unit: `velocity_m_s`, `speed_m_s`, `phi_m` at unit speed, `Phi_m2_s` = u phi; field "
+        "data `speed_u_m_s`, `depth_m`); each file's `.units.json` beside it names every array's unit and meaning."
     )
     out = []
     for P in _field_depths(case, run):
@@ -213,10 +214,10 @@ def _velocity_field_run(ctx: Context) -> None:
         rel2, p2 = ctx.vtk_path(f"velocity_meridian_{tag}.vtu")
         rel3, p3 = ctx.vtk_path(f"velocity_3d_{tag}.vtu")
         rels, ps = ctx.vtk_path(f"projectile_{tag}.vtu")
-        vtk.write_vtu(vtk.meridian_mesh(field), p2)
-        vtk.write_vtu(vtk.revolved_mesh(field, run.field_segments), p3)
+        vtk.write_vtu(vtk.meridian_mesh(field), p2, run.vtk_coordinates)
+        vtk.write_vtu(vtk.revolved_mesh(field, run.field_segments), p3, run.vtk_coordinates)
         outline = projectile_outline(pr.nose, pr.length, P)
-        vtk.write_vtu(vtk.revolved_surface(outline, 4 * run.field_segments), ps)
+        vtk.write_vtu(vtk.revolved_surface(outline, 4 * run.field_segments), ps, run.vtk_coordinates)
         drawn = np.unique(field.quads)
         speed = np.hypot(field.vx, field.vr)[drawn]
         fig, scale = velocity_field_figure(
@@ -292,7 +293,7 @@ def _fem_field_run(ctx: Context) -> None:
     d.para(
         "The independent finite-element solution of the same potential problem (fem_check: gmsh mesh of the "
         "meridian half-plane, P2 elements with curved edges, monopole Robin far field, errata item 2f), written "
-        "as `.vtu` with the BEM potential at the same vertices for comparison (`phi_bem`, `phi_difference`)."
+        "as `.vtu` with the BEM potential at the same vertices for comparison (`phi_bem_m`, `phi_difference_m`)."
     )
     rows, out = [], []
     for P in _field_depths(case, run):
@@ -302,10 +303,10 @@ def _fem_field_run(ctx: Context) -> None:
         mesh = vtk.fem_meridian_mesh(sol, u, bem_at_vertices(sol, bem))
         tag = _depth_tag(P)
         rel, path = ctx.vtk_path(f"fem_potential_{tag}.vtu")
-        vtk.write_vtu(mesh, path)
+        vtk.write_vtu(mesh, path, run.vtk_coordinates)
         pts = mesh.points
         near = np.hypot(pts[:, 0] - P, pts[:, 1]) < 3 * pr.diameter
-        diff, ref = mesh.point_data["phi_difference"], mesh.point_data["phi_bem"]
+        diff, ref = mesh.point_data["phi_difference_m"], mesh.point_data["phi_bem_m"]
         ok = near & np.isfinite(diff)
         dmax = float(np.max(np.abs(diff[ok])) / np.max(np.abs(ref[ok]))) if ok.any() else float("nan")
         rows.append([_mm(P), str(sol.dofs), fmt(sol.A), fmt(bem.A), f"{abs(sol.A - bem.A) / abs(bem.A):.1e}",

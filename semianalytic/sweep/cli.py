@@ -57,42 +57,11 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 
 def run(args: argparse.Namespace) -> int:
-    from semianalytic.case import load_case
-    from semianalytic.sweep.engine import run_sweep
-    from semianalytic.sweep.spec import build_spec
-
-    if args.resume and args.force:
-        raise InputError("--resume", "cannot be combined with --force")
-    if args.workers < 1:
-        raise InputError("--workers", "must be at least 1")
-    if args.batch_size is not None and args.batch_size < 1:
-        raise InputError("--batch-size", "must be at least 1")
-    if args.samples < 0:
-        raise InputError("--samples", "must not be negative")
-    if args.scheduler is not None and not args.scheduler.strip():
-        raise InputError("--scheduler", "empty; give 'inline', 'local' or a dask scheduler address (host:port)")
-    spec = build_spec(args.vary, args.sample, args.samples, args.seed)
-    case = load_case(args.case)
-    check_axes(case, spec)
-    from semianalytic.guards import check_case, check_sweep_size
-    from semianalytic.sweep.kernels import changes_table
-
-    check_case(case)  # refuse before any worker starts what would not fit in memory
-    geometries = 1
-    for axis in spec.axes:
-        if changes_table(axis.key):
-            geometries *= len(axis.values)
-    geometries *= args.samples if any(changes_table(s.key) for s in spec.samplers) else 1
-    check_sweep_size(spec.n_cases, geometries, "--samples" if spec.samplers else "--vary")
-    kernel = sweep_kernel(case, args.analysis, args.cache_dir, args.full)
-    summary = run_sweep(
-        args.case, spec, args.out, fmt=args.fmt, resume=args.resume, force=args.force,
-        scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size,
-        progress=not args.no_progress, kernel=kernel,
-    )
+    summary, stats = sweep_case(
+        args.case, args.out, args.vary, args.sample, samples=args.samples, seed=args.seed, analysis=args.analysis,
+        full=args.full, fmt=args.fmt, scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size,
+        cache_dir=args.cache_dir, resume=args.resume, force=args.force, progress=not args.no_progress)
     info = summary.to_json()
-    stats_path = summary.out / "statistics.json"
-    stats = json.loads(stats_path.read_text()) if stats_path.exists() else {}
     if args.json:
         print(json.dumps({**info, "statistics": stats}, indent=2))
     else:
@@ -106,6 +75,52 @@ def run(args: argparse.Namespace) -> int:
                 print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
                       f"(n = {st['n']})")
     return 0 if summary.n_error == 0 else 1
+
+
+def sweep_case(case_path: str, out: str, vary: list[str] = (), sample: list[str] = (), *, samples: int = 0,
+               seed: int = 0, analysis: str | None = None, full: bool = False, fmt: str = "csv",
+               scheduler: str | None = None, workers: int = 2, batch_size: int | None = None,
+               cache_dir: str | None = None, resume: bool = False, force: bool = False, progress: bool = True):
+    """The ``sweep`` command with typed arguments (the flags of the same names): checks, runs and
+    writes ``out``; returns ``(summary, statistics)`` (the engine's summary and the
+    ``statistics.json`` it wrote)."""
+    vary, sample = list(vary), list(sample)
+    from semianalytic.case import load_case
+    from semianalytic.sweep.engine import run_sweep
+    from semianalytic.sweep.spec import build_spec
+
+    if resume and force:
+        raise InputError("--resume", "cannot be combined with --force")
+    if workers < 1:
+        raise InputError("--workers", "must be at least 1")
+    if batch_size is not None and batch_size < 1:
+        raise InputError("--batch-size", "must be at least 1")
+    if samples < 0:
+        raise InputError("--samples", "must not be negative")
+    if scheduler is not None and not scheduler.strip():
+        raise InputError("--scheduler", "empty; give 'inline', 'local' or a dask scheduler address (host:port)")
+    spec = build_spec(vary, sample, samples, seed)
+    case = load_case(case_path)
+    check_axes(case, spec)
+    from semianalytic.guards import check_case, check_sweep_size
+    from semianalytic.sweep.kernels import changes_table
+
+    check_case(case)  # refuse before any worker starts what would not fit in memory
+    geometries = 1
+    for axis in spec.axes:
+        if changes_table(axis.key):
+            geometries *= len(axis.values)
+    geometries *= samples if any(changes_table(s.key) for s in spec.samplers) else 1
+    check_sweep_size(spec.n_cases, geometries, "--samples" if spec.samplers else "--vary")
+    kernel = sweep_kernel(case, analysis, cache_dir, full)
+    summary = run_sweep(
+        case_path, spec, out, fmt=fmt, resume=resume, force=force,
+        scheduler=scheduler, workers=workers, batch_size=batch_size,
+        progress=progress, kernel=kernel,
+    )
+    stats_path = summary.out / "statistics.json"
+    stats = json.loads(stats_path.read_text()) if stats_path.exists() else {}
+    return summary, stats
 
 
 def sweep_kernel(case, analysis, cache_dir, full):

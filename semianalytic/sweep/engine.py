@@ -598,8 +598,12 @@ def _record(store: ResultStore, rows: list[dict] | Columns, summary: SweepSummar
 
 
 def _progress(total: int, enabled: bool):
-    if not enabled:
+    from semianalytic.progress import counter, mode
+
+    if not enabled or mode() == "off":
         return None
+    if mode() == "lines":  # a log: a start and an end line, not a bar's carriage returns
+        return counter(total, "sweep", "case")
     from tqdm import tqdm
 
     return tqdm(total=total, unit="case", file=sys.stderr, dynamic_ncols=True, mininterval=0.5)
