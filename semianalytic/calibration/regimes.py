@@ -549,7 +549,7 @@ def regime_shots(case, coefficients) -> RegimeShots:
         U.append(s.velocity)
         m.append(setup.mass)
         P.append(s.depth)
-        r = RESPONSE_REGIME.get(s.row.get(col, "")) if col else None
+        r = RESPONSE_REGIME.get(s.row.get(col, "").strip()) if col else None
         rec.append(rg.REGIMES.index(r) if r else -1)
         h = s.row.get(data.hardness_column, "") if data.hardness_column else ""
         try:
@@ -559,6 +559,9 @@ def regime_shots(case, coefficients) -> RegimeShots:
         p1.append(float(penetration_curve(setup, [s.velocity])["depth_elastic_exact_rod_m"][0]))
         fd.append(float(peer_depths(case, setup, [s.velocity])["forrestal"][0]))
         crits.append((setup.critical_inputs(), setup.phi))
+    if col and not np.any(np.array(rec) >= 0):  # the transitions would be placed by the depths alone, silently
+        raise InputError("data.response_column", f"no selected shot has a recorded response in column {col!r} (every "
+                                                 f"label is blank); record each shot's response ({', '.join(RESPONSE_REGIME)})")
     vcrit = np.vectorize(lambda Y, j: crit.critical_velocity(float(Y), crits[j][0], crits[j][1]), otypes=[float])
     idx = np.arange(len(shots))
 
@@ -749,9 +752,71 @@ def is_regimes_posterior(path) -> bool:
         return False
 
 
+DRAW_SUPPORT = {
+    "dynamic_factor": (F_PRIOR[0], F_PRIOR[1], "the prior uniform(1, 3)"),
+    "breakup_factor": (BREAKUP_PRIOR[0], BREAKUP_PRIOR[1], "the prior uniform(1, 3)"),
+    "sigma": (0.0, 5.0, "halfnormal(0.3) truncated by the sampler at 5"),
+    "sigma_deformed": (0.0, 5.0, "halfnormal(0.3) truncated by the sampler at 5"),
+    "tau": (0.0, 2.0, "halfnormal(0.1) truncated by the sampler at 2"),
+}
+"""Support of each parameter of a regimes posterior (:func:`sample_regimes`: the priors of the module
+docstring, with the bounds its log-density enforces); sigma and tau exclude 0."""
+
+
+def check_draws(path, samples: dict) -> dict:
+    """The draws of a regimes posterior's ``samples`` as arrays, checked: dynamic_factor, sigma and
+    tau present; every list non-empty, of JSON numbers, finite, of one length; every draw inside
+    :data:`DRAW_SUPPORT`.  InputError (exit 2) naming the file and the parameter otherwise."""
+    from semianalytic.errors import InputError
+
+    draws, n = {}, None
+    for k in ("dynamic_factor", "sigma", "tau", "breakup_factor", "sigma_deformed"):
+        if k not in samples:
+            if k in ("dynamic_factor", "sigma", "tau"):
+                raise InputError(f"samples.{k}", f"{path}: missing (a regimes posterior holds draws of dynamic_factor, "
+                                                 "sigma and tau)")
+            continue
+        v = samples[k]
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+            raise InputError(f"samples.{k}", f"{path}: expected a list of numbers, one per draw")
+        a = np.asarray(v, float)
+        if a.size == 0:
+            raise InputError(f"samples.{k}", f"{path}: empty: the posterior holds no draw")
+        if n is None:
+            n = a.size
+        elif a.size != n:
+            raise InputError(f"samples.{k}", f"{path}: {a.size} draws, samples.dynamic_factor has {n} "
+                                             "(one value per draw in every list)")
+        lo, hi, why = DRAW_SUPPORT[k]
+        ok = np.isfinite(a) & (a >= lo) & (a <= hi) & ((a > 0) if lo == 0 else True)
+        if not ok.all():
+            j = int(np.argmax(~ok))
+            raise InputError(f"samples.{k}", f"{path}: draw {j} is {float(a[j]):.6g}, outside the support "
+                                             f"{'(' if lo == 0 else '['}{lo:g}, {hi:g}] of {why}")
+        draws[k] = a
+    return draws
+
+
+def _check_range(path, rng) -> list:
+    from semianalytic.case import MAX_STRIKING_VELOCITY
+    from semianalytic.errors import InputError
+
+    ok = (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                           for x in rng))
+    if ok:
+        lo, hi = map(float, rng)
+        ok = math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= MAX_STRIKING_VELOCITY
+    if not ok:
+        raise InputError("velocity_range_m_s", f"{path}: expected [lowest, highest] striking velocity of the "
+                                               f"calibration shots (0 < lowest <= highest <= "
+                                               f"{MAX_STRIKING_VELOCITY:g} m/s); got {rng!r}")
+    return [lo, hi]
+
+
 def read_regimes_posterior(path, case) -> dict:
     """Read a regimes posterior and check it against ``case`` (nose, target, options); InputError
     naming the file otherwise."""
+    import dataclasses
     import json
     from pathlib import Path
 
@@ -759,16 +824,21 @@ def read_regimes_posterior(path, case) -> dict:
 
     try:
         obj = json.loads(Path(path).read_text())
+        known = {f.name for f in dataclasses.fields(Options)}
+        if not isinstance(obj["options"], dict) or not set(obj["options"]) <= known:
+            extra = sorted(set(obj["options"]) - known) if isinstance(obj["options"], dict) else obj["options"]
+            raise InputError("options", f"{path}: unknown option(s) {extra!r}; the options are {', '.join(sorted(known))}")
         opt = Options(**obj["options"])
-        draws = {k: np.asarray(obj["samples"][k], float) for k in ("dynamic_factor", "sigma", "tau")}
-        for k in ("breakup_factor", "sigma_deformed"):
-            if k in obj["samples"]:
-                draws[k] = np.asarray(obj["samples"][k], float)
+        samples = obj["samples"]
+        if not isinstance(samples, dict):
+            raise TypeError("samples is not a JSON object")
         sig = obj["signature"]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError("--posterior", f"{path}: not a readable regimes posterior ({exc})") from None
     if obj.get("version") != REGIMES_VERSION:
         raise InputError("--posterior", f"{path}: version {obj.get('version')!r}, expected {REGIMES_VERSION}")
+    draws = check_draws(path, samples)
+    obj["velocity_range_m_s"] = _check_range(path, obj.get("velocity_range_m_s"))
     mine = geometry_signature(case)
     other_nose = []
     for k, v in sig.items():
@@ -785,7 +855,7 @@ def read_regimes_posterior(path, case) -> dict:
                     ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
                     ("discrepancy", DISCREPANCIES), ("rigid_depth", RIGID_DEPTHS)):
         if getattr(opt, k) not in vals:
-            raise InputError("--posterior", f"{path}: unknown model set {k} = {getattr(opt, k)!r}")
+            raise InputError(f"options.{k}", f"{path}: unknown value {getattr(opt, k)!r}; one of {', '.join(vals)}")
     for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
         if need and (k not in draws or len(draws[k]) != len(draws["sigma"])):
             raise InputError("--posterior", f"{path}: samples.{k} missing or of another length than samples.sigma "
