@@ -509,6 +509,19 @@ def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | Non
     return out, {"regime": regimes, "rigid_model": rigid, "eroding_model": ero}, [f"warning: {w}" for w in warnings]
 
 
+def check_posterior_files(paths) -> None:
+    """Every check of ``--posterior`` files that needs no case, before anything is computed: a
+    regimes posterior by :func:`.regimes.load_regimes_file`, any other by :func:`.case.read_posterior`
+    (draws finite, one per draw, inside their priors' support); InputError naming the file."""
+    from semianalytic.calibration.regimes import is_regimes_posterior, load_regimes_file
+
+    for one in paths:
+        if is_regimes_posterior(one):
+            load_regimes_file(one)
+        else:
+            read_posterior(one)
+
+
 def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_model: str | None = None) -> dict:
     """{"depth_quantiles_m": {model: {"0.05": [...], "0.5": [...], "0.95": [...], ...}}} at the
     case's striking velocities (or ``velocities``), with the case's projectile (mass from its

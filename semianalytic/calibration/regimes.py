@@ -794,6 +794,13 @@ def check_draws(path, samples: dict) -> dict:
             raise InputError(f"samples.{k}", f"{path}: draw {j} is {float(a[j]):.6g}, outside the support "
                                              f"{'(' if lo == 0 else '['}{lo:g}, {hi:g}] of {why}")
         draws[k] = a
+    for k, v in samples.items():  # any further parameter: numbers, finite, one per draw
+        if k in DRAW_SUPPORT:
+            continue
+        a = np.asarray(v, float) if isinstance(v, list) and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in v) else None
+        if a is None or a.size != n or not np.all(np.isfinite(a)):
+            raise InputError(f"samples.{k}", f"{path}: expected {n} finite numbers, one per draw")
     return draws
 
 
@@ -813,9 +820,10 @@ def _check_range(path, rng) -> list:
     return [lo, hi]
 
 
-def read_regimes_posterior(path, case) -> dict:
-    """Read a regimes posterior and check it against ``case`` (nose, target, options); InputError
-    naming the file otherwise."""
+def load_regimes_file(path) -> tuple[dict, "Options", dict]:
+    """(the JSON object, its :class:`Options`, the checked draws) of a regimes posterior file: every
+    check that needs no case (format version, options and their values, draws by
+    :func:`check_draws`, the calibrated velocity range); InputError naming the file otherwise."""
     import dataclasses
     import json
     from pathlib import Path
@@ -832,13 +840,34 @@ def read_regimes_posterior(path, case) -> dict:
         samples = obj["samples"]
         if not isinstance(samples, dict):
             raise TypeError("samples is not a JSON object")
-        sig = obj["signature"]
+        if not isinstance(obj["signature"], dict):
+            raise TypeError("signature is not a JSON object")
     except (OSError, ValueError, KeyError, TypeError) as exc:
+        if isinstance(exc, InputError):
+            raise
         raise InputError("--posterior", f"{path}: not a readable regimes posterior ({exc})") from None
     if obj.get("version") != REGIMES_VERSION:
         raise InputError("--posterior", f"{path}: version {obj.get('version')!r}, expected {REGIMES_VERSION}")
+    for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
+                    ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
+                    ("discrepancy", DISCREPANCIES), ("rigid_depth", RIGID_DEPTHS)):
+        if getattr(opt, k) not in vals:
+            raise InputError(f"options.{k}", f"{path}: unknown value {getattr(opt, k)!r}; one of {', '.join(vals)}")
     draws = check_draws(path, samples)
+    for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
+        if need and k not in draws:
+            raise InputError(f"samples.{k}", f"{path}: missing (the model set {opt.label()} needs it)")
     obj["velocity_range_m_s"] = _check_range(path, obj.get("velocity_range_m_s"))
+    return obj, opt, draws
+
+
+def read_regimes_posterior(path, case) -> dict:
+    """Read a regimes posterior (:func:`load_regimes_file`) and check it against ``case``: another
+    nose or target is a transfer, accepted with a note (:func:`transfer_notes`)."""
+    from semianalytic.errors import InputError
+
+    obj, opt, draws = load_regimes_file(path)
+    sig = obj["signature"]
     mine = geometry_signature(case)
     other_nose = []
     for k, v in sig.items():
@@ -851,15 +880,6 @@ def read_regimes_posterior(path, case) -> dict:
             continue
         raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another target: "
                                         "refit with calibrate --model regimes)")
-    for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
-                    ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
-                    ("discrepancy", DISCREPANCIES), ("rigid_depth", RIGID_DEPTHS)):
-        if getattr(opt, k) not in vals:
-            raise InputError(f"options.{k}", f"{path}: unknown value {getattr(opt, k)!r}; one of {', '.join(vals)}")
-    for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
-        if need and (k not in draws or len(draws[k]) != len(draws["sigma"])):
-            raise InputError("--posterior", f"{path}: samples.{k} missing or of another length than samples.sigma "
-                                            f"(the model set {opt.label()} needs it)")
     notes = []
     if other_nose:
         notes.append(f"note: posterior {path}: fitted for {', '.join(other_nose)}; applied to this case's nose as a "

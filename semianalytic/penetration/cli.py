@@ -205,6 +205,10 @@ def run(args) -> int:
     from semianalytic.cache import override_coefficients
 
     cases = [override_coefficients(c, contact=args.contact, tolerance=args.tolerance) for c in _load(args.cases)]
+    if args.posterior:  # a bad posterior file stops before any table is built
+        from semianalytic.calibration.evaluate import check_posterior_files
+
+        check_posterior_files(args.posterior)
     if args.coefficients == "bem":  # refuse before solving what would not fit in memory
         from semianalytic.guards import check_coefficients
 
