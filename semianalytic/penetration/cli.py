@@ -135,26 +135,39 @@ def _print_text(result: dict, desc: str, file=None) -> None:
           f"deforming between; depth = {result['part1_model']} below U_y, Alekseevskii-Tate rod above (Y_p = "
           f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")
     head = (
-        f"  {'U_s':>7} | {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} | {'elastic exact rod':>17} |"
-        f" {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8} | {'regime':>9} | {'depth':>7} | yields"
+        f"  {'U_s':>7} | {'regime':>9} | {'depth':>7} || {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} |"
+        f" {'elastic exact rod':>17} | {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8}"
     )
+    p("  verdict (regime and its depth) first; then each model's own depth (valid only in its regime)")
     p(head)
-    p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8} | {'':>9} | {'P mm':>7} |")
+    p(f"  {'m/s':>7} | {'':>9} | {'P mm':>7} || {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8}")
     n = len(result["striking_velocity_m_s"])
     for i in range(n):
         r = {k: result[k][i] for k in (
             "striking_velocity_m_s", "depth_rigid_m", "time_rigid_s", "depth_quasi_rigid_m", "time_quasi_rigid_s",
             "depth_elastic_m", "stop_time_elastic_s", "depth_elastic_exact_rod_m", "stop_time_elastic_exact_rod_s",
-            "depth_forrestal_m", "depth_chen_li_m", "yields")}
+            "depth_forrestal_m", "depth_chen_li_m")}
         p(
-            f"  {r['striking_velocity_m_s']:7.0f} | {_fmt(r['depth_rigid_m'], 1e3):>7} {_fmt(r['time_rigid_s'], 1e6):>7} |"
+            f"  {r['striking_velocity_m_s']:7.0f} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} ||"
+            f" {_fmt(r['depth_rigid_m'], 1e3):>7} {_fmt(r['time_rigid_s'], 1e6):>7} |"
             f" {_fmt(r['depth_quasi_rigid_m'], 1e3):>7} {_fmt(r['time_quasi_rigid_s'], 1e6):>7} |"
             f" {_fmt(r['depth_elastic_m'], 1e3):>7} {_fmt(r['stop_time_elastic_s'], 1e6):>7} |"
             f" {_fmt(r['depth_elastic_exact_rod_m'], 1e3):>8} {_fmt(r['stop_time_elastic_exact_rod_s'], 1e6):>8} |"
             f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
-            f" {_fmt(result['depth_eroding_m'][i], 1e3):>8} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} |"
-            f" {'YES (outside the model)' if r['yields'] else 'no'}"
+            f" {_fmt(result['depth_eroding_m'][i], 1e3):>8}"
         )
+    U = result["striking_velocity_m_s"]
+    src = result.get("regime_source") or []
+    if "posterior" in src:
+        p(f"  verdict source: the regimes posterior's most probable regime at U_s = "
+          f"{', '.join(f'{u:.0f}' for u, s in zip(U, src) if s == 'posterior')} m/s, else the {result.get('regime_rule')} rule")
+    def at(flags):
+        hit = [f"{u:.0f}" for u, x in zip(U, flags or []) if x]
+        return f"at U_s = {', '.join(hit)} m/s" if hit else "at no striking velocity"
+
+    p(f"  diagnostics (they follow the verdict or are marked as not used by it): yields (the regime is not rigid) "
+      f"{at(result['yields'])}; Part I's U_s >= U_sC (eqs. (33)/(36); not used by the {result.get('regime_rule')} "
+      f"rule) {at(result.get('part1_critical_exceeded'))}")
     est = result.get("depth_error_estimate_m")
     if est:
         worst = {k: max((e / d for e, d in zip(est[k], result[f"depth_{k}_m"]) if d and math.isfinite(d)), default=math.nan)
@@ -237,6 +250,9 @@ def run(args) -> int:
         results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model,
                                                  regime_rule=args.regime_rule), **quantiles))
         results[-1]["warnings"] = [*results[-1]["warnings"], *notes]
+        from semianalytic.penetration.evaluate import one_verdict
+
+        one_verdict(results[-1])  # with a regimes posterior, its most probable regime is the verdict
         descs.append(desc)
         _warn_separation(results[-1])
         for line in results[-1]["warnings"]:
