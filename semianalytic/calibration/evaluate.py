@@ -575,7 +575,9 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
         aware, warnings = rp["quantiles"], rp["warnings"]
         info = {"model": "regimes", "options": rp["options"], "file": str(regime_files[0])}
         extra = {"regime_probability": rp["regime_probability"], "regime_model_holds": rp["model_holds"],
-                 "regime_transition_velocities_m_s": rp["transition_velocities_m_s"]}
+                 "regime_notes": rp["notes"], "posterior_transfer": rp["transfer"],
+                 "regime_transition_velocities_m_s": rp["transition_velocities_m_s"],
+                 "regime_transition_intervals_90_m_s": rp["transition_intervals_90_m_s"]}
     else:
         aware, info, warnings = _regime_aware(case, coefficients, U, quantiles, part1_model)
     if aware:
