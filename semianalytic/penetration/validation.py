@@ -160,10 +160,17 @@ def _check_row_labels(data, row: dict, i: int, shot_id: str, name: str) -> None:
     col = getattr(data, "hardness_column", None)
     if col:
         h = row[col].strip()
+        from semianalytic.penetration.hardness import HRC_RANGE
+
         try:
-            ok = math.isfinite(float(h))
+            value = float(h)
+            ok = math.isfinite(value)
         except ValueError:
             ok = False
+        if ok and not HRC_RANGE[0] <= value <= HRC_RANGE[1]:
+            raise InputError("data.hardness_column", f"row {i + 1} of {name} (shot {shot_id}): {value:g} HRC is outside "
+                                                     f"{HRC_RANGE[0]:g}-{HRC_RANGE[1]:g} HRC, the range of the hardness "
+                                                     "conversion (ASTM E140, Table 1)")
         if not ok:
             raise InputError("data.hardness_column", f"row {i + 1} of {name} (shot {shot_id}): hardness {h!r} is not a "
                                                      "number (Rockwell C); give every selected shot its hardness, or drop "
