@@ -179,6 +179,18 @@ def _print_text(result: dict, desc: str, file=None) -> None:
         for model, q in result["depth_quantiles_m"].items():
             cells = "  ".join(f"{a * 1e3:.0f} [{b * 1e3:.0f}, {c * 1e3:.0f}]" for a, b, c in zip(q["0.5"], q["0.05"], q["0.95"]))
             p(f"    {model:<18} {cells}")
+        prob = result.get("regime_probability")
+        if prob:
+            cells = "  ".join("-" if r is None or not math.isfinite(r) else f"{r:.2f}/{d:.2f}/{e:.2f}"
+                              for r, d, e in zip(prob["rigid"], prob["deforming"], prob["eroding"]))
+            p(f"    {'P(rigid/def./ero.)':<18} {cells}")
+        for u, note in zip(result["striking_velocity_m_s"], result.get("regime_notes") or []):
+            if note:
+                p(f"    at {u:.0f} m/s: {note}")
+        tr = result.get("posterior_transfer") or {}
+        if tr.get("transfer"):
+            p(f"    transfer ({'; '.join(tr['reasons'])}): tau + {tr['tau_added']:.3f}, sigma + {tr['sigma_added']:.3f} "
+              "in quadrature (posterior_transfer gives the rule)")
     val = result.get("validation")
     if val:
         p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
