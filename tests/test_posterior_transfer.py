@@ -229,3 +229,51 @@ def test_calibrate_posterior_draw_outside_its_prior(tmp_path):
         with pytest.raises(InputError) as err:
             read_posterior(p)
         assert err.value.field == f"models.elastic.samples.{key}" and str(p) in err.value.message
+
+
+def test_calibrate_transfer_sigma_matches_the_committed_cross_validation():
+    """TRANSFER_SIGMA per model recomputed by hand from the committed cross_validation.json
+    (0.001: written to 3 decimals)."""
+    from semianalytic.calibration.evaluate import TRANSFER_SIGMA
+
+    cv = json.loads((ROOT / "reports" / "calibration_piekutowski1999" / "cross_validation.json").read_text())
+    (tr,) = cv["transfer"].values()
+    for m, value in TRANSFER_SIGMA.items():
+        def ms(s):
+            return float(np.mean(np.log(np.asarray(s["measured_m"]) / np.asarray(s["0.5"])) ** 2))
+        assert value == pytest.approx(math.sqrt(ms(tr["models"][m]["shots"]) - ms(cv["loo"][m]["shots"])), abs=1e-3), m
+
+
+def test_calibrate_posterior_on_another_nose_widens(tmp_path):
+    """A calibrate posterior that records its projectile (3-CRH ogive) applied to a 6-CRH ogive:
+    a note on stderr, posterior_transfer_models, and the 90 % interval of elastic_exact_rod at
+    0.8 km/s wider by the hand-computed ratio mean sqrt(sigma^2 + 0.029^2) / mean sigma (5 %:
+    the mixture over draws is not one log-normal; the surrogate's R_t spread is the same in both)."""
+    import shutil
+
+    from semianalytic.calibration.evaluate import projectile_signature
+    from semianalytic.case import load_case
+
+    for f in ("piekutowski1999_var4340.toml", "piekutowski1999_ogive_6061T6511.csv"):
+        shutil.copy(ROOT / "cases" / f, tmp_path)
+    text = (tmp_path / "piekutowski1999_var4340.toml").read_text()
+    text = text[: text.index("\n[data]")].replace('striking_velocities = ["0.5 km/s"', 'striking_velocities = ["0.8 km/s"')
+    home = tmp_path / "home.toml"
+    home.write_text(text)
+    away = tmp_path / "away.toml"
+    away.write_text(text.replace("crh = 3.0", "crh = 6.0"))
+    obj = json.loads(RIGID_POST.read_text())
+    obj["projectile"] = projectile_signature(load_case(home))
+    post = tmp_path / "post.json"
+    post.write_text(json.dumps(obj))
+    code, a, err_a = _penetrate(home, post, cwd=tmp_path)
+    assert code == 0 and "posterior_transfer_models" not in a, err_a
+    code, b, err_b = _penetrate(away, post, cwd=tmp_path)
+    assert code == 0, err_b
+    assert "crh = 3.0 (the case: 6.0)" in err_b and "widened" in err_b
+    assert b["posterior_transfer_models"][str(post)]["sigma_added"]["elastic_exact_rod"] == pytest.approx(0.029)
+    sig = np.asarray(obj["models"]["elastic_exact_rod"]["samples"]["sigma"])
+    expected = np.mean(np.sqrt(sig**2 + 0.029**2)) / np.mean(sig)
+    w = [math.log(r["depth_quantiles_m"]["elastic_exact_rod"]["0.95"][0] / r["depth_quantiles_m"]["elastic_exact_rod"]["0.05"][0])
+         for r in (a, b)]
+    assert w[1] / w[0] == pytest.approx(expected, rel=0.05)
