@@ -9,7 +9,9 @@ Shared by ``tests/test_corpus.py`` (assertions in ``make test``) and ``tests/har
 - ``# expect: warn FIELD``: exit 0 with a ``warning: FIELD`` line on stderr;
 - ``# expect: ok``: exit 0;
 - ``# expect-text: TEXT``: where the field is a whole section, the key the message must name;
-- ``# commands: NAME ...``: the primary commands (default: coefficients, penetrate, run).
+- ``# commands: NAME ...``: the primary commands (default: coefficients, penetrate, run);
+- ``# args: ...``: further arguments of the primary commands, ``{corpus}`` standing for this
+  folder (e.g. ``--posterior {corpus}/posteriors/regimes_nan.json``).
 
 Binary and non-UTF-8 files carry the same ASCII header before their bytes.
 """
@@ -38,14 +40,15 @@ def corpus_files() -> list[Path]:
 def headers(path: Path) -> dict[str, str]:
     out = {}
     for line in path.read_bytes().split(b"\n")[:6]:
-        m = re.match(rb"# (expect-text|expect|commands|why): (.*)", line)
+        m = re.match(rb"# (expect-text|expect|commands|args|why): (.*)", line)
         if m:
             out[m.group(1).decode()] = m.group(2).decode("utf-8", "replace").strip()
     return out
 
 
-def argv(command: str, case: str, out: Path) -> tuple[str, list[str]]:
-    """(package, argv) of one command on ``case`` writing only under ``out``."""
+def argv(command: str, case: str, out: Path, args: str = "") -> tuple[str, list[str]]:
+    """(package, argv) of one command on ``case`` writing only under ``out`` (``args``: the
+    file's ``# args:`` header)."""
     if command == "fem_check verify":
         return "fem_check", ["verify", case, "--quick", "--h", "0.1", "--json"]
     extra = {
@@ -57,8 +60,10 @@ def argv(command: str, case: str, out: Path) -> tuple[str, list[str]]:
         "cavity": ["--json"],
         "ballistic-limit": ["--json"],
         "nanostrength": ["--json"],
+        "calibrate": ["--out", str(out / "calibrate"), "--quiet"],
     }[command]
-    return "semianalytic", [command, case, *extra]
+    more = [a.replace("{corpus}", str(HERE / "corpus")) for a in args.split()]
+    return "semianalytic", [command, case, *extra, *more]
 
 
 @dataclass
@@ -90,9 +95,9 @@ class Outcome:
         return f"exit {self.rc}"
 
 
-def run_command(command: str, case: str, out: Path) -> Outcome:
+def run_command(command: str, case: str, out: Path, extra: str = "") -> Outcome:
     """One in-process run (stdout and stderr captured)."""
-    package, args = argv(command, case, out)
+    package, args = argv(command, case, out, extra)
     if package == "fem_check":
         from fem_check.cli import main
     else:

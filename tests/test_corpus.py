@@ -39,7 +39,7 @@ def test_corpus_file(path, tmp_path, monkeypatch):
     work.mkdir()
     with working_directory(work):
         for command in [*primary, *others]:
-            res = run_command(command, str(path), work / "out")
+            res = run_command(command, str(path), work / "out", head.get("args", "") if command in primary else "")
             assert not res.traceback, (command, res.err)
             assert res.rc in (0, 2), (command, res.rc, res.err)
             if res.rc == 2:

@@ -62,14 +62,17 @@ def test_json_keys_and_closed_form(tmp_path, capsys):
     Ybar = (1 + rho * A / m) * 1.64e9
     UsC = 1.64e9 * c0 / 210e9 + math.sqrt(2 / (rho * 0.11) * (Ybar - R))  # eq. (36) by hand
     assert res["critical_velocity_m_s"][0] == pytest.approx(UsC, rel=1e-12)
-    assert res["yields"] == [U >= UsC for U in res["striking_velocity_m_s"]] == [False, False, True]
+    # Part I's own criterion is the diagnostic part1_critical_exceeded; yields follows the verdict (issue 36 item 7)
+    assert res["part1_critical_exceeded"] == [U >= UsC for U in res["striking_velocity_m_s"]] == [False, False, True]
+    assert res["yields"] == [r != "rigid" for r in res["regime"]]
     assert all(e <= q <= r for e, q, r in zip(res["depth_elastic_m"], res["depth_quasi_rigid_m"], res["depth_rigid_m"]))
 
 
 def test_text_output_flags_yielding(tmp_path, capsys):
     code, out, err = _run(capsys, _write(tmp_path, CASE), "--coefficients", "paper")
     assert code == 0, err
-    assert "U_sC" in out and "YES (outside the model)" in out
+    assert "U_sC" in out and "YES (outside the model)" not in out  # issue 36 item 7: no verdict beside a contrary flag
+    assert "Part I's U_s >= U_sC (eqs. (33)/(36); not used by the meyer rule) at U_s = " in out
 
 
 def test_appendix_inverse_problem_through_the_cli(tmp_path, capsys):

@@ -301,12 +301,16 @@ def test_penetrate_regime_probability_and_mixture(tmp_path):
         assert key in out
 
 
-def test_penetrate_refuses_a_regimes_posterior_of_another_target(tmp_path, capsys):
+def test_penetrate_accepts_a_regimes_posterior_of_another_target(tmp_path, capsys):
+    """Issue 36 item 5: a posterior's rod parameters apply to any target (R_t recomputed from the
+    case): another target is accepted with a note naming what differs, and the transfer widens."""
     case = _copy(tmp_path, VAR, _no_data)
     sig_case = _copy(tmp_path / "..", VAR, lambda t: _no_data(t).replace('yield_stress = "400 MPa"', 'yield_stress = "300 MPa"'))
     post = _regimes_posterior(tmp_path, sig_case)
-    code, _, err = _run(capsys, "penetrate", case, "--posterior", post, "--coefficients", "paper")
-    assert code == 2 and err.startswith("error: --posterior:") and str(post) in err and "target_yield_stress" in err
+    code, out, err = _run(capsys, "penetrate", case, "--json", "--posterior", post, "--coefficients", "paper")
+    assert code == 0, err
+    assert str(post) in err and "another target" in err and "target_yield_stress" in err
+    assert json.loads(out)["posterior_transfer"]["transfer"] is True
 
 
 def test_penetrate_transfers_a_regimes_posterior_to_another_nose(tmp_path, capsys):

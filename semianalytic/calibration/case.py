@@ -249,9 +249,52 @@ MAX_POSTERIOR_DRAWS = 200_000
 
 def read_posterior(path) -> dict:
     """Read and validate a posterior.json written by ``calibrate``; returns
-    {"target": ..., "parameters": [keys], "models": {name: {"theta": (n, p), "sigma": (n,)}}, "raw": obj}."""
-    field = "--posterior"
+    {"target": ..., "parameters": [keys], "models": {name: {"theta": (n, p), "sigma": (n,)}}, "raw": obj}.
+    Every draw is checked: finite, one per draw in every list, and inside its prior's support
+    (:func:`_check_support`); an InputError names the file and the parameter."""
     path = Path(path)
+    try:
+        return _read_posterior(path)
+    except InputError as exc:
+        if str(path) in exc.message:
+            raise
+        raise InputError(exc.field, f"{path}: {exc.message}") from None
+
+
+PRIOR_TAIL = 1e-9
+"""A draw of a posterior file must lie inside its prior's central 1 - 2e-9 (the ppf at 1e-9 and
+1 - 1e-9: for a lognormal of sigma_ln 0.5 a factor 20 either side of the median).  ``calibrate``
+truncates its posterior to the priors' central 1 - 2e-3 (calibration.evaluate._range), so a real
+file never comes near; a draw beyond is no draw of that posterior (e.g. edited, or another
+prior's)."""
+
+
+def _check_support(values: np.ndarray, prior_text, kind: str, field: str) -> None:
+    """Refuse draws outside the support of the prior written beside them (``prior_text``, as
+    ``calibrate`` writes it), within :data:`PRIOR_TAIL`; a file without the text is checked for
+    positivity where the parameter is a positive quantity."""
+    if not isinstance(prior_text, str):
+        return
+    prior = parse_prior(prior_text, kind, field)
+    lo, hi = (float(v) for v in prior.ppf([PRIOR_TAIL, 1.0 - PRIOR_TAIL]))
+    if getattr(prior, "positive", False):
+        lo = max(lo, 0.0)
+    bad = ~((values >= lo * (1 - 1e-12)) & (values <= hi * (1 + 1e-12)))
+    if bad.any():
+        k = int(np.argmax(bad))
+        raise InputError(field, f"draw {k} is {values[k]:.6g}, outside the support of its prior {prior_text} "
+                                f"({lo:.4g} to {hi:.4g} SI, the central 1 - {2 * PRIOR_TAIL:g}): not a posterior of "
+                                "that prior")
+
+
+def _kind_of(key: str) -> str:
+    if key in ERODING_KEYS:
+        return "pressure"
+    return _KINDS.get(key.rsplit(".", 1)[-1], ("dimensionless",))[0]
+
+
+def _read_posterior(path: Path) -> dict:
+    field = "--posterior"
     if not path.is_file():
         raise InputError(field, f"file {str(path)!r} does not exist")
     try:
@@ -301,6 +344,12 @@ def read_posterior(path) -> dict:
             if not mkeys or any(k not in keys for k in mkeys):
                 raise InputError(f"models.{name}.parameters", "expected a non-empty list of the file's parameter keys")
         theta = np.column_stack([_samples(samples, k, f"models.{name}.samples", len(sigma)) for k in mkeys])
+        priors = {p.get("key"): p.get("prior") for p in params if isinstance(p, dict)}
+        for j, k in enumerate(mkeys):
+            _check_support(theta[:, j], priors.get(k), _kind_of(k), f"models.{name}.samples.{k}")
+        disc = obj.get("discrepancy")
+        _check_support(sigma, disc.get("prior") if isinstance(disc, dict) else None, "dimensionless",
+                       f"models.{name}.samples.sigma")
         models[name] = {"theta": theta, "sigma": sigma, "parameters": list(mkeys)}
         if name == ERODING:
             models[name]["eroding"] = _eroding_entry(mobj, mkeys, theta, f"models.{name}")

@@ -249,6 +249,7 @@ def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, 
         "discrepancy": {"model": "ln P_measured = ln P_model + eps, eps ~ N(0, sigma^2)", "prior": sigma_prior_text},
         "shots_used": "recorded eroding" if eroding is not None else "recorded rigid (all selected without a response column)",
         "cavity_shape": list(target.inputs.cavity_shape),
+        "projectile": projectile_signature(case),
         "data": {
             "file": data.file, "source": data.source, "select": data.select,
             "shots": [{"id": i, "velocity_m_s": float(v), "depth_m": float(d), "mass_kg": float(mm)}
@@ -256,6 +257,40 @@ def _posterior_json(case, target: Target, keys, units, sigma_prior_text, shots, 
         },
         "models": models,
     }
+
+
+TRANSFER_SIGMA = {"rigid": 0.024, "quasi_rigid": 0.029, "elastic": 0.034, "elastic_exact_rod": 0.029,
+                  "forrestal": 0.047, "chen_li": 0.050}
+"""Depth scatter added (in quadrature, ln depth) per rigid-projectile model when a ``calibrate``
+posterior is applied to another projectile than the one it was fitted on (nose, diameter,
+density, strength): the transfer inflation measured on the bundled data,
+sqrt(mean e_T^2 - mean e_LOO^2), e = ln(measured / predictive median), the VAR 4340 posterior
+predicting the AerMet 100 shots (T) against its own leave-one-out (reports/calibration_piekutowski1999/
+cross_validation.json, 7 shots each; tests/test_posterior_transfer.py recomputes them).  A
+measurement for another steel on the same nose: no second nose's shots are bundled, so this is a
+floor for a transfer to another nose, not a bound."""
+
+
+def projectile_signature(case) -> dict:
+    """What a ``calibrate`` posterior's projectile was: nose, crh, diameter, density, yield stress."""
+    p = case.require("projectile")
+    return {"nose": p.nose, "crh": getattr(p, "crh", None), "diameter_m": p.diameter,
+            "density_kg_m3": getattr(p, "density", None), "yield_stress_Pa": getattr(p, "yield_stress", None)}
+
+
+def _projectile_transfer(case, raw: dict) -> list[str]:
+    """What differs between the posterior's projectile (``raw["projectile"]``) and the case's."""
+    theirs = raw.get("projectile")
+    if not isinstance(theirs, dict):
+        return []
+    mine = projectile_signature(case)
+    out = []
+    for k, v in theirs.items():
+        w = mine.get(k)
+        same = v == w or (isinstance(v, (int, float)) and isinstance(w, (int, float)) and math.isclose(v, w, rel_tol=1e-9))
+        if not same:
+            out.append(f"{k} = {v!r} (the case: {w!r})")
+    return out
 
 
 def _problem(keys, priors, sigma_prior, resistance, surrogate, depth):
@@ -509,6 +544,19 @@ def _regime_aware(case, coefficients, U, quantiles: dict, part1_model: str | Non
     return out, {"regime": regimes, "rigid_model": rigid, "eroding_model": ero}, [f"warning: {w}" for w in warnings]
 
 
+def check_posterior_files(paths) -> None:
+    """Every check of ``--posterior`` files that needs no case, before anything is computed: a
+    regimes posterior by :func:`.regimes.load_regimes_file`, any other by :func:`.case.read_posterior`
+    (draws finite, one per draw, inside their priors' support); InputError naming the file."""
+    from semianalytic.calibration.regimes import is_regimes_posterior, load_regimes_file
+
+    for one in paths:
+        if is_regimes_posterior(one):
+            load_regimes_file(one)
+        else:
+            read_posterior(one)
+
+
 def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_model: str | None = None) -> dict:
     """{"depth_quantiles_m": {model: {"0.05": [...], "0.5": [...], "0.95": [...], ...}}} at the
     case's striking velocities (or ``velocities``), with the case's projectile (mass from its
@@ -524,6 +572,7 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
     paths = [path] if isinstance(path, (str, bytes)) or not hasattr(path, "__iter__") else list(path)
     U = np.asarray(case.require("impact").striking_velocities if velocities is None else velocities, float)
     quantiles, seen = {}, {}
+    transfer_models, transfer_notes = {}, []
     regime_files = [p for p in paths if is_regimes_posterior(p)]
     if len(regime_files) > 1:
         raise InputError("--posterior", f"two regimes posteriors ({regime_files[0]} and {regime_files[1]}); give one")
@@ -540,6 +589,16 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
             seen[m] = str(one)
         draws = {m: (post["models"][m]["theta"], post["models"][m]["sigma"]) for m in models}
         rigid = tuple(m for m in models if m != ERODING)
+        differs = _projectile_transfer(case, post["raw"]) if rigid else []
+        if differs:
+            added = {m: TRANSFER_SIGMA.get(m, max(TRANSFER_SIGMA.values())) for m in rigid}
+            for m in rigid:
+                draws[m] = (draws[m][0], np.sqrt(draws[m][1] ** 2 + added[m] ** 2))
+            transfer_models[str(one)] = {"reasons": differs, "sigma_added": added}
+            transfer_notes.append(f"note: posterior {one}: fitted for another projectile ({', '.join(differs)}): a transfer; "
+                                  "the depth scatter sigma of each rigid-projectile model is widened in quadrature by its "
+                                  "transfer inflation measured on the bundled data ("
+                                  + ", ".join(f"{m} {v:.3f}" for m, v in added.items()) + ")")
         if rigid:
             target = _target(case, coefficients, keys, cavity_shape=post["cavity_shape"], models=rigid)
             shots = ShotSet(U, np.full(U.shape, target.inputs.setup.mass), np.full(U.shape, np.nan),
@@ -562,11 +621,16 @@ def predict_with_posterior(case, coefficients, path, velocities=None, *, part1_m
         aware, warnings = rp["quantiles"], rp["warnings"]
         info = {"model": "regimes", "options": rp["options"], "file": str(regime_files[0])}
         extra = {"regime_probability": rp["regime_probability"], "regime_model_holds": rp["model_holds"],
-                 "regime_transition_velocities_m_s": rp["transition_velocities_m_s"]}
+                 "regime_notes": rp["notes"], "posterior_transfer": rp["transfer"],
+                 "regime_transition_velocities_m_s": rp["transition_velocities_m_s"],
+                 "regime_transition_intervals_90_m_s": rp["transition_intervals_90_m_s"]}
     else:
         aware, info, warnings = _regime_aware(case, coefficients, U, quantiles, part1_model)
     if aware:
         quantiles["regime_aware"] = aware
+    warnings = [*transfer_notes, *warnings]
+    if transfer_models:
+        extra["posterior_transfer_models"] = transfer_models
     return {
         "depth_quantiles_m": quantiles,
         "posterior_file": ", ".join(map(str, paths)),

@@ -51,9 +51,9 @@ class Normal:
         return -0.5 * z * z - math.log(self.sd * math.sqrt(2 * math.pi))
 
     def ppf(self, q):
-        from scipy import stats
+        from scipy import special  # the normal quantile, without loading scipy.stats (~0.4 s)
 
-        return stats.norm.ppf(np.asarray(q, float), self.mean, self.sd)
+        return self.mean + self.sd * special.ndtri(np.asarray(q, float))
 
     def describe(self, unit_scale: float = 1.0, unit: str = "") -> str:
         return f"normal({self.mean / unit_scale:.4g} {unit}, {self.sd / unit_scale:.4g} {unit})"
@@ -89,9 +89,9 @@ class HalfNormal:
         return np.where(x > 0, -0.5 * z * z + math.log(math.sqrt(2 / math.pi) / self.scale), -np.inf)
 
     def ppf(self, q):
-        from scipy import stats
+        from scipy import special  # |N(0, scale^2)| has the quantile scale * Phi^-1((1 + q) / 2)
 
-        return stats.halfnorm.ppf(np.asarray(q, float), scale=self.scale)
+        return self.scale * special.ndtri(0.5 * (1.0 + np.asarray(q, float)))
 
     def describe(self, unit_scale: float = 1.0, unit: str = "") -> str:
         return f"halfnormal({self.scale:g})"

@@ -549,7 +549,7 @@ def regime_shots(case, coefficients) -> RegimeShots:
         U.append(s.velocity)
         m.append(setup.mass)
         P.append(s.depth)
-        r = RESPONSE_REGIME.get(s.row.get(col, "")) if col else None
+        r = RESPONSE_REGIME.get(s.row.get(col, "").strip()) if col else None
         rec.append(rg.REGIMES.index(r) if r else -1)
         h = s.row.get(data.hardness_column, "") if data.hardness_column else ""
         try:
@@ -559,6 +559,9 @@ def regime_shots(case, coefficients) -> RegimeShots:
         p1.append(float(penetration_curve(setup, [s.velocity])["depth_elastic_exact_rod_m"][0]))
         fd.append(float(peer_depths(case, setup, [s.velocity])["forrestal"][0]))
         crits.append((setup.critical_inputs(), setup.phi))
+    if col and not np.any(np.array(rec) >= 0):  # the transitions would be placed by the depths alone, silently
+        raise InputError("data.response_column", f"no selected shot has a recorded response in column {col!r} (every "
+                                                 f"label is blank); record each shot's response ({', '.join(RESPONSE_REGIME)})")
     vcrit = np.vectorize(lambda Y, j: crit.critical_velocity(float(Y), crits[j][0], crits[j][1]), otypes=[float])
     idx = np.arange(len(shots))
 
@@ -729,6 +732,7 @@ def posterior_json(case, shots: RegimeShots, opt: Options, sample: dict, n_store
         "case": str(case.path) if case.path else case.title, "title": case.title,
         "options": opt.as_dict(), "signature": geometry_signature(case),
         "velocity_range_m_s": [float(np.min(shots.velocity)), float(np.max(shots.velocity))],
+        "meyer_hardness_range_Pa": [float(np.min(shots.meyer_hardness)), float(np.max(shots.meyer_hardness))],
         "groups": shots.group, "n_shots": len(shots),
         "priors": priors, "summary": summ, "at_prior_edge": edge,
         "diagnostics": sample["diagnostics"],
@@ -749,9 +753,79 @@ def is_regimes_posterior(path) -> bool:
         return False
 
 
-def read_regimes_posterior(path, case) -> dict:
-    """Read a regimes posterior and check it against ``case`` (nose, target, options); InputError
-    naming the file otherwise."""
+DRAW_SUPPORT = {
+    "dynamic_factor": (F_PRIOR[0], F_PRIOR[1], "the prior uniform(1, 3)"),
+    "breakup_factor": (BREAKUP_PRIOR[0], BREAKUP_PRIOR[1], "the prior uniform(1, 3)"),
+    "sigma": (0.0, 5.0, "halfnormal(0.3) truncated by the sampler at 5"),
+    "sigma_deformed": (0.0, 5.0, "halfnormal(0.3) truncated by the sampler at 5"),
+    "tau": (0.0, 2.0, "halfnormal(0.1) truncated by the sampler at 2"),
+}
+"""Support of each parameter of a regimes posterior (:func:`sample_regimes`: the priors of the module
+docstring, with the bounds its log-density enforces); sigma and tau exclude 0."""
+
+
+def check_draws(path, samples: dict) -> dict:
+    """The draws of a regimes posterior's ``samples`` as arrays, checked: dynamic_factor, sigma and
+    tau present; every list non-empty, of JSON numbers, finite, of one length; every draw inside
+    :data:`DRAW_SUPPORT`.  InputError (exit 2) naming the file and the parameter otherwise."""
+    from semianalytic.errors import InputError
+
+    draws, n = {}, None
+    for k in ("dynamic_factor", "sigma", "tau", "breakup_factor", "sigma_deformed"):
+        if k not in samples:
+            if k in ("dynamic_factor", "sigma", "tau"):
+                raise InputError(f"samples.{k}", f"{path}: missing (a regimes posterior holds draws of dynamic_factor, "
+                                                 "sigma and tau)")
+            continue
+        v = samples[k]
+        if not isinstance(v, list) or not all(isinstance(x, (int, float)) and not isinstance(x, bool) for x in v):
+            raise InputError(f"samples.{k}", f"{path}: expected a list of numbers, one per draw")
+        a = np.asarray(v, float)
+        if a.size == 0:
+            raise InputError(f"samples.{k}", f"{path}: empty: the posterior holds no draw")
+        if n is None:
+            n = a.size
+        elif a.size != n:
+            raise InputError(f"samples.{k}", f"{path}: {a.size} draws, samples.dynamic_factor has {n} "
+                                             "(one value per draw in every list)")
+        lo, hi, why = DRAW_SUPPORT[k]
+        ok = np.isfinite(a) & (a >= lo) & (a <= hi) & ((a > 0) if lo == 0 else True)
+        if not ok.all():
+            j = int(np.argmax(~ok))
+            raise InputError(f"samples.{k}", f"{path}: draw {j} is {float(a[j]):.6g}, outside the support "
+                                             f"{'(' if lo == 0 else '['}{lo:g}, {hi:g}] of {why}")
+        draws[k] = a
+    for k, v in samples.items():  # any further parameter: numbers, finite, one per draw
+        if k in DRAW_SUPPORT:
+            continue
+        a = np.asarray(v, float) if isinstance(v, list) and all(
+            isinstance(x, (int, float)) and not isinstance(x, bool) for x in v) else None
+        if a is None or a.size != n or not np.all(np.isfinite(a)):
+            raise InputError(f"samples.{k}", f"{path}: expected {n} finite numbers, one per draw")
+    return draws
+
+
+def _check_range(path, rng) -> list:
+    from semianalytic.case import MAX_STRIKING_VELOCITY
+    from semianalytic.errors import InputError
+
+    ok = (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
+                                                           for x in rng))
+    if ok:
+        lo, hi = map(float, rng)
+        ok = math.isfinite(lo) and math.isfinite(hi) and 0 < lo <= hi <= MAX_STRIKING_VELOCITY
+    if not ok:
+        raise InputError("velocity_range_m_s", f"{path}: expected [lowest, highest] striking velocity of the "
+                                               f"calibration shots (0 < lowest <= highest <= "
+                                               f"{MAX_STRIKING_VELOCITY:g} m/s); got {rng!r}")
+    return [lo, hi]
+
+
+def load_regimes_file(path) -> tuple[dict, "Options", dict]:
+    """(the JSON object, its :class:`Options`, the checked draws) of a regimes posterior file: every
+    check that needs no case (format version, options and their values, draws by
+    :func:`check_draws`, the calibrated velocity range); InputError naming the file otherwise."""
+    import dataclasses
     import json
     from pathlib import Path
 
@@ -759,43 +833,58 @@ def read_regimes_posterior(path, case) -> dict:
 
     try:
         obj = json.loads(Path(path).read_text())
+        known = {f.name for f in dataclasses.fields(Options)}
+        if not isinstance(obj["options"], dict) or not set(obj["options"]) <= known:
+            extra = sorted(set(obj["options"]) - known) if isinstance(obj["options"], dict) else obj["options"]
+            raise InputError("options", f"{path}: unknown option(s) {extra!r}; the options are {', '.join(sorted(known))}")
         opt = Options(**obj["options"])
-        draws = {k: np.asarray(obj["samples"][k], float) for k in ("dynamic_factor", "sigma", "tau")}
-        for k in ("breakup_factor", "sigma_deformed"):
-            if k in obj["samples"]:
-                draws[k] = np.asarray(obj["samples"][k], float)
-        sig = obj["signature"]
+        samples = obj["samples"]
+        if not isinstance(samples, dict):
+            raise TypeError("samples is not a JSON object")
+        if not isinstance(obj["signature"], dict):
+            raise TypeError("signature is not a JSON object")
     except (OSError, ValueError, KeyError, TypeError) as exc:
+        if isinstance(exc, InputError):
+            raise
         raise InputError("--posterior", f"{path}: not a readable regimes posterior ({exc})") from None
     if obj.get("version") != REGIMES_VERSION:
         raise InputError("--posterior", f"{path}: version {obj.get('version')!r}, expected {REGIMES_VERSION}")
-    mine = geometry_signature(case)
-    other_nose = []
-    for k, v in sig.items():
-        w = mine.get(k)
-        same = (v == w) if not (isinstance(v, float) and isinstance(w, float)) else math.isclose(v, w, rel_tol=1e-9)
-        if same:
-            continue
-        if k in NOSE_KEYS:  # the parameters are the rod steel's and the target's, not the nose's
-            other_nose.append(f"{k} = {v!r} (the case: {w!r})")
-            continue
-        raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another target: "
-                                        "refit with calibrate --model regimes)")
     for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
                     ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
                     ("discrepancy", DISCREPANCIES), ("rigid_depth", RIGID_DEPTHS)):
         if getattr(opt, k) not in vals:
-            raise InputError("--posterior", f"{path}: unknown model set {k} = {getattr(opt, k)!r}")
+            raise InputError(f"options.{k}", f"{path}: unknown value {getattr(opt, k)!r}; one of {', '.join(vals)}")
+    draws = check_draws(path, samples)
     for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
-        if need and (k not in draws or len(draws[k]) != len(draws["sigma"])):
-            raise InputError("--posterior", f"{path}: samples.{k} missing or of another length than samples.sigma "
-                                            f"(the model set {opt.label()} needs it)")
-    notes = []
+        if need and k not in draws:
+            raise InputError(f"samples.{k}", f"{path}: missing (the model set {opt.label()} needs it)")
+    obj["velocity_range_m_s"] = _check_range(path, obj.get("velocity_range_m_s"))
+    return obj, opt, draws
+
+
+def read_regimes_posterior(path, case) -> dict:
+    """Read a regimes posterior (:func:`load_regimes_file`) and check it against ``case``: another
+    nose or target is a transfer, accepted with a note (:func:`transfer_notes`)."""
+    from semianalytic.errors import InputError
+
+    obj, opt, draws = load_regimes_file(path)
+    sig = obj["signature"]
+    mine = geometry_signature(case)
+    other_nose, other_target = [], []
+    for k, v in sig.items():
+        w = mine.get(k)
+        same = (v == w) if not (isinstance(v, float) and isinstance(w, float)) else math.isclose(v, w, rel_tol=1e-9)
+        if not same:
+            (other_nose if k in NOSE_KEYS else other_target).append(f"{k} = {v!r} (the case: {w!r})")
+    notes, reasons = [], []
     if other_nose:
-        notes.append(f"note: posterior {path}: fitted for {', '.join(other_nose)}; applied to this case's nose as a "
-                     "transfer: its parameters (dynamic factor of the rod steel, scatter of the transitions and depths) "
-                     "are not the nose's, while the Part I depth and the transition criteria are recomputed for this nose")
-    return {"options": opt, "draws": draws, "raw": obj, "notes": notes}
+        reasons.append(f"another nose: fitted for {', '.join(other_nose)}")
+    if other_target:
+        reasons.append(f"another target: fitted for {', '.join(other_target)}")
+        notes.append(f"note: posterior {path}: fitted on another target ({', '.join(other_target)}); its rod parameters "
+                     "(dynamic factor, breakup factor of the rod steel) are applied to this target, whose resistance "
+                     "R_t is recomputed from the case's [target] properties")
+    return {"options": opt, "draws": draws, "raw": obj, "notes": notes, "transfer_reasons": reasons}
 
 
 def shots_at(case, coefficients, U) -> RegimeShots:
@@ -832,31 +921,151 @@ def shots_at(case, coefficients, U) -> RegimeShots:
         target_density=ei.target_density, resistance={"part1": setup.resistance_pa, "tate1986": tate})
 
 
+TRANSFER_DEPTH_SIGMA = 0.116
+"""Depth scatter added (in quadrature, ln depth) when a regimes posterior transfers to a nose,
+hardness or target outside what it was fitted on: the leave-one-steel-out inflation measured on
+the bundled data (reports/calibration_piekutowski1999_regimes/transfer.json, the chosen model
+set): the RMS of ln(measured / predicted median) over the 31 shots with a depth is 0.165 when each
+steel is predicted from the other's posterior and 0.117 in-sample, and sqrt(0.165^2 - 0.117^2)
+= 0.116 (:func:`transfer_depth_inflation` recomputes it; tests/test_posterior_transfer.py checks
+the constant against the committed file)."""
+
+RIGID_BELOW_RANGE = 0.99
+"""Below the calibrated velocity range a regimes posterior's prediction is given where the rod is
+rigid with at least this probability (the rigid model, Part I, holds down to any speed); it says so
+in a note."""
+
+
+def transfer_depth_inflation(transfer: dict) -> float:
+    """sqrt(max(0, mean e_T^2 - mean e_I^2)), e = ln(measured / median), over the shots of the
+    chosen model set of a transfer study (``transfer.json`` of ``calibrate --model regimes
+    --cross-validate``): T the leave-one-group-out predictions, I the in-sample ones."""
+    rec = next(o for o in transfer["options"] if o["options"] == transfer["chosen"])
+
+    def ms(scores):
+        e = [math.log(s["measured_m"] / s["q50_m"]) for sc in scores for s in sc["shots"]
+             if s["measured_m"] is not None and math.isfinite(s["measured_m"]) and s["q50_m"]]
+        return float(np.mean(np.square(e)))
+
+    return math.sqrt(max(0.0, ms(rec["transfer"]) - ms(rec["in_sample"])))
+
+
+def criteria_spread(shots: RegimeShots, opt: Options, f: float, b) -> dict:
+    """The spread of the transition criteria on this rod and nose at one (f, b): the standard
+    deviation of ln U_y over the onset criteria and of ln U_e over the erosion criteria (every
+    criterion of :mod:`.regime` but this project's own nose-length rule), the larger of the two as
+    ``tau`` (the transfer uncertainty of the transition velocities)."""
+    import dataclasses
+
+    out = {}
+    for name, crit, attr in (("onset", rg.ONSET_CRITERIA, "Uy"), ("erosion", rg.EROSION_CRITERIA, "Ue")):
+        vals = {}
+        for c in crit:
+            if c == "nose_length":
+                continue
+            th = model_outcome([f], shots, dataclasses.replace(opt, **{name: c}), None if b is None else [b])
+            v = float(np.median(getattr(th, attr)[0]))
+            if math.isfinite(v) and v > 0:
+                vals[c] = v
+        out[name] = {"velocities_m_s": vals,
+                     "sd_ln": float(np.std(np.log(list(vals.values())))) if len(vals) > 1 else 0.0}
+    out["tau"] = max(out["onset"]["sd_ln"], out["erosion"]["sd_ln"])
+    return out
+
+
+def _hardness_reason(post: dict, shots: RegimeShots):
+    rng = post["raw"].get("meyer_hardness_range_Pa")
+    if not (isinstance(rng, list) and len(rng) == 2):
+        return None
+    H = float(shots.meyer_hardness[0])
+    lo, hi = map(float, rng)
+    if lo <= H <= hi:
+        return None
+    return (f"another hardness: the rod's Meyer hardness {H / 1e9:.2f} GPa is outside the {lo / 1e9:.2f}-{hi / 1e9:.2f} "
+            "GPa of the shots it was fitted on")
+
+
 def predict_case(case, coefficients, path, U, probs=(0.05, 0.25, 0.5, 0.75, 0.95)) -> dict:
     """``penetrate --posterior`` with a regimes posterior: per velocity ``regime_probability``
-    {rigid, deforming, eroding} and the regime-aware quantiles of the mixture; velocities outside
-    the posterior's calibrated range (10 % margin) are refused as "no model holds" (NaN and a
-    warning)."""
+    {rigid, deforming, eroding} and the regime-aware quantiles of the mixture.
+
+    Every striking velocity is answered: inside the calibrated range (10 % margin) by the
+    mixture; below it, where the rod is rigid with probability >= :data:`RIGID_BELOW_RANGE`, by
+    the same mixture (the rigid model) with a note; elsewhere (above the range, or below it where
+    the rod may deform) null, with the reason in ``regime_notes`` and on stderr.
+
+    Transfer (issue 36 item 5): applied to another nose, a hardness outside the fitted shots' or
+    another target (accepted: the rod parameters are the steel's, R_t is recomputed from the
+    case), the transition scatter tau is widened in quadrature by the spread of the published
+    criteria on this rod and nose (:func:`criteria_spread`) and the depth scatter sigma by
+    :data:`TRANSFER_DEPTH_SIGMA`; ``transfer`` states the reasons and the amounts."""
     post = read_regimes_posterior(path, case)
     shots = shots_at(case, coefficients, U)
     d = post["draws"]
     idx = np.linspace(0, len(d["sigma"]) - 1, min(PREDICTION_DRAWS, len(d["sigma"]))).astype(int)
     sd = d.get("sigma_deformed")
     sig = np.column_stack([d["sigma"][idx], (sd if sd is not None else d["sigma"])[idx]])
+    tau = d["tau"][idx]
     b = d["breakup_factor"][idx] if "breakup_factor" in d else None
-    pred = predict(shots, post["options"], d["dynamic_factor"][idx], sig, d["tau"][idx], probs, b=b)
+    opt = post["options"]
+    reasons = list(post["transfer_reasons"])
+    hard = _hardness_reason(post, shots)
+    if hard:
+        reasons.append(hard)
+    transfer = {"transfer": bool(reasons), "reasons": reasons, "tau_added": 0.0, "sigma_added": 0.0}
+    warnings = list(post["notes"])
+    if reasons:
+        spread = criteria_spread(shots, opt, float(np.median(d["dynamic_factor"])),
+                                 None if b is None else float(np.median(b)))
+        transfer.update(tau_added=spread["tau"], sigma_added=TRANSFER_DEPTH_SIGMA, criteria=spread,
+                        rule="tau' = sqrt(tau^2 + s_U^2), s_U = the larger SD of ln U_y over the onset criteria and of "
+                             "ln U_e over the erosion criteria on this rod and nose (published ones; the nose-length "
+                             "rule, ours, left out); sigma' = sqrt(sigma^2 + 0.116^2), the leave-one-steel-out "
+                             "inflation of the depth error on the bundled data")
+        tau = np.sqrt(tau**2 + spread["tau"] ** 2)
+        sig = np.sqrt(sig**2 + TRANSFER_DEPTH_SIGMA**2)
+        warnings.append(f"note: posterior {path}: a transfer ({'; '.join(reasons)}): the intervals are widened by a "
+                        f"stated rule: transition scatter tau + {spread['tau']:.3f} (spread of the criteria on this rod "
+                        f"and nose), depth scatter sigma + {TRANSFER_DEPTH_SIGMA:.3f} (leave-one-steel-out inflation), "
+                        "both in quadrature")
+    pred = predict(shots, opt, d["dynamic_factor"][idx], sig, tau, probs, b=b)
     lo, hi = post["raw"]["velocity_range_m_s"]
-    holds = (shots.velocity >= 0.9 * lo) & (shots.velocity <= 1.1 * hi)
+    V = shots.velocity
+    inside = (V >= 0.9 * lo) & (V <= 1.1 * hi)
+    p_rigid = pred["regime_probability"][0]
+    below_rigid = (V < 0.9 * lo) & (p_rigid >= RIGID_BELOW_RANGE)
+    finite = np.all(np.isfinite(pred["quantiles"]), axis=0) & np.all(np.isfinite(pred["regime_probability"]), axis=0)
+    holds = (inside | below_rigid) & finite
+    reason = [None] * len(V)
+    for i, u in enumerate(V):
+        if below_rigid[i] and finite[i]:
+            reason[i] = (f"below the calibrated {lo:.0f}-{hi:.0f} m/s: rigid with probability {p_rigid[i]:.3f}, the rigid "
+                         "model (Part I) holds there; given as extrapolated")
+        elif not inside[i]:
+            reason[i] = (f"no model holds: outside the calibrated {lo:.0f}-{hi:.0f} m/s (10 % margin)"
+                         + ("" if u > hi else f", and the rod is not surely rigid (P(rigid) = {p_rigid[i]:.3f} < "
+                                              f"{RIGID_BELOW_RANGE})"))
+        elif not finite[i]:
+            reason[i] = "no model holds: the regime model gives no finite depth here"
     q = np.where(holds[None, :], pred["quantiles"], np.nan)
     prob = np.where(holds[None, :], pred["regime_probability"], np.nan)
-    warnings = list(post["notes"])
+    if np.any(below_rigid & finite):
+        at = ", ".join(f"{u:.0f}" for u in V[below_rigid & finite])
+        warnings.append(f"note: posterior {path}: U_s = {at} m/s below the calibrated {lo:.0f}-{hi:.0f} m/s: the rigid "
+                        f"prediction is given (P(rigid) >= {RIGID_BELOW_RANGE} there; regime_notes)")
     if not holds.all():
-        bad = ", ".join(f"{u:.0f}" for u in shots.velocity[~holds])
+        bad = ", ".join(f"{u:.0f}" for u in V[~holds])
         warnings.append(f"warning: posterior {path}: no model holds at U_s = {bad} m/s: the regime model was "
-                        f"calibrated on {lo:.0f}-{hi:.0f} m/s (10 % margin); no depth is given there")
+                        f"calibrated on {lo:.0f}-{hi:.0f} m/s (10 % margin); no depth is given there (null; the reason "
+                        "per velocity in regime_notes)")
+    z90 = 1.6448536269514722
+    t_med = float(np.median(tau))
     return {"quantiles": {f"{p:g}": q[k].tolist() for k, p in enumerate(probs)},
             "regime_probability": {name: prob[k].tolist() for k, name in enumerate(rg.REGIMES)},
-            "model_holds": holds.tolist(), "options": post["options"].as_dict(),
+            "model_holds": holds.tolist(), "notes": reason, "options": opt.as_dict(), "transfer": transfer,
             "transition_velocities_m_s": {"onset": pred["U_y"].tolist(), "breakup": pred["U_x"].tolist(),
                                           "erosion": pred["U_e"].tolist()},
+            "transition_intervals_90_m_s": {k: [[float(v * math.exp(-z90 * t_med)), float(v * math.exp(z90 * t_med))]
+                                                for v in pred[key]]
+                                            for k, key in (("onset", "U_y"), ("breakup", "U_x"), ("erosion", "U_e"))},
             "warnings": warnings}

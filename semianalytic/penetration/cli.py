@@ -135,28 +135,41 @@ def _print_text(result: dict, desc: str, file=None) -> None:
           f"deforming between; depth = {result['part1_model']} below U_y, Alekseevskii-Tate rod above (Y_p = "
           f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")
     head = (
-        f"  {'U_s':>7} | {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} | {'elastic exact rod':>17} |"
-        f" {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8} | {'regime':>9} | {'depth':>7} | yields"
+        f"  {'U_s':>7} | {'regime':>9} | {'depth':>7} || {'rigid':>15} | {'quasi-rigid':>15} | {'elastic (29)':>15} |"
+        f" {'elastic exact rod':>17} | {'Forrestal':>9} | {'Chen-Li':>8} | {'eroding':>8}"
     )
+    p("  verdict (regime and its depth) first; then each model's own depth (valid only in its regime)")
     p(head)
-    p(f"  {'m/s':>7} | {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8} | {'':>9} | {'P mm':>7} |")
+    p(f"  {'m/s':>7} | {'':>9} | {'P mm':>7} || {'P mm    t us':>15} | {'P mm    t us':>15} | {'P mm   t* us':>15} | {'P mm   t* us':>17} | {'P mm':>9} | {'P mm':>8} | {'P mm':>8}")
     p("  (P: final depth; t: time to rest, eq. (11); t*: the elastic projectile's stop, eq. (30'), where "
-      "m ubar^2 = 2 (W1 + W2); yields: U_s at or above the critical velocity U_sC, eq. (33))")
+      "m ubar^2 = 2 (W1 + W2))")
     n = len(result["striking_velocity_m_s"])
     for i in range(n):
         r = {k: result[k][i] for k in (
             "striking_velocity_m_s", "depth_rigid_m", "time_rigid_s", "depth_quasi_rigid_m", "time_quasi_rigid_s",
             "depth_elastic_m", "stop_time_elastic_s", "depth_elastic_exact_rod_m", "stop_time_elastic_exact_rod_s",
-            "depth_forrestal_m", "depth_chen_li_m", "yields")}
+            "depth_forrestal_m", "depth_chen_li_m")}
         p(
-            f"  {r['striking_velocity_m_s']:7.0f} | {_fmt(r['depth_rigid_m'], 1e3):>7} {_fmt(r['time_rigid_s'], 1e6):>7} |"
+            f"  {r['striking_velocity_m_s']:7.0f} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} ||"
+            f" {_fmt(r['depth_rigid_m'], 1e3):>7} {_fmt(r['time_rigid_s'], 1e6):>7} |"
             f" {_fmt(r['depth_quasi_rigid_m'], 1e3):>7} {_fmt(r['time_quasi_rigid_s'], 1e6):>7} |"
             f" {_fmt(r['depth_elastic_m'], 1e3):>7} {_fmt(r['stop_time_elastic_s'], 1e6):>7} |"
             f" {_fmt(r['depth_elastic_exact_rod_m'], 1e3):>8} {_fmt(r['stop_time_elastic_exact_rod_s'], 1e6):>8} |"
             f" {_fmt(r['depth_forrestal_m'], 1e3):>9} | {_fmt(r['depth_chen_li_m'], 1e3):>8} |"
-            f" {_fmt(result['depth_eroding_m'][i], 1e3):>8} | {result['regime'][i]:>9} | {_fmt(result['depth_m'][i], 1e3):>7} |"
-            f" {'YES (outside the model)' if r['yields'] else 'no'}"
+            f" {_fmt(result['depth_eroding_m'][i], 1e3):>8}"
         )
+    U = result["striking_velocity_m_s"]
+    src = result.get("regime_source") or []
+    if "posterior" in src:
+        p(f"  verdict source: the regimes posterior's most probable regime at U_s = "
+          f"{', '.join(f'{u:.0f}' for u, s in zip(U, src) if s == 'posterior')} m/s, else the {result.get('regime_rule')} rule")
+    def at(flags):
+        hit = [f"{u:.0f}" for u, x in zip(U, flags or []) if x]
+        return f"at U_s = {', '.join(hit)} m/s" if hit else "at no striking velocity"
+
+    p(f"  diagnostics (they follow the verdict or are marked as not used by it): yields (the regime is not rigid) "
+      f"{at(result['yields'])}; Part I's U_s >= U_sC (eqs. (33)/(36); not used by the {result.get('regime_rule')} "
+      f"rule) {at(result.get('part1_critical_exceeded'))}")
     est = result.get("depth_error_estimate_m")
     if est:
         worst = {k: max((e / d for e, d in zip(est[k], result[f"depth_{k}_m"]) if d and math.isfinite(d)), default=math.nan)
@@ -168,6 +181,18 @@ def _print_text(result: dict, desc: str, file=None) -> None:
         for model, q in result["depth_quantiles_m"].items():
             cells = "  ".join(f"{a * 1e3:.0f} [{b * 1e3:.0f}, {c * 1e3:.0f}]" for a, b, c in zip(q["0.5"], q["0.05"], q["0.95"]))
             p(f"    {model:<18} {cells}")
+        prob = result.get("regime_probability")
+        if prob:
+            cells = "  ".join("-" if r is None or not math.isfinite(r) else f"{r:.2f}/{d:.2f}/{e:.2f}"
+                              for r, d, e in zip(prob["rigid"], prob["deforming"], prob["eroding"]))
+            p(f"    {'P(rigid/def./ero.)':<18} {cells}")
+        for u, note in zip(result["striking_velocity_m_s"], result.get("regime_notes") or []):
+            if note:
+                p(f"    at {u:.0f} m/s: {note}")
+        tr = result.get("posterior_transfer") or {}
+        if tr.get("transfer"):
+            p(f"    transfer ({'; '.join(tr['reasons'])}): tau + {tr['tau_added']:.3f}, sigma + {tr['sigma_added']:.3f} "
+              "in quadrature (posterior_transfer gives the rule)")
     val = result.get("validation")
     if val:
         p(f"  measured depths ({len(val['shots'])} shots): relative error (predicted - measured)/measured")
@@ -207,6 +232,10 @@ def run(args) -> int:
     from semianalytic.cache import override_coefficients
 
     cases = [override_coefficients(c, contact=args.contact, tolerance=args.tolerance) for c in _load(args.cases)]
+    if args.posterior:  # a bad posterior file stops before any table is built
+        from semianalytic.calibration.evaluate import check_posterior_files
+
+        check_posterior_files(args.posterior)
     if args.coefficients == "bem":  # refuse before solving what would not fit in memory
         from semianalytic.guards import check_coefficients
 
@@ -235,6 +264,9 @@ def run(args) -> int:
         results.append(dict(evaluate_case(case, coefficients, w1=args.w1, part1_model=args.part1_model,
                                                  regime_rule=args.regime_rule), **quantiles))
         results[-1]["warnings"] = [*results[-1]["warnings"], *notes]
+        from semianalytic.penetration.evaluate import one_verdict
+
+        one_verdict(results[-1])  # with a regimes posterior, its most probable regime is the verdict
         descs.append(desc)
         _warn_separation(results[-1])
         for line in results[-1]["warnings"]:

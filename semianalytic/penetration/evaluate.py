@@ -13,7 +13,79 @@ import numpy as np
 
 from semianalytic.errors import InputError
 
-__all__ = ["evaluate_case", "contact_summary"]
+__all__ = ["evaluate_case", "contact_summary", "one_verdict"]
+
+PART1_DEPTH_KEYS = {"rigid": "depth_rigid_m", "quasi_rigid": "depth_quasi_rigid_m", "elastic": "depth_elastic_m",
+                    "elastic_exact_rod": "depth_elastic_exact_rod_m"}
+
+
+def one_verdict(result: dict) -> dict:
+    """One verdict per striking velocity (issue 36 item 7), in place: ``regime`` is the verdict
+    and every diagnostic follows it.
+
+    * With a regimes posterior (``regime_probability``), the verdict is the posterior's most
+      probable regime where its model holds, else the rule's label; the rule's labels stay in
+      ``regime_rule_labels`` and ``regime_source`` says which gave each verdict ("posterior" or
+      "rule").  Where the posterior's verdict is rigid or eroding, ``depth_m`` is that regime's
+      depth (the Part I model, the eroding rod).
+    * ``yields`` is ``regime != "rigid"`` (the projectile yields exactly where the verdict says it
+      is no longer rigid); Part I's own criterion U_s >= U_sC (eqs. (33)/(36)), which the
+      verdict's rule need not use, is kept as the diagnostic ``part1_critical_exceeded``.
+    * ``valid``: a rigid-projectile model is valid only where the verdict is rigid, the eroding
+      rod never where it is rigid.
+    Returns ``result`` with note lines added to ``warnings`` where a diagnostic differs from the
+    verdict."""
+    regime = list(result.get("regime_rule_labels", result["regime"]))  # idempotent: a second call starts again
+    U = result["striking_velocity_m_s"]
+    n = len(regime)
+    source = ["rule"] * n
+    notes = []
+    prob = result.get("regime_probability")
+    if prob:
+        result["regime_rule_labels"] = list(regime)
+        names = list(prob)
+        part1 = result.get(PART1_DEPTH_KEYS.get(result.get("part1_model"), ""), [None] * n)
+        depth = list(result["depth_m"])
+        for i in range(n):
+            p = [prob[k][i] for k in names]
+            if all(x is not None and math.isfinite(x) for x in p):
+                verdict = names[max(range(len(p)), key=lambda k: p[k])]
+                source[i] = "posterior"
+                if verdict != regime[i]:
+                    regime[i] = verdict
+                    if verdict == "rigid":
+                        depth[i] = part1[i]
+                    elif verdict == "eroding":
+                        depth[i] = result["depth_eroding_m"][i]
+        moved = [f"{U[i]:.0f}" for i in range(n) if regime[i] != result["regime_rule_labels"][i]]
+        if moved:
+            notes.append(f"note: regime: the posterior's most probable regime is the verdict; it differs from the "
+                         f"{result.get('regime_rule')} rule's label at U_s = {', '.join(moved)} m/s (regime_rule_labels)")
+        result["depth_m"] = depth
+    result["regime"] = regime
+    result["regime_source"] = source
+    usc = [bool(x) for x in result.get("part1_critical_exceeded", result.get("yields", [False] * n))]
+    result["part1_critical_exceeded"] = usc
+    result["yields"] = [r != "rigid" for r in regime]
+    odd = [f"{U[i]:.0f}" for i in range(n) if usc[i] and regime[i] == "rigid"]
+    if odd and result.get("regime_rule") != "nose_length":
+        uc = result.get("critical_velocity_m_s", [None])[0]
+        notes.append(f"note: diagnostic: U_s >= Part I's U_sC = {uc:.0f} m/s (eqs. (33)/(36)) at U_s = {', '.join(odd)} "
+                     f"m/s, where the verdict is rigid: the {result.get('regime_rule')} rule does not use U_sC "
+                     "(part1_critical_exceeded)")
+    valid = result.get("valid") or {}
+    for k, v in valid.items():
+        if k in ("regime_aware",):
+            continue
+        if k == "eroding":
+            valid[k] = [bool(x) and r != "rigid" for x, r in zip(v, regime)]
+        else:
+            valid[k] = [bool(x) and r == "rigid" for x, r in zip(v, regime)]
+    result["warnings"] = [*(w for w in result.get("warnings", []) if not w.startswith(_VERDICT_NOTES)), *notes]
+    return result
+
+
+_VERDICT_NOTES = ("note: regime: the posterior's", "note: diagnostic: U_s >= Part I's")
 
 
 def contact_summary(setup, U, profile=None) -> dict:
@@ -104,6 +176,7 @@ def evaluate_case(case, coefficients, *, w1: str = "neglect", velocities=None, p
         bad = [f"{u:g}" for u, ok in zip(U, res["converged"]) if not ok]
         out["warnings"] = [*out.get("warnings", []), f"eq. (11): an iterative solve did not converge at "
                            f"{len(bad)} striking velocities ({', '.join(bad[:3])} m/s ...); see 'converged'"]
+    one_verdict(out)
     if data is not None and data.file is not None:
         rows = predict_shots(case, coefficients, rigid_regime_shots(case, load_shots(case)), w1=w1)
         out["validation"] = {"shots": rows, "statistics": error_statistics(rows)}

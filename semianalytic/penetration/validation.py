@@ -102,13 +102,15 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     data = case.require("data")
     if data.file is None:
         return []
+    from semianalytic.case import MAX_STRIKING_VELOCITY, MIN_STRIKING_VELOCITY
     from semianalytic.io import case_input_path
 
     path = case_input_path(case.path, data.file, "data.file")
     if not path.is_file():
         raise InputError("data.file", f"{str(path)!r} does not exist")
     names, table = read_csv_rows(path)
-    columns = {k: getattr(data, k) for k in ("velocity_column", "depth_column", "mass_column", "id_column")}
+    columns = {k: getattr(data, k, None) for k in ("velocity_column", "depth_column", "mass_column", "id_column",
+                                                   "response_column", "hardness_column")}
     columns.update({f"select.{c}": c for c in data.select})
     for key, col in columns.items():
         if col is not None and col not in names:
@@ -133,9 +135,46 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
             raise InputError("data.file", f"row {i + 1} of {path.name} has a value that is not a finite number (NaN or inf)")
         if not (V > 0 and (P > 0 or no_depth) and (m is None or m > 0)):
             raise InputError("data.file", f"row {i + 1} of {path.name}: velocity, depth and mass must be positive")
+        if not MIN_STRIKING_VELOCITY <= V <= MAX_STRIKING_VELOCITY:  # the bound of a case's striking velocity
+            raise InputError("data.velocity_column", f"row {i + 1} of {path.name}: {V:g} m/s is outside "
+                                                     f"{MIN_STRIKING_VELOCITY:g}-{MAX_STRIKING_VELOCITY:g} m/s, the range "
+                                                     "of a striking velocity any model here reads (a solid projectile)")
         shot_id = str(row[data.id_column]) if data.id_column else str(i + 1)
+        _check_row_labels(data, row, i, shot_id, path.name)
         shots.append(Shot(shot_id, V, P, m, row))
     return shots
+
+
+def _check_row_labels(data, row: dict, i: int, shot_id: str, name: str) -> None:
+    """A selected row's recorded response (one of the known labels, or blank: not recorded) and
+    its hardness (a number where ``hardness_column`` is given: a blank would silently take the
+    nominal ``[projectile] hardness``)."""
+    from semianalytic.penetration.regime_setup import RESPONSE_REGIME
+
+    if data.response_column:
+        label = row[data.response_column].strip()
+        if label and label not in RESPONSE_REGIME:
+            raise InputError("data.response_column", f"row {i + 1} of {name} (shot {shot_id}): response {label!r} is "
+                                                     f"not a known label; one of {', '.join(RESPONSE_REGIME)} (or blank: "
+                                                     "no recorded response)")
+    col = getattr(data, "hardness_column", None)
+    if col:
+        h = row[col].strip()
+        from semianalytic.penetration.hardness import HRC_RANGE
+
+        try:
+            value = float(h)
+            ok = math.isfinite(value)
+        except ValueError:
+            ok = False
+        if ok and not HRC_RANGE[0] <= value <= HRC_RANGE[1]:
+            raise InputError("data.hardness_column", f"row {i + 1} of {name} (shot {shot_id}): {value:g} HRC is outside "
+                                                     f"{HRC_RANGE[0]:g}-{HRC_RANGE[1]:g} HRC, the range of the hardness "
+                                                     "conversion (ASTM E140, Table 1)")
+        if not ok:
+            raise InputError("data.hardness_column", f"row {i + 1} of {name} (shot {shot_id}): hardness {h!r} is not a "
+                                                     "number (Rockwell C); give every selected shot its hardness, or drop "
+                                                     "hardness_column to use [projectile] hardness for all")
 
 
 def rigid_regime_shots(case, shots: list[Shot]) -> list[Shot]:
