@@ -117,6 +117,24 @@ def _arithmetic_unknowns(nose, order: int, refinement: float, max_depth_nose_len
     return order * (estimate + shank)
 
 
+def _least_unknowns(nose, order: int) -> tuple[float, int]:
+    """A lower bound of the primary unknowns of the deepest half-space layout, by counting only
+    (no layout built): :func:`semianalytic.bem.panels.halfspace_layout` lays at least one panel
+    per interval between a table spline's knots (it cuts the spline there) and at least two on
+    every other segment, and at least one on the shank.  Returns (unknowns, knot intervals)."""
+    from semianalytic.geometry import SplineCurve
+
+    panels, intervals = 1.0, 0
+    for seg in nose.segments:
+        if isinstance(seg, SplineCurve):
+            k = max(len(seg.knots) - 1, 1)
+            intervals += k
+            panels += k
+        else:
+            panels += 2
+    return order * panels, intervals
+
+
 def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_depth_nose_lengths: float = 300.0,
                            levels: int = 12) -> float:
     """Primary unknowns N of the largest half-space layout of ``nose`` (order x panels): the
@@ -218,6 +236,7 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     rough = _arithmetic_unknowns(nose, order, ref, depth)
     if math.isfinite(rough) and bem_bytes(4.0 * rough) <= limit:
         return check_table_time(case, bem_bytes(rough))
+    _refuse_by_least_unknowns(case, nose, order, limit, order_given=order != case.bem.order)
     need = need_for(nose)
     if need <= limit:
         return check_table_time(case, need)
@@ -246,6 +265,27 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
                                                                "the tip) or lower the refinement")
     _refuse(shape_field(psec.nose), what, need, limit, "make the nose less slender or lower the refinement")
     return need
+
+
+def _refuse_by_least_unknowns(case, nose, order: int, limit: float, *, order_given: bool) -> None:
+    """Refuse, before any panel plan is built, a nose whose lower bound of unknowns
+    (:func:`_least_unknowns`) already exceeds the budget: a table nose of thousands of points
+    (each knot interval is a panel; building the real plan of 10 000 of them takes seconds)."""
+    least, intervals = _least_unknowns(nose, order)
+    need = bem_bytes(least)
+    if need <= limit:
+        return
+    what = f"the BEM solve of the {nose.kind} nose (at least {least:.3g} unknowns"
+    what += f": {intervals} point intervals x order {order})" if intervals else ")"
+    if order_given and order > 2 and bem_bytes(_least_unknowns(nose, 2)[0]) <= limit:
+        best = max(o for o in range(2, order) if bem_bytes(_least_unknowns(nose, o)[0]) <= limit)
+        _refuse("--order", what, need, limit, f"the largest order that could fit is {best}")
+    if case.projectile.nose == "table":
+        fit = int(math.sqrt(limit / BEM_BYTES_PER_UNKNOWN2) / order) - 1
+        _refuse("projectile.points", what, need, limit,
+                f"use fewer points ({len(case.projectile.points)} given, at most about {max(fit, 2)} could fit at "
+                f"order {order}; a few dozen describe a smooth nose)")
+    _refuse(shape_field(case.projectile.nose), what, need, limit, "make the nose less slender or lower the order")
 
 
 def check_body(case, order: int | None = None, refinement: float | None = None) -> float:
