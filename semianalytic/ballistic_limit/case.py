@@ -148,7 +148,7 @@ class ShotSection(Section):
     @field_validator("projectile_length", "projectile_diameter", "projectile_mass", "projectile_delta_h",
                      "target_delta_h", "measured")
     @classmethod
-    def _plausible(cls, v, info):
+    def _plausible_shot(cls, v, info):
         return _check_range(info.field_name)(v)
 
     @model_validator(mode="after")
