@@ -46,7 +46,7 @@ def run_optimize(args: argparse.Namespace, command: str) -> dict:
     if out is not None:
         check_output_dir(out, args.force, protect=(args.case,))
     if report is not None:
-        check_report_target(report, args.force)
+        check_report_target(report, args.force, inputs=[args.case])
     cache_dir = str(table_dir(args.cache_dir))
     sched = args.scheduler or ("local" if args.workers > 1 else "inline")
     client, cluster, name = connect(sched, args.workers)
