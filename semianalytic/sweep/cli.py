@@ -71,6 +71,11 @@ def run(args: argparse.Namespace) -> int:
         raise InputError("--samples", "must not be negative")
     if args.scheduler is not None and not args.scheduler.strip():
         raise InputError("--scheduler", "empty; give 'inline', 'local' or a dask scheduler address (host:port)")
+    if args.scheduler is not None and args.scheduler.strip() not in ("inline", "local") \
+            and not args.scheduler.strip().endswith(".json"):
+        from semianalytic.sweep.engine import probe_scheduler
+
+        probe_scheduler(args.scheduler)  # a non-dask peer named up front, within seconds (issue 40)
     spec = build_spec(args.vary, args.sample, args.samples, args.seed)
     case = load_case(args.case)
     check_axes(case, spec)
