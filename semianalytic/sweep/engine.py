@@ -473,6 +473,33 @@ def probe_scheduler(address: str, connect_seconds: float = PROBE_CONNECT_SECONDS
                                         f"({data[:16]!r}, not dask's frame header)")
 
 
+class _deferred_interrupts:
+    """SIGINT and SIGTERM noted, not raised, inside the block (a dask cluster interrupted half-way
+    through its start prints tracebacks from its own cleanup); the list it yields holds the name of
+    a signal that came.  Only in the main thread."""
+
+    def __enter__(self):
+        import signal
+        import threading
+
+        self.got, self.old = [], {}
+        if threading.current_thread() is threading.main_thread():
+            for sig in (signal.SIGINT, signal.SIGTERM):
+                try:
+                    self.old[sig] = signal.signal(sig, lambda signum, frame: self.got.append(
+                        "Ctrl-C" if signum == signal.SIGINT else f"signal {signal.Signals(signum).name}"))
+                except (ValueError, OSError):
+                    pass
+        return self.got
+
+    def __exit__(self, *exc):
+        import signal
+
+        for sig, handler in self.old.items():
+            signal.signal(sig, handler)
+        return False
+
+
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address, or of the one a scheduler file names
@@ -494,13 +521,31 @@ def connect(scheduler: str | None, workers: int):
         environ.update(OPENBLAS_NUM_THREADS=1, OMP_NUM_THREADS=1, MKL_NUM_THREADS=1)
         # and no statistical profiler in the workers (a thread that samples the task's stack every 10 ms,
         # for the dashboard, which a sweep does not open)
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False}):
+        import atexit
+        import logging
+        import tempfile
+
+        # the workers' scratch space (dask-scratch-space, its lock files) in a folder of ours, removed at exit,
+        # also after Ctrl-C or SIGTERM (issue 40: dask left it in $TMPDIR)
+        scratch = tempfile.mkdtemp(prefix="semianalytic-dask-")
+        atexit.register(shutil.rmtree, scratch, True)
+        environ.update(DASK_TEMPORARY_DIRECTORY=scratch)
+        config = {"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False,
+                  "temporary-directory": scratch}
+        with dask.config.set(config), _deferred_interrupts() as interrupted:
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+                silence_logs=logging.CRITICAL, local_directory=scratch,
+                env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+                     "DASK_TEMPORARY_DIRECTORY": scratch},
             )
-        client = Client(cluster)
-        client.run(own_session)
+            client = Client(cluster)
+            client.run(own_session)
+        if interrupted:  # a Ctrl-C or SIGTERM while the cluster started: stop it whole, then say so
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
+            client.close()
+            cluster.close()
+            raise KeyboardInterrupt(interrupted[0])
         return client, cluster, "local"
     client = None
     try:
@@ -636,6 +681,11 @@ def run_sweep(
     finally:
         store.close()
         if client is not None:
+            import logging
+
+            # a cluster stopped by Ctrl-C or SIGTERM logs its workers' closed connections with tracebacks:
+            # not the user's business (the one line of the dispatcher says what happened)
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
             client.close()
         if cluster is not None:
             cluster.close()
