@@ -252,7 +252,9 @@ def chain_diagnostics(chains, names) -> dict:
 
     with _w.catch_warnings():
         _w.simplefilter("ignore")
-        import arviz as az
+        from semianalytic.thirdparty import import_arviz
+
+        az = import_arviz()  # no stamp file in ~/.cache (issue 40)
 
         chains = np.asarray(chains, float)
         out, warn = {}, []
