@@ -77,7 +77,17 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
     name, rest = argv[0], argv[1:]
     from semianalytic.thirdparty import keep_caches_out_of_home
 
-    keep_caches_out_of_home()  # matplotlib's font cache in this project's per-user cache, not ~/.cache (issue 40)
+    # matplotlib's font cache in this project's per-user cache, not ~/.cache (issue 40); for this command
+    # (and the processes it starts) only: tests call main() repeatedly
+    mpl_set = keep_caches_out_of_home()
+    try:
+        return _dispatch_command(prog, commands, name, rest)
+    finally:
+        if mpl_set is not None and os.environ.get("MPLCONFIGDIR") == mpl_set:
+            del os.environ["MPLCONFIGDIR"]
+
+
+def _dispatch_command(prog: str, commands: dict[str, tuple[str, str]], name: str, rest: list[str]) -> int:
     if name not in commands:
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2

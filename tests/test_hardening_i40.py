@@ -125,3 +125,197 @@ def test_probe_accepts_a_dask_frame_header():
         probe_scheduler(f"tcp://127.0.0.1:{server.port}")  # no error
     finally:
         server.close()
+
+
+# ------------------------------------------------------------------------------------------
+# --csv and --report targets: never a case file, never a non-regular file; refused before writing
+
+
+def test_csv_never_replaces_the_case_a_fifo_or_a_users_file(tmp_path, capsys, monkeypatch):
+    monkeypatch.chdir(tmp_path)
+    case = tmp_path / "case.toml"
+    text = FIG15A.read_text()
+    case.write_text(text)
+    fifo = tmp_path / "fifo"
+    os.mkfifo(fifo)
+    (tmp_path / "link.csv").symlink_to(case)
+    mine = tmp_path / "mine.csv"
+    mine.write_text("my,own,data\n")
+    for target, says in ((case, "input file"), (tmp_path / "link.csv", "input file"), (fifo, "FIFO"),
+                         (mine, "not written by this tool")):
+        for command in (["penetrate", case], ["run", case, "--out", tmp_path / "o", "--no-render"]):
+            rc, err = _run(capsys, *command, "--csv", target, "--force")
+            _one_line_error(rc, err, "--csv")
+            assert says in err, err
+    assert case.read_text() == text and mine.read_text() == "my,own,data\n"  # untouched
+    assert fifo.is_fifo() and not (tmp_path / "o").exists()
+    # the tool's own CSV is replaced with --force (the header line is the tool's)
+    rc, err = _run(capsys, "penetrate", case, "--csv", tmp_path / "d.csv")
+    assert rc == 0, err
+    rc, err = _run(capsys, "penetrate", case, "--csv", tmp_path / "d.csv", "--force")
+    assert rc == 0, err
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("command", ["calibrate", "optimize"])
+def test_report_above_the_working_folder_leaves_no_file(tmp_path, capsys, monkeypatch, command):
+    work = tmp_path / "a" / "b"
+    work.mkdir(parents=True)
+    monkeypatch.chdir(work)
+    argv = {"calibrate": ["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--steps", "60", "--quiet"],
+            "optimize": ["optimize", ROOT / "cases" / "optimize_fig5_into_fig15a.toml", "--vary", "projectile.crh=2:4",
+                         "--coarse", "2", "--confirm", "0", "--no-progress"]}[command]
+    rc, err = _run(capsys, *argv, "--out", "out", "--report", "out/../../x.md")
+    _one_line_error(rc, err, "--report")
+    assert sorted(p.relative_to(tmp_path).as_posix() for p in tmp_path.rglob("*")) == ["a", "a/b"]
+
+
+# ------------------------------------------------------------------------------------------
+# bounds before work on the flags that drive it
+
+
+def test_flags_that_drive_work_are_bounded_up_front(capsys, tmp_path, monkeypatch):
+    monkeypatch.delenv("SEMIANALYTIC_TIME_LIMIT", raising=False)
+    monkeypatch.delenv("SEMIANALYTIC_MEMORY_LIMIT", raising=False)
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))  # nothing cached: the work is real
+    ogive = ROOT / "cases" / "fig5_ogive.toml"
+    for argv, field, says in [
+        # 2000 depths at refinement 8 and order 16: hours of BEM solves (the issue's probe ran past 120 s)
+        (["coefficients", ogive, "--refinement", "8", "--order", "16", "--depths", "2000"], "--depths", "time budget"),
+        (["coefficients", ogive, "--refinement", "8", "--depths", "2000"], "--depths", "time budget"),
+        # 1e6 steps of the regimes model: 32 walkers x 1e6 steps at 2.7e-4 s each, about 2.4 h
+        (["calibrate", ROOT / "cases" / "piekutowski1999_var4340_hardness_regimes.toml", "--model", "regimes",
+          "--out", tmp_path / "c", "--steps", "1000000", "--quiet"], "--steps", "time budget"),
+        (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", tmp_path / "c", "--steps", "200000",
+          "--quiet"], "--steps", "time budget"),
+    ]:
+        t0 = time.monotonic()
+        rc, err = _run(capsys, *argv)
+        _one_line_error(rc, err, field)
+        assert says in err and time.monotonic() - t0 < 30, err
+    assert not (tmp_path / "c").exists()
+
+
+def test_sweep_values_outside_the_case_are_refused_up_front(capsys, tmp_path):
+    for extra, field, says in [
+        (["--vary", "impact.striking_velocity=1e-9 m/s,500 m/s"], "impact.striking_velocities", "the value 1e-09 m/s"),
+        (["--sample", "target.density=lognormal(2710 kg/m^3, 50)", "--samples", "10"], "target.density",
+         "narrow the distribution"),
+        (["--sample", "target.resistance.poisson_ratio=uniform(0.3, 0.7)", "--samples", "10"],
+         "target.resistance", "--sample target.resistance.poisson_ratio"),
+    ]:
+        rc, err = _run(capsys, "sweep", FIG15A, "--out", tmp_path / "sw", "--scheduler", "inline", "--no-progress", *extra)
+        _one_line_error(rc, err, field)
+        assert says in err, err
+        assert not (tmp_path / "sw").exists()
+    # a narrow lognormal stays inside the physical range: accepted
+    rc, err = _run(capsys, "sweep", FIG15A, "--out", tmp_path / "ok", "--scheduler", "inline", "--no-progress",
+                   "--sample", "target.density=lognormal(2710 kg/m^3, 0.02)", "--samples", "2",
+                   "--vary", "impact.striking_velocity=500 m/s")
+    assert rc == 0, err
+
+
+# ------------------------------------------------------------------------------------------
+# faults: signals leave no temporary file and no traceback; third-party caches out of $HOME
+
+
+def _signalled(tmp_path, argv, sig, ready, timeout=120.0):
+    """Start ``python -m semianalytic ARGV`` with its own TMPDIR and HOME, send ``sig`` once
+    ``ready()`` holds (or after ``timeout``), and return (returncode, stderr, tmpdir, work)."""
+    import signal  # noqa: F401 (the caller's sig)
+
+    tmpdir, work, home = tmp_path / "tmp", tmp_path / "work", tmp_path / "home"
+    for d in (tmpdir, work, home):
+        d.mkdir()
+    env = {**os.environ, "TMPDIR": str(tmpdir), "HOME": str(home), "PYTHONPATH": str(ROOT), "MPLBACKEND": "Agg",
+           "OPENBLAS_NUM_THREADS": "1", "SEMIANALYTIC_CACHE_DIR": os.environ.get("SEMIANALYTIC_CACHE_DIR")
+           or str(tmp_path / "cache")}
+    env.pop("MPLCONFIGDIR", None)
+    env.pop("XDG_CACHE_HOME", None)
+    proc = subprocess.Popen([sys.executable, "-m", "semianalytic", *map(str, argv)], cwd=work, env=env,
+                            stdout=subprocess.DEVNULL, stderr=subprocess.PIPE, text=True)
+    deadline = time.monotonic() + timeout
+    while time.monotonic() < deadline and proc.poll() is None and not ready(work):
+        time.sleep(0.2)
+    proc.send_signal(sig)
+    try:
+        _, err = proc.communicate(timeout=90)
+    except subprocess.TimeoutExpired:
+        proc.kill()
+        _, err = proc.communicate()
+        raise
+    return proc.returncode, err, tmpdir, work, home
+
+
+@pytest.mark.long
+@pytest.mark.parametrize("which", ["sweep", "calibrate"])
+@pytest.mark.parametrize("signame", ["SIGTERM", "SIGINT"])
+def test_signals_leave_no_temporary_file_and_no_traceback(tmp_path, which, signame):
+    import signal
+
+    argv, ready = {
+        # a resumable sweep on a local dask cluster, stopped once its first cases are written
+        "sweep": (["sweep", FIG15A, "--out", "out", "--samples", "4000", "--scheduler", "local", "--no-progress",
+                   "--sample", "target.density=normal(2710 kg/m^3, 20 kg/m^3)", "--batch-size", "200"],
+                  lambda w: (w / "out" / "results.csv").exists()),
+        # the sampler running (its staging folder made)
+        "calibrate": (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", "out", "--steps", "5000",
+                       "--quiet"], lambda w: any(p.name.startswith(".out.") for p in w.iterdir())),
+    }[which]
+    rc, err, tmpdir, work, home = _signalled(tmp_path, argv, getattr(signal, signame), ready)
+    assert rc == 1, err
+    assert "Traceback" not in err and len(err.strip().splitlines()) == 1 and err.startswith("interrupted"), err
+    assert not list(tmpdir.rglob("*")), sorted(map(str, tmpdir.rglob("*")))  # no dask-scratch-space, no cc*.s
+    left = sorted(p.relative_to(work).as_posix() for p in work.rglob("*"))
+    if which == "sweep":  # the finished cases kept for --resume, nothing else (no .tmp beside them)
+        assert set(left) <= {"out", "out/results.csv", "out/sweep.json"}, left
+    else:
+        assert left == [], left
+    assert not list(home.rglob("*")), sorted(map(str, home.rglob("*")))  # nothing in $HOME
+
+
+@pytest.mark.long
+def test_calibrate_writes_nothing_into_home(tmp_path):
+    """matplotlib's font cache and arviz's daily_warning stay out of $HOME (no option asked for
+    them); the report's figures are still made."""
+    home, work = tmp_path / "home", tmp_path / "work"
+    home.mkdir()
+    work.mkdir()
+    env = {k: v for k, v in os.environ.items() if k not in ("MPLCONFIGDIR", "XDG_CACHE_HOME", "XDG_CONFIG_HOME")}
+    env.update(HOME=str(home), PYTHONPATH=str(ROOT), MPLBACKEND="Agg", OPENBLAS_NUM_THREADS="1",
+               SEMIANALYTIC_CACHE_DIR=str(tmp_path / "cache"))
+    proc = subprocess.run([sys.executable, "-m", "semianalytic", "calibrate",
+                           str(ROOT / "cases" / "piekutowski1999_var4340.toml"), "--out", "out", "--steps", "60",
+                           "--quiet"], cwd=work, env=env, capture_output=True, text=True, timeout=600)
+    assert proc.returncode == 0, proc.stderr
+    assert list((work / "out").glob("*.png"))
+    assert not list(home.rglob("*")), sorted(map(str, home.rglob("*")))
+    assert (tmp_path / "cache" / "matplotlib").is_dir()  # the font cache: in this project's per-user cache
+
+
+def test_matplotlib_config_of_the_user_is_kept(tmp_path, monkeypatch):
+    from semianalytic import thirdparty
+
+    monkeypatch.delenv("MPLCONFIGDIR", raising=False)
+    monkeypatch.setenv("XDG_CONFIG_HOME", str(tmp_path / "cfg"))
+    monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
+    monkeypatch.delitem(sys.modules, "matplotlib", raising=False)
+    (tmp_path / "cfg" / "matplotlib").mkdir(parents=True)
+    (tmp_path / "cfg" / "matplotlib" / "matplotlibrc").write_text("figure.dpi: 80\n")
+    assert thirdparty.keep_caches_out_of_home() is None and "MPLCONFIGDIR" not in os.environ  # theirs
+    (tmp_path / "cfg" / "matplotlib" / "matplotlibrc").unlink()
+    assert thirdparty.keep_caches_out_of_home() == str(tmp_path / "cache" / "matplotlib")  # ours
+    monkeypatch.setenv("MPLCONFIGDIR", str(tmp_path / "mine"))
+    assert thirdparty.keep_caches_out_of_home() is None and os.environ["MPLCONFIGDIR"] == str(tmp_path / "mine")
+
+
+# ------------------------------------------------------------------------------------------
+# smaller findings
+
+
+def test_bare_command_prints_one_line():
+    for package in ("semianalytic", "fem_check"):
+        proc = subprocess.run([sys.executable, "-m", package], capture_output=True, text=True, timeout=60,
+                              env={**os.environ, "PYTHONPATH": str(ROOT)})
+        assert proc.returncode == 2 and proc.stdout == "", proc.stdout
+        assert len(proc.stderr.strip().splitlines()) == 1 and proc.stderr.startswith("error: command"), proc.stderr
