@@ -29,7 +29,7 @@ import numpy as np
 
 from semianalytic.case import Case, load_case, parse_case
 from semianalytic.errors import InputError
-from semianalytic.io import atomic_write_json
+from semianalytic.io import atomic_write_json, deferred_interrupts
 from semianalytic.sweep.kernels import Kernel, select_kernel
 from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
 from semianalytic.sweep.store import Columns, ResultStore, results_path
@@ -473,33 +473,6 @@ def probe_scheduler(address: str, connect_seconds: float = PROBE_CONNECT_SECONDS
                                         f"({data[:16]!r}, not dask's frame header)")
 
 
-class _deferred_interrupts:
-    """SIGINT and SIGTERM noted, not raised, inside the block (a dask cluster interrupted half-way
-    through its start prints tracebacks from its own cleanup); the list it yields holds the name of
-    a signal that came.  Only in the main thread."""
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        self.got, self.old = [], {}
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                try:
-                    self.old[sig] = signal.signal(sig, lambda signum, frame: self.got.append(
-                        "Ctrl-C" if signum == signal.SIGINT else f"signal {signal.Signals(signum).name}"))
-                except (ValueError, OSError):
-                    pass
-        return self.got
-
-    def __exit__(self, *exc):
-        import signal
-
-        for sig, handler in self.old.items():
-            signal.signal(sig, handler)
-        return False
-
-
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address, or of the one a scheduler file names
@@ -532,7 +505,7 @@ def connect(scheduler: str | None, workers: int):
         environ.update(DASK_TEMPORARY_DIRECTORY=scratch)
         config = {"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False,
                   "temporary-directory": scratch}
-        with dask.config.set(config), _deferred_interrupts() as interrupted:
+        with dask.config.set(config), deferred_interrupts() as interrupted:
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
                 silence_logs=logging.CRITICAL, local_directory=scratch,
