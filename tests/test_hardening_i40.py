@@ -86,7 +86,7 @@ def _sweep_at(capsys, tmp_path, address):
     (b"SSH-2.0-OpenSSH_9.6\r\n", "not a dask scheduler"),  # other bytes: dask read a 3 EiB frame length
     (None, "sent no dask handshake"),  # an HTTP server waits for a request: dask hung past 120 s
     (b"", "sent no dask handshake"),  # accepts, says nothing (b"" sends nothing either)
-])
+], ids=["ssh-banner", "http-like-silent", "empty-reply"])
 def test_a_peer_that_is_not_dask_is_named_within_seconds(tmp_path, capsys, reply, says):
     server = _Server(reply)
     try:
