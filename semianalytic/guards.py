@@ -447,13 +447,15 @@ def check_table_time(case, need_bytes: float, depths: int | None = None) -> floa
     hint = "make the nose less slender, give fewer points or a lower refinement (or raise the time budget)"
     n_depths = depths if depths is not None else getattr(case.coefficients, "depths", None)
     if n_depths:
+        adaptive = seconds
         seconds *= n_depths / ADAPTIVE_DEPTHS
-        if seconds > time_limit():
+        # the depth count is named when it is what breaks the budget (more depths than an adaptive
+        # table, which would fit); otherwise the key that shapes the nose
+        if seconds > time_limit() and n_depths > ADAPTIVE_DEPTHS and adaptive <= time_limit():
             field = "--depths" if depths is not None else "coefficients.depths"
             fit = int(time_limit() / (unknowns2 * TABLE_SECONDS_PER_UNKNOWN2 / ADAPTIVE_DEPTHS))
             hint = (f"use fewer depths (at most about {fit} fit; the adaptive table, without a depth count, uses "
-                    f"about {ADAPTIVE_DEPTHS}) or a lower refinement or order (or raise the time budget)" if fit >= 8 else
-                    "use a lower refinement or order (or raise the time budget)")
+                    f"about {ADAPTIVE_DEPTHS}) or a lower refinement or order (or raise the time budget)")
     check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(unknowns2):.3g} unknowns"
                       f"{f' at {n_depths} depths' if n_depths else ''})", seconds=seconds, hint=hint)
     return need_bytes
