@@ -97,53 +97,6 @@ def interrupt_on_termination():
     return restore
 
 
-class deferred_interrupts:
-    """SIGINT and SIGTERM noted, not raised, inside the block; the list it yields holds the name of
-    the signal that came ("Ctrl-C", "signal SIGTERM"), for the caller to raise KeyboardInterrupt
-    where it is safe: outside a library that catches every exception and prints its traceback
-    (emcee's likelihood wrapper) or cleans up half-made state noisily (a dask cluster starting).
-    Only in the main thread; elsewhere a no-op."""
-
-    def __enter__(self):
-        import signal
-        import threading
-
-        self.got, self.old = [], {}
-        if threading.current_thread() is threading.main_thread():
-            for sig in (signal.SIGINT, signal.SIGTERM):
-                try:
-                    self.old[sig] = signal.signal(sig, self._note)
-                except (ValueError, OSError):
-                    pass
-        return self.got
-
-    def _note(self, signum, frame):
-        import signal
-
-        self.got.append("Ctrl-C" if signum == signal.SIGINT else f"signal {signal.Signals(signum).name}")
-
-    def __exit__(self, *exc):
-        import signal
-
-        for sig, handler in self.old.items():
-            signal.signal(sig, handler)
-        return False
-
-
-def run_mcmc(sampler, p0, steps: int, **kwargs):
-    """``sampler.run_mcmc(p0, steps, **kwargs)`` of emcee, step by step, with Ctrl-C and SIGTERM
-    raised between steps (KeyboardInterrupt, one line from the dispatcher): raised inside the
-    likelihood, emcee's wrapper printed its own traceback first (issue 40)."""
-    state = None
-    with deferred_interrupts() as got:
-        for state in sampler.sample(p0, iterations=steps, **kwargs):
-            if got:
-                break
-    if got:
-        raise KeyboardInterrupt(got[0])
-    return state
-
-
 def check_file_target(path: str | os.PathLike, field: str, inputs=()) -> Path:
     """Refuse (issue 40), before anything is written, an output file that is one of ``inputs``
     (the case files of the same command line: ``penetrate CASE --csv CASE --force`` would

@@ -444,7 +444,7 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
     arviz.from_emcee reads an ensemble), after ``burn`` steps."""
     import emcee
 
-    from semianalytic.io import run_mcmc
+    from semianalytic.thirdparty import run_mcmc
 
     from semianalytic.calibration.sampler import MOVES, chain_diagnostics
 

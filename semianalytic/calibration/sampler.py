@@ -182,7 +182,7 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
     a point in u near the mode (e.g. the full-data mode for a leave-one-out refit)."""
     import emcee
 
-    from semianalytic.io import run_mcmc
+    from semianalytic.thirdparty import run_mcmc
 
     rng = np.random.default_rng(seed)
     if start is not None and np.isfinite(problem.log_prob(np.asarray(start)[None, :])[0]):

@@ -29,7 +29,8 @@ import numpy as np
 
 from semianalytic.case import Case, load_case, parse_case
 from semianalytic.errors import InputError
-from semianalytic.io import atomic_write_json, deferred_interrupts
+from semianalytic.io import atomic_write_json
+from semianalytic.thirdparty import deferred_interrupts
 from semianalytic.sweep.kernels import Kernel, select_kernel
 from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
 from semianalytic.sweep.store import Columns, ResultStore, results_path
