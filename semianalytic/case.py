@@ -47,6 +47,7 @@ __all__ = [
 
 LengthUnit = Literal["m", "cm", "mm", "um"]
 _UNIT_SCALE = {"m": 1.0, "cm": 1e-2, "mm": 1e-3, "um": 1e-6}
+MAX_DYNAMIC_FACTOR = 5.0  # projectile.dynamic_factor: above it no metal's rate sensitivity (issue 40)
 
 
 class BodySection(Section):
@@ -147,6 +148,10 @@ class ProjectileSection(Section):
             f = data.get("dynamic_factor", DEFAULT_DYNAMIC_FACTOR)
             if isinstance(f, bool) or not isinstance(f, (int, float)):
                 raise InputError("projectile.dynamic_factor", f"must be a number >= 1 (dimensionless); got {f!r}")
+            if not 1.0 <= float(f) <= MAX_DYNAMIC_FACTOR:  # the key the user wrote, not the yield_stress it makes
+                raise InputError("projectile.dynamic_factor", f"must lie in [1, {MAX_DYNAMIC_FACTOR:g}] (dynamic / static "
+                                 "yield stress: the regimes calibration finds 1.40-1.53 with a prior of 1-3, "
+                                 f"reports/validation_regimes.md; above 5 is no metal's rate sensitivity); got {f!r}")
             data = dict(data, yield_stress=f"{float(dynamic_yield_stress(parse_hardness(data['hardness']), float(f))):.9g} Pa")
         return data
 

@@ -61,13 +61,33 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
     if argv and argv[0] == "--version":
         print(version_text(prog))
         return 0
-    if not argv or argv[0] in ("-h", "--help"):
+    if not argv:  # exit status 2 is one line naming the field (issue 40): the command list is --help's
+        example = "demo" if "demo" in commands else next(iter(commands))
+        print(f"error: command: missing; give one, e.g. {prog} {example} (the commands: {prog} --help)", file=sys.stderr)
+        return 2
+    if argv[0] in ("-h", "--help"):
         width = max(len(n) for n in commands)
         lines = [*start_here, *([""] if start_here else []), f"usage: {prog} [--version] COMMAND [options]", "", "commands:"]
         lines += [f"  {name:<{width}}  {help_}" for name, (_, help_) in commands.items()]
-        print("\n".join(lines))
-        return 0 if argv else 2
+        try:
+            print("\n".join(lines))
+        except BrokenPipeError:  # `--help | head`: the reader went away
+            os.dup2(os.open(os.devnull, os.O_WRONLY), sys.stdout.fileno())
+        return 0
     name, rest = argv[0], argv[1:]
+    from semianalytic.thirdparty import keep_caches_out_of_home
+
+    # matplotlib's font cache in this project's per-user cache, not ~/.cache (issue 40); for this command
+    # (and the processes it starts) only: tests call main() repeatedly
+    mpl_set = keep_caches_out_of_home()
+    try:
+        return _dispatch_command(prog, commands, name, rest)
+    finally:
+        if mpl_set is not None and os.environ.get("MPLCONFIGDIR") == mpl_set:
+            del os.environ["MPLCONFIGDIR"]
+
+
+def _dispatch_command(prog: str, commands: dict[str, tuple[str, str]], name: str, rest: list[str]) -> int:
     if name not in commands:
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2

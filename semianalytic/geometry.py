@@ -133,8 +133,10 @@ class SplineCurve:
     def _between_knots(self) -> tuple["SplineCurve", ...]:
         k = self.knots
         pieces = tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
+        table = self._scalar_table  # one copy of the coefficients for all pieces (a copy per piece: n^2)
         for p in pieces:
             p.__dict__["_splines"] = self._splines  # same curve: share the fitted splines
+            p.__dict__["_scalar_table"] = table
         return pieces
 
     @cached_property

@@ -117,6 +117,24 @@ def _arithmetic_unknowns(nose, order: int, refinement: float, max_depth_nose_len
     return order * (estimate + shank)
 
 
+def _least_unknowns(nose, order: int) -> tuple[float, int]:
+    """A lower bound of the primary unknowns of the deepest half-space layout, by counting only
+    (no layout built): :func:`semianalytic.bem.panels.halfspace_layout` lays at least one panel
+    per interval between a table spline's knots (it cuts the spline there) and at least two on
+    every other segment, and at least one on the shank.  Returns (unknowns, knot intervals)."""
+    from semianalytic.geometry import SplineCurve
+
+    panels, intervals = 1.0, 0
+    for seg in nose.segments:
+        if isinstance(seg, SplineCurve):
+            k = max(len(seg.knots) - 1, 1)
+            intervals += k
+            panels += k
+        else:
+            panels += 2
+    return order * panels, intervals
+
+
 def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_depth_nose_lengths: float = 300.0,
                            levels: int = 12) -> float:
     """Primary unknowns N of the largest half-space layout of ``nose`` (order x panels): the
@@ -194,7 +212,7 @@ def _refuse(field: str, what: str, need: float, limit: float, hint: str) -> None
 
 def check_coefficients(case, order: int | None = None, refinement: float | None = None,
                        max_depth: float | None = None, *, default_refinement: float = 0.3,
-                       option_prefix: str = "bem") -> float:
+                       option_prefix: str = "bem", depths: int | None = None) -> float:
     """Refuse a coefficient table (or a half-space solve) of the case's ``[projectile]`` that
     does not fit; returns the estimated bytes.  The field named is the one that drives the size:
     the refinement or order when they were raised, else the nose shape (``crh`` of an ogive,
@@ -217,10 +235,11 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
     # needed (building the deepest layout costs most of a second).
     rough = _arithmetic_unknowns(nose, order, ref, depth)
     if math.isfinite(rough) and bem_bytes(4.0 * rough) <= limit:
-        return check_table_time(case, bem_bytes(rough))
+        return check_table_time(case, bem_bytes(rough), depths)
+    _refuse_by_least_unknowns(case, nose, order, limit, order_given=order != case.bem.order)
     need = need_for(nose)
     if need <= limit:
-        return check_table_time(case, need)
+        return check_table_time(case, need, depths)
     what = f"the BEM solve of the {nose.kind} nose (~{bem_halfspace_unknowns(nose, order, ref, depth):.3g} unknowns)"
     if ref > default_refinement and need_for(nose, r=default_refinement) <= limit:
         best = _largest(lambda r: need_for(nose, r=r) <= limit, default_refinement, ref)
@@ -246,6 +265,27 @@ def check_coefficients(case, order: int | None = None, refinement: float | None 
                                                                "the tip) or lower the refinement")
     _refuse(shape_field(psec.nose), what, need, limit, "make the nose less slender or lower the refinement")
     return need
+
+
+def _refuse_by_least_unknowns(case, nose, order: int, limit: float, *, order_given: bool) -> None:
+    """Refuse, before any panel plan is built, a nose whose lower bound of unknowns
+    (:func:`_least_unknowns`) already exceeds the budget: a table nose of thousands of points
+    (each knot interval is a panel; building the real plan of 10 000 of them takes seconds)."""
+    least, intervals = _least_unknowns(nose, order)
+    need = bem_bytes(least)
+    if need <= limit:
+        return
+    what = f"the BEM solve of the {nose.kind} nose (at least {least:.3g} unknowns"
+    what += f": {intervals} point intervals x order {order})" if intervals else ")"
+    if order_given and order > 2 and bem_bytes(_least_unknowns(nose, 2)[0]) <= limit:
+        best = max(o for o in range(2, order) if bem_bytes(_least_unknowns(nose, o)[0]) <= limit)
+        _refuse("--order", what, need, limit, f"the largest order that could fit is {best}")
+    if case.projectile.nose == "table":
+        fit = int(math.sqrt(limit / BEM_BYTES_PER_UNKNOWN2) / order) - 1
+        _refuse("projectile.points", what, need, limit,
+                f"use fewer points ({len(case.projectile.points)} given, at most about {max(fit, 2)} could fit at "
+                f"order {order}; a few dozen describe a smooth nose)")
+    _refuse(shape_field(case.projectile.nose), what, need, limit, "make the nose less slender or lower the order")
 
 
 def check_body(case, order: int | None = None, refinement: float | None = None) -> float:
@@ -289,6 +329,31 @@ def check_field_grid(case) -> float:
         _refuse("run.field_segments", what, need, limit, f"the largest field_segments that fits is {best}")
     _refuse("run.field_grid", what, need, limit, "use fewer nodes (the default is [49, 25])")
     return need
+
+
+# The velocity field of ``run``: the BEM gradient at every node of the meridian grid (2 nx x nr
+# nodes per depth) sums over the N unknowns: 6.3e-7 s per node and unknown measured (fig13 ogive,
+# N ~ 380, grid 61 x 31 -> 201 x 101: 8.8 s more CPU for 36 800 more nodes, load 4; the CPU time
+# is what an idle core takes); 6e-7 is taken.
+FIELD_SECONDS_PER_NODE_UNKNOWN = 6e-7
+
+
+def check_field_time(case, unknowns: float) -> float:
+    """Refuse a ``[run]`` velocity field whose BEM evaluation at the grid's nodes would run past
+    the time budget; returns the estimated seconds."""
+    run = case.section("run")
+    if run is None or (run.analyses is not None and "velocity_field" not in run.analyses):
+        return 0.0
+    nx, nr = run.field_grid
+    depths = len(run.field_depths or [None])
+    seconds = depths * 2 * nx * nr * unknowns * FIELD_SECONDS_PER_NODE_UNKNOWN
+    per_grid = seconds / (nx * nr)
+    fit = int(time_limit() / per_grid) if per_grid > 0 else 0
+    check_work("run.field_grid", f"the velocity field ({depths} depth(s) x {2 * nx} x {nr} nodes against "
+                                 f"~{unknowns:.3g} BEM unknowns)", seconds=seconds,
+               hint=f"use fewer nodes (the default is [49, 25]; nx x nr at most about {fit} fit) or fewer "
+                    "run.field_depths (or raise the time budget)")
+    return seconds
 
 
 def fem_unknowns(diameter: float, wetted_length: float, far_radius: float, h: float, growth: float = 3.0) -> float:
@@ -343,9 +408,10 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
     if case.projectile is not None:
         check_coefficients(case, order, refinement, max_depth)
         if field and case.section("run") is not None:
-            check_coefficients(case, order, refinement, 1.0 + 1e-9 + max(
+            need = check_coefficients(case, order, refinement, 1.0 + 1e-9 + max(
                 [d / _depth_unit(case) for d in (case.section("run").field_depths or [])] or [1.0]),
                 default_refinement=1.0)
+            check_field_time(case, math.sqrt(need / BEM_BYTES_PER_UNKNOWN2))
     if case.body is not None:
         check_body(case, order, refinement)
     if field:
@@ -357,6 +423,7 @@ def check_case(case, *, order: int | None = None, refinement: float | None = Non
 # 5e-5 s is taken (an idle core, about twice as fast), so that only what runs past the budget
 # on any core of this kind is refused.
 TABLE_SECONDS_PER_UNKNOWN2 = 5e-5
+ADAPTIVE_DEPTHS = 70  # depths of an adaptive table, to which the time above refers
 
 
 SHAPE_FIELDS = {"ogive": "projectile.crh", "cone": "projectile.half_angle", "table": "projectile.points",
@@ -368,15 +435,29 @@ def shape_field(nose: str) -> str:
     return SHAPE_FIELDS.get(nose, "projectile")
 
 
-def check_table_time(case, need_bytes: float) -> float:
+def check_table_time(case, need_bytes: float, depths: int | None = None) -> float:
     """Refuse a coefficient table whose estimated time exceeds the time budget (issue 27); its
-    size is the BEM guard's (bytes = BEM_BYTES_PER_UNKNOWN2 N^2).  Returns ``need_bytes``."""
-    seconds = need_bytes / BEM_BYTES_PER_UNKNOWN2 * TABLE_SECONDS_PER_UNKNOWN2
+    size is the BEM guard's (bytes = BEM_BYTES_PER_UNKNOWN2 N^2).  A fixed grid of ``depths``
+    depths (``--depths``, ``coefficients.depths``) costs ``depths / ADAPTIVE_DEPTHS`` adaptive
+    tables.  Returns ``need_bytes``."""
+    unknowns2 = need_bytes / BEM_BYTES_PER_UNKNOWN2
+    seconds = unknowns2 * TABLE_SECONDS_PER_UNKNOWN2
     psec = case.projectile
     field = shape_field(psec.nose)
-    check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(need_bytes / BEM_BYTES_PER_UNKNOWN2):.3g}"
-                      " unknowns)", seconds=seconds,
-               hint="make the nose less slender, give fewer points or a lower refinement (or raise the time budget)")
+    hint = "make the nose less slender, give fewer points or a lower refinement (or raise the time budget)"
+    n_depths = depths if depths is not None else getattr(case.coefficients, "depths", None)
+    if n_depths:
+        adaptive = seconds
+        seconds *= n_depths / ADAPTIVE_DEPTHS
+        # the depth count is named when it is what breaks the budget (more depths than an adaptive
+        # table, which would fit); otherwise the key that shapes the nose
+        if seconds > time_limit() and n_depths > ADAPTIVE_DEPTHS and adaptive <= time_limit():
+            field = "--depths" if depths is not None else "coefficients.depths"
+            fit = int(time_limit() / (unknowns2 * TABLE_SECONDS_PER_UNKNOWN2 / ADAPTIVE_DEPTHS))
+            hint = (f"use fewer depths (at most about {fit} fit; the adaptive table, without a depth count, uses "
+                    f"about {ADAPTIVE_DEPTHS}) or a lower refinement or order (or raise the time budget)")
+    check_work(field, f"the coefficient table of the {psec.nose} nose (~{math.sqrt(unknowns2):.3g} unknowns"
+                      f"{f' at {n_depths} depths' if n_depths else ''})", seconds=seconds, hint=hint)
     return need_bytes
 
 
@@ -396,7 +477,11 @@ DEFAULT_TIME_LIMIT = 600.0  # s: 10 minutes
 TIME_ENV = "SEMIANALYTIC_TIME_LIMIT"
 # seconds per unit of work, lower bounds measured on this project's machine (2 cores, loaded):
 DESIGN_SECONDS = 1.0  # one optimiser design: one BEM coefficient table (sweep.engine.GEOMETRY_SECONDS)
-LIKELIHOOD_SECONDS = 2e-5  # one emcee log-posterior evaluation over a few dozen shots
+# one emcee log-posterior evaluation over a few dozen shots: 2.7e-4 s measured per walker, step and
+# model on the bundled Piekutowski cases (calibrate --steps 500 vs 2500, 34.5 s CPU for 128 000
+# evaluations, load 2.4; the regimes model the same, 1200 steps x 32 walkers in 10.4 s; CPU times,
+# what an idle core takes); 2.5e-4 is taken
+LIKELIHOOD_SECONDS = 2.5e-4
 SWEEP_CASE_SECONDS = 1e-6  # one vectorised sweep case (a few microseconds)
 # bytes each unit keeps until the end:
 CHAIN_BYTES_PER_DRAW = 8.0  # one float of an emcee chain (per walker, step and parameter + log-prob)
@@ -460,11 +545,12 @@ def check_optimiser(n_variables: int, *, method: str, coarse: int, confirm: int,
     return designs
 
 
-def check_sampler(walkers: int, steps: int, n_parameters: int, n_models: int = 1, field: str = "--steps") -> None:
+def check_sampler(walkers: int, steps: int, n_parameters: int, n_models: int = 1, field: str = "--steps",
+                  seconds_per_draw: float = LIKELIHOOD_SECONDS) -> None:
     """Refuse an emcee run whose chains would not fit in memory or would run past the time budget."""
     draws = float(walkers) * float(steps) * max(n_models, 1)
     check_work(field, f"the sampler ({walkers} walkers x {steps} steps x {n_models} model(s))",
-               seconds=draws * LIKELIHOOD_SECONDS, nbytes=draws * (n_parameters + 2) * CHAIN_BYTES_PER_DRAW * 2,
+               seconds=draws * seconds_per_draw, nbytes=draws * (n_parameters + 2) * CHAIN_BYTES_PER_DRAW * 2,
                hint="lower --steps (the reports use 1000 to 5000)")
 
 

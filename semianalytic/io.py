@@ -97,7 +97,38 @@ def interrupt_on_termination():
     return restore
 
 
-def check_report_target(path: str | os.PathLike, force: bool) -> Path:
+def check_file_target(path: str | os.PathLike, field: str, inputs=()) -> Path:
+    """Refuse (issue 40), before anything is written, an output file that is one of ``inputs``
+    (the case files of the same command line: ``penetrate CASE --csv CASE --force`` would
+    replace the case) or that exists and is not a regular file (a FIFO, a device, a socket:
+    ``--force`` would replace it by a regular file, or block on it).  A symbolic link is judged
+    by what it points to."""
+    path = Path(path)
+    try:
+        st = path.stat() if os.path.lexists(path) else None
+    except OSError as exc:
+        raise InputError(field, f"cannot use {str(path)[:60]!r}: {exc.strerror}") from None
+    if st is None:
+        return path
+    import stat
+
+    if not stat.S_ISREG(st.st_mode):
+        kind = ("a folder" if stat.S_ISDIR(st.st_mode) else "a named pipe (FIFO)" if stat.S_ISFIFO(st.st_mode) else
+                "a device" if stat.S_ISCHR(st.st_mode) or stat.S_ISBLK(st.st_mode) else
+                "a socket" if stat.S_ISSOCK(st.st_mode) else "not a regular file")
+        raise InputError(field, f"{str(path)!r} is {kind}, not a regular file; name a new file")
+    for given in inputs:
+        try:
+            same = os.path.samefile(path, given)
+        except OSError:
+            same = False
+        if same:
+            raise InputError(field, f"{str(path)!r} is the input file {str(given)!r} of this command; "
+                                    "name another file (nothing was written)")
+    return path
+
+
+def check_report_target(path: str | os.PathLike, force: bool, inputs=()) -> Path:
     """A report path that may be written: refuse to overwrite an existing one without force, and
     (issue 27) a report into ``/``, the home folder (or above it) or a folder above the working
     folder (``--report OUT/../../..``)."""
@@ -111,6 +142,7 @@ def check_report_target(path: str | os.PathLike, force: bool) -> Path:
                                          "folder; write reports into a folder of their own")
     except OSError as exc:  # e.g. a name longer than the file system allows
         raise InputError("--report", f"cannot use {str(path)[:60]!r}: {exc.strerror}") from None
+    check_file_target(path, "--report", inputs)
     if exists and not force:
         raise InputError(str(path), "exists; pass --force to overwrite it")
     if exists and not written_by_the_tool(path):

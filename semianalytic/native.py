@@ -110,10 +110,13 @@ def _compile(source: Path, target: Path) -> bool:
     target.parent.mkdir(parents=True, exist_ok=True)
     fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
     os.close(fd)
+    # the compiler's own temporary files (cc*.s, cc*.o) in a folder of ours, removed whatever happens
+    # (issue 40: a compiler killed by Ctrl-C or SIGTERM left them in $TMPDIR)
+    scratch = tempfile.mkdtemp(prefix=f".{target.name}.cc-", dir=target.parent)
     try:
         try:
             proc = subprocess.run([*cmd, *CFLAGS, "-o", tmp, str(source), "-lm"], capture_output=True, text=True,
-                                  timeout=300)
+                                  timeout=300, env={**os.environ, "TMPDIR": scratch})
         except subprocess.SubprocessError as exc:  # a compiler that hangs
             _debug("compiling %s failed (%s): numpy kernels", source.name, exc)
             return False
@@ -126,6 +129,9 @@ def _compile(source: Path, target: Path) -> bool:
     finally:
         if os.path.exists(tmp):
             os.unlink(tmp)
+        import shutil
+
+        shutil.rmtree(scratch, ignore_errors=True)
 
 
 def load_library(source: Path):

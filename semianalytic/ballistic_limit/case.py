@@ -41,7 +41,46 @@ from semianalytic.ballistic_limit.shots import PAPER_PROJECTILE_DENSITY, Layer, 
 from semianalytic.schema import Section
 from semianalytic.units import Density, Length, Mass, Pressure, Velocity, registry
 
-__all__ = ["BallisticLimitSection", "ShotSection", "LayerSection"]
+__all__ = ["BallisticLimitSection", "ShotSection", "LayerSection", "SHOT_RANGES", "check_shot", "check_limits"]
+
+# Plausible ranges of the Part IV inputs (this project's own limits, with their reasons; far wider
+# than Part IV's Tables 2-3, which hold L_p 12-52 mm, m_p 2.3-7.9 g, delta_H 0.35-0.93 and
+# ballistic limits of 280-916 m/s).  Outside: exit status 2 naming the field and the range.
+SHOT_RANGES: dict[str, tuple[float, float, str, str]] = {
+    "projectile_length": (1e-4, 3.0, "m", "0.1 mm (a fragment) to 3 m (three times the longest kinetic-energy "
+                                          "penetrator)"),
+    "projectile_diameter": (1e-4, 0.5, "m", "0.1 mm (a fragment) to 0.5 m (a naval shell)"),
+    "projectile_mass": (1e-6, 1e3, "kg", "1 mg (a fragment) to 1000 kg (a bunker-buster's penetrator)"),
+    "delta_h": (0.1, 1.0, "", "0.1 to 1 (Milman's plasticity characteristic: Part IV, Table 1 spans 0.35 for "
+                              "ceramics to 0.93 for metals; no solid is known below 0.1)"),
+    "measured": (1.0, 12e3, "m/s", "1 m/s (slower than a dropped projectile: not a ballistic test) to 12 km/s "
+                                   "(beyond every model, as for striking velocities)"),
+}
+# alpha = rho_t h_t / (rho_p L_p) of eq. (5): V_cr grows like exp(alpha/2).  Part IV's plates have
+# alpha <= 0.8; at alpha = 10 a rigid rod would need V_cr ~ 150 a (several km/s for any metal), beyond the
+# rigid-projectile model of eq. (2) (the rod erodes above ~1.5 km/s): refused above, with the reason.
+MAX_ALPHA = 10.0
+MAX_BALLISTIC_LIMIT = 12e3  # m/s: a computed V_cr above the striking velocities' bound is refused
+
+
+def _range_problem(key: str, value) -> str | None:
+    bounds = SHOT_RANGES.get("delta_h" if key.endswith("delta_h") or key.endswith("delta_H") else key)
+    if value is None or bounds is None:
+        return None
+    low, high, unit, why = bounds
+    if low <= value <= high:
+        return None
+    return f"{value:.4g}{' ' + unit if unit else ''} lies outside the plausible range {why}"
+
+
+def _check_range(key: str):
+    def validate(v):
+        problem = _range_problem(key, v)
+        if problem:
+            raise ValueError(problem)
+        return v
+
+    return validate
 
 
 def _constant(unit: str, example: str):
@@ -77,6 +116,11 @@ class LayerSection(Section):
     hardness: Pressure
     delta_h: Fraction
 
+    @field_validator("delta_h")
+    @classmethod
+    def _delta_h(cls, v):
+        return _check_range("delta_h")(v)
+
     def to_layer(self) -> Layer:
         return Layer(self.name, self.density, self.thickness, self.hardness, self.delta_h)
 
@@ -100,6 +144,12 @@ class ShotSection(Section):
     resistance: Pressure | None = Field(default=None, description="R(3) given directly instead of Y and E")
     measured: Velocity | None = None
     layers: list[LayerSection] | None = None
+
+    @field_validator("projectile_length", "projectile_diameter", "projectile_mass", "projectile_delta_h",
+                     "target_delta_h", "measured")
+    @classmethod
+    def _plausible_shot(cls, v, info):
+        return _check_range(info.field_name)(v)
 
     @model_validator(mode="after")
     def _target(self):
@@ -163,3 +213,50 @@ class BallisticLimitSection(Section):
     @property
     def constants(self) -> EmpiricalConstants:
         return EmpiricalConstants(self.C1, self.C2, self.C3)
+
+
+_SHOT_FIELDS = {"projectile_length": "projectile_length", "projectile_diameter": "projectile_diameter",
+                "projectile_mass": "projectile_mass", "projectile_delta_H": "projectile_delta_h",
+                "target_delta_H": "target_delta_h", "measured": "measured"}
+
+
+def check_shot(shot: Shot, field: str, row: str = "") -> None:
+    """Refuse a shot (of a table file: ``field`` is ``ballistic_limit.table``, ``row`` names the
+    shot) whose inputs leave :data:`SHOT_RANGES` or whose plate is beyond eq. (5)'s reach
+    (:data:`MAX_ALPHA`); an inline shot's fields are checked by :class:`ShotSection`."""
+    from semianalytic.errors import InputError
+
+    where = f"{row}: " if row else ""
+    for attr, key in _SHOT_FIELDS.items():
+        problem = _range_problem(key, getattr(shot, attr))
+        if problem:
+            raise InputError(field if row else f"{field}.{key}", f"{where}{key} {problem}")
+    for k, layer in enumerate(shot.layers):
+        problem = _range_problem("delta_h", layer.delta_H)
+        if problem:
+            raise InputError(field if row else f"{field}.layers.{k}.delta_h", f"{where}delta_h {problem}")
+    plates = [(layer.density, layer.thickness, f"layers.{k}.thickness") for k, layer in enumerate(shot.layers)] or [
+        (shot.target_density, shot.thickness, "thickness")]
+    rho_p, L_p = shot.projectile_density, shot.projectile_length
+    alpha = sum(rho * h for rho, h, _ in plates if rho and h) / (rho_p * L_p) if rho_p and L_p else 0.0
+    if alpha > MAX_ALPHA:
+        key = plates[-1][2] if len(plates) == 1 else "layers"
+        raise InputError(field if row else f"{field}.{key}",
+                         f"{where}the plate's areal mass is alpha = rho_t h_t/(rho_p L_p) = {alpha:.3g} times the "
+                         f"projectile's, above {MAX_ALPHA:g}: eq. (5) grows like exp(alpha/2) (Part IV's plates have "
+                         "alpha <= 0.8), so no rigid projectile perforates this plate; give a thinner plate or a "
+                         "longer projectile")
+
+
+def check_limits(row: dict, field: str) -> None:
+    """Refuse a shot whose computed ballistic limit (any law) exceeds :data:`MAX_BALLISTIC_LIMIT`:
+    the inputs are beyond every model (the field named is the plate's thickness)."""
+    import math
+
+    from semianalytic.errors import InputError
+
+    for key, value in row.items():
+        if key.startswith("V_") and isinstance(value, float) and math.isfinite(value) and value > MAX_BALLISTIC_LIMIT:
+            raise InputError(field, f"{row['name']}: the ballistic limit {key} = {value:.3g} m/s exceeds "
+                                    f"{MAX_BALLISTIC_LIMIT / 1e3:g} km/s, beyond every model (the projectile would "
+                                    "melt): the plate is too thick or too hard for this projectile")

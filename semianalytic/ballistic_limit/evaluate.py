@@ -26,9 +26,14 @@ def evaluate_case(case) -> dict:
         if not path.is_file():
             raise InputError("ballistic_limit.table", f"file {section.table!r} not found next to the case file")
         shots += load_shots(path)
+    from semianalytic.ballistic_limit.case import check_limits, check_shot
+
+    n_table = len(shots)
     shots += [s.to_shot(section.projectile_density) for s in section.shots]
     rows = []
-    for shot in shots:
+    for k, shot in enumerate(shots):
+        field = "ballistic_limit.table" if k < n_table else f"ballistic_limit.shots.{k - n_table}"
+        check_shot(shot, field, shot.name if k < n_table else "")
         row = {"name": shot.name}
         if shot.measured is not None:
             row["measured_V_m_s"] = shot.measured
@@ -39,6 +44,7 @@ def evaluate_case(case) -> dict:
         crit = [critical_values(shot, v, section.constants) for v in section.critical_velocities]
         if any(crit):
             row["critical"] = [c for c in crit if c]
+        check_limits(row, field if k < n_table else f"{field}.{'layers' if shot.layers else 'thickness'}")
         rows.append(row)
     return {
         "case": case.title,

@@ -26,7 +26,7 @@ def check_outputs_and_load(args):
 
         if not str(args.report).endswith(".md"):
             raise InputError("--report", f"expected a path ending in .md; got {args.report!r}")
-        check_report_target(args.report, args.force)
+        check_report_target(args.report, args.force, inputs=[args.case, *args.transfer])
     case = load_case(args.case)
     for sec in ("projectile", "target", "data"):
         case.require(sec)

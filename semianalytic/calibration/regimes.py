@@ -444,6 +444,8 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
     arviz.from_emcee reads an ensemble), after ``burn`` steps."""
     import emcee
 
+    from semianalytic.thirdparty import run_mcmc
+
     from semianalytic.calibration.sampler import MOVES, chain_diagnostics
 
     rng = np.random.default_rng(seed)
@@ -485,7 +487,7 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
         # has steps in f where a transition crosses a shot, which the stretch move crosses slowly
         sampler = emcee.EnsembleSampler(walkers, len(names), log_prob, vectorize=True, moves=MOVES())
         sampler.random_state = np.random.RandomState(seed + 1000 * c).get_state()
-        sampler.run_mcmc(p0, steps, progress=False)
+        run_mcmc(sampler, p0, steps, progress=False)  # Ctrl-C and SIGTERM between steps (issue 40)
         chains_out.append(sampler.get_chain(discard=burn))  # (steps - burn, walkers, n_par)
     arr = np.concatenate([np.swapaxes(ch, 0, 1) for ch in chains_out])  # (chains x walkers, draws, n_par)
     nat = arr.copy()

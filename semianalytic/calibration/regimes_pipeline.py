@@ -34,6 +34,9 @@ def run_regimes(args, command: str) -> dict:
         raise InputError("--steps", f"must be at least 200 with --model regimes; got {args.steps}")
     if args.transfer and not args.cross_validate:
         raise InputError("--transfer", "is used only with --cross-validate")
+    from semianalytic.guards import check_sampler
+
+    check_sampler(32, args.steps or 4500, 4, 1)  # sample_regimes: 4 chains x 8 walkers; refused before any work
     case = check_outputs_and_load(args)
     others = []
     for p in args.transfer:

@@ -182,6 +182,8 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
     a point in u near the mode (e.g. the full-data mode for a leave-one-out refit)."""
     import emcee
 
+    from semianalytic.thirdparty import run_mcmc
+
     rng = np.random.default_rng(seed)
     if start is not None and np.isfinite(problem.log_prob(np.asarray(start)[None, :])[0]):
         from scipy.optimize import minimize
@@ -202,8 +204,8 @@ def sample_posterior(problem: Problem, *, walkers: int = 32, steps: int = 2000, 
     for c in range(CHAINS):
         sampler = emcee.EnsembleSampler(per, ndim, problem.log_prob, vectorize=True)
         sampler.random_state = np.random.RandomState(seed + 7919 * c).get_state()
-        sampler.run_mcmc(p0[c * per:(c + 1) * per], steps, progress=progress,
-                         progress_kwargs={"desc": f"sampling {problem.surrogate.model} ({c + 1}/{CHAINS})", "leave": False})
+        run_mcmc(sampler, p0[c * per:(c + 1) * per], steps, progress=progress,  # Ctrl-C between steps (issue 40)
+                 progress_kwargs={"desc": f"sampling {problem.surrogate.model} ({c + 1}/{CHAINS})", "leave": False})
         chains.append(sampler.get_chain(discard=burn))  # (steps - burn, per, ndim)
         taus.append(np.asarray(sampler.get_autocorr_time(discard=burn, tol=0, quiet=True), float))
         acc.append(float(np.mean(sampler.acceptance_fraction)))
@@ -252,7 +254,9 @@ def chain_diagnostics(chains, names) -> dict:
 
     with _w.catch_warnings():
         _w.simplefilter("ignore")
-        import arviz as az
+        from semianalytic.thirdparty import import_arviz
+
+        az = import_arviz()  # no stamp file in ~/.cache (issue 40)
 
         chains = np.asarray(chains, float)
         out, warn = {}, []

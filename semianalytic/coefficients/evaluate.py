@@ -168,7 +168,7 @@ def projectile_output(case, *, at=None, interpolated=False, reading=None, depths
     from semianalytic.geometry import nose_from_section
     from semianalytic.guards import check_coefficients
 
-    check_coefficients(case, order, refinement, max_depth)  # refuse what would not fit in memory
+    check_coefficients(case, order, refinement, max_depth, depths=depths)  # refuse what would not fit in memory or time
     nose = nose_from_section(case.projectile)
     reading = reading or case.coefficients.reading
     n_depths = depths or case.coefficients.depths

@@ -84,7 +84,7 @@ class CrystalSpec(Section):
 
 # Issue 27 (this project's own bounds): the largest bar and basis a study may name.  The
 # report's largest are l = 1200 and m = n = 2500.
-MAX_PLANES = 2000
+MAX_PLANES = 2040
 MAX_MN = 10**9
 
 

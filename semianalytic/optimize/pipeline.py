@@ -70,7 +70,7 @@ def optimize_case(case_path: str | None, vary: list[str], objective: str = "dept
     if out is not None:
         check_output_dir(out, force, protect=(case_path,) if case_path else ())
     if report is not None:
-        check_report_target(report, force)
+        check_report_target(report, force, inputs=[case_path] if case_path else [])
     cache_dir = str(table_dir(cache_dir))
     sched = scheduler or ("local" if workers > 1 else "inline")
     client, cluster, name = connect(sched, workers)

@@ -244,11 +244,11 @@ def run(args) -> int:
     if args.csv is not None:
         from semianalytic.penetration.table_out import check_csv_target
 
-        check_csv_target(args.csv, args.force)
+        check_csv_target(args.csv, args.force, inputs=args.cases)
     if args.report is not None:
         from semianalytic.penetration.report import report_path
 
-        check_report_target(report_path(args.report, cases, args.report_name), args.force)
+        check_report_target(report_path(args.report, cases, args.report_name), args.force, inputs=args.cases)
     results, descs = [], []
     for case in cases:
         coefficients, desc, fallback = coefficients_for_case(case, args.coefficients, args.cache_dir)

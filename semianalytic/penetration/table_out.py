@@ -66,19 +66,32 @@ def depth_csv(results: list[tuple[str, dict]]) -> str:
     return buf.getvalue()
 
 
-def check_csv_target(path: str, force: bool) -> None:
+def check_csv_target(path: str, force: bool, inputs=()) -> None:
     """Refuse ``--csv FILE`` before any work: an existing file without ``--force``, a folder,
-    or a folder that cannot be written."""
+    one of the command's input files, a FIFO or device (issue 40), an existing file that this
+    tool did not write (its first line is not :data:`CSV_HEADER`), or a folder that cannot be
+    written."""
     import os
     from pathlib import Path
 
     from semianalytic.errors import InputError
+    from semianalytic.io import check_file_target
 
     p = Path(path)
     if p.is_dir():
         raise InputError("--csv", f"{path!r} is a folder; expected a file name such as depths.csv")
+    check_file_target(p, "--csv", inputs)
     if p.exists() and not force:
         raise InputError("--csv", f"{path!r} exists; pass --force to overwrite it")
+    if p.exists():
+        try:
+            with p.open("rb") as fh:
+                first = fh.readline(4096).decode("utf-8", "replace").strip()
+        except OSError as exc:
+            raise InputError("--csv", f"cannot read {path!r}: {exc.strerror}") from None
+        if next(csv.reader([first]), None) != CSV_HEADER:
+            raise InputError("--csv", f"{path!r} exists and was not written by this tool (its first line is not "
+                                      "the depth table's header): --force replaces only the tool's own CSV files")
     parent = p.absolute().parent
     while not parent.exists() and parent != parent.parent:
         parent = parent.parent

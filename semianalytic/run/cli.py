@@ -40,7 +40,7 @@ def run(args: argparse.Namespace) -> int:
     if args.csv is not None:
         from semianalytic.penetration.table_out import check_csv_target
 
-        check_csv_target(args.csv, args.force)
+        check_csv_target(args.csv, args.force, inputs=[args.case])
     out = Path(args.out)
     results = run_case(
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir,

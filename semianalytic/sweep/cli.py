@@ -99,6 +99,10 @@ def sweep_case(case_path: str, out: str, vary: list[str] = (), sample: list[str]
         raise InputError("--samples", "must not be negative")
     if scheduler is not None and not scheduler.strip():
         raise InputError("--scheduler", "empty; give 'inline', 'local' or a dask scheduler address (host:port)")
+    if scheduler is not None and scheduler.strip() not in ("inline", "local") and not scheduler.strip().endswith(".json"):
+        from semianalytic.sweep.engine import probe_scheduler
+
+        probe_scheduler(scheduler)  # a non-dask peer named up front, within seconds (issue 40)
     spec = build_spec(vary, sample, samples, seed)
     case = load_case(case_path)
     check_axes(case, spec)
@@ -142,33 +146,43 @@ def sweep_kernel(case, analysis, cache_dir, full):
 
 
 def check_axes(case, spec) -> None:
-    """Refuse (exit status 2) an axis whose every value the case rejects for that key, e.g.
-    ``impact.striking_velocity=400:500:10 kg`` (a mass where a velocity belongs): checked at
-    the first and the last value of each axis, before any worker starts."""
+    """Refuse (exit status 2) a sweep with a value the case rejects, before any worker starts:
+    every axis at its smallest and largest value, every sample at the ends of its support
+    (:meth:`semianalytic.sweep.spec.Sampler.support`: a lognormal whose draws leave the physical
+    range of the quantity is refused, issue 40).  An axis whose every value is rejected is named
+    by the case key (e.g. ``impact.striking_velocity=400:500:10 kg``, a mass where a velocity
+    belongs); one bad value names the option and the value."""
     from semianalytic.case import parse_case
     from semianalytic.sweep.kernels import changes_table
     from semianalytic.sweep.spec import VELOCITY_KEY, apply_overrides, raw_value
 
-    for axis in spec.axes:
-        target = "impact.striking_velocities" if axis.key == VELOCITY_KEY else axis.key
+    probes = [(f"--vary {a.key}", a.key, a.unit, a.integer, sorted({min(a.values), max(a.values)}), True)
+              for a in spec.axes]
+    probes += [(f"--sample {s.key}", s.key, s.unit, False, list(s.support()), False) for s in spec.samplers]
+    for option, key, unit, integer, values, axis in probes:
+        target = "impact.striking_velocities" if key == VELOCITY_KEY else key
         errors = []
-        for value in {axis.values[0], axis.values[-1]}:
+        for value in values:
             try:
-                varied = parse_case(apply_overrides(case.raw, {axis.key: raw_value(value, axis.unit, axis.integer)}),
-                                    case.path)
-                if changes_table(axis.key):  # the BEM table of the first and last geometry fits
+                varied = parse_case(apply_overrides(case.raw, {key: raw_value(value, unit, integer)}), case.path)
+                if changes_table(key):  # the BEM table of the first and last geometry fits
                     from semianalytic.guards import check_case
 
                     try:
                         check_case(varied)
                     except InputError as exc:
-                        raise InputError(f"--vary {axis.key}", f"the value {value:g}: {exc}") from None
+                        raise InputError(option, f"the value {value:g}: {exc}") from None
             except InputError as exc:
-                if exc.field.startswith("--vary"):
+                if exc.field.startswith(("--vary", "--sample")):
                     raise
                 if exc.field == target or exc.field.startswith(target + "."):
-                    errors.append(exc)
+                    errors.append((value, exc))
                     continue
-            break
-        else:
-            raise InputError(errors[0].field, f"{errors[0].message} (every value from --vary {axis.key})")
+        if not errors:
+            continue
+        if axis and len(errors) == len(values):
+            raise InputError(errors[0][1].field, f"{errors[0][1].message} (every value from {option})")
+        value, exc = errors[0]
+        shown = f"{value:.4g} {unit}".strip()
+        raise InputError(exc.field, f"{exc.message} (the value {shown} of {option})" if axis else
+                         f"{exc.message} (the support of {option} reaches {shown}: narrow the distribution)")

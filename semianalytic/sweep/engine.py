@@ -30,6 +30,7 @@ import numpy as np
 from semianalytic.case import Case, load_case, parse_case
 from semianalytic.errors import InputError
 from semianalytic.io import atomic_write_json
+from semianalytic.thirdparty import deferred_interrupts
 from semianalytic.sweep.kernels import Kernel, select_kernel
 from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
 from semianalytic.sweep.store import Columns, ResultStore, results_path
@@ -397,6 +398,82 @@ def own_session() -> int:
     return os.getsid(0)
 
 
+# A dask scheduler writes its handshake as soon as it accepts a connection (distributed.comm.core
+# Listener.on_connection): a TCP frame whose first 8 bytes are the little-endian byte count of the
+# message (a few hundred) and the next 8 its frame count.  The probe connects, reads those 16
+# bytes and names a peer that sends nothing (an HTTP server waits for a request) or other bytes
+# (dask read an SSH banner as a frame of 3 EiB and reported "out of memory").
+PROBE_CONNECT_SECONDS = 3.0
+PROBE_HANDSHAKE_SECONDS = 5.0
+
+
+def _scheduler_host_port(address: str) -> tuple[str, int] | None:
+    """(host, port) of a ``tcp://host:port`` or ``host:port`` address; None for another protocol
+    (tls://, ucx://, inproc://: left to dask)."""
+    text = address.strip()
+    if "://" in text:
+        scheme, _, text = text.partition("://")
+        if scheme != "tcp":
+            return None
+    host, sep, port = text.rpartition(":")
+    if not sep or not port.isdigit() or not 0 < int(port) < 65536:
+        raise InputError("--scheduler", f"expected a dask scheduler address tcp://HOST:PORT (or HOST:PORT, or "
+                                        f"'inline' or 'local'); got {address!r}")
+    return host.strip("[]") or "127.0.0.1", int(port)
+
+
+def probe_scheduler(address: str, connect_seconds: float = PROBE_CONNECT_SECONDS,
+                    handshake_seconds: float = PROBE_HANDSHAKE_SECONDS) -> None:
+    """Refuse (InputError on ``--scheduler``) an address where no dask scheduler answers, within
+    about ``connect_seconds + handshake_seconds``: nothing listening, no answer, a peer that sends
+    no handshake or bytes that are not dask's frame header."""
+    import socket
+    import struct
+
+    where = _scheduler_host_port(address)
+    if where is None:
+        return
+    host, port = where
+    try:
+        sock = socket.create_connection((host, port), timeout=connect_seconds)
+    except ConnectionRefusedError:
+        raise InputError("--scheduler", f"nothing listens at {host}:{port} (connection refused); start the dask "
+                                        "scheduler there or give 'local'") from None
+    except (socket.timeout, TimeoutError):
+        raise InputError("--scheduler", f"{host}:{port} did not answer within {connect_seconds:g} s") from None
+    except OSError as exc:
+        raise InputError("--scheduler", f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
+    data = b""
+    try:
+        deadline = time.monotonic() + handshake_seconds
+        while len(data) < 16:
+            left = deadline - time.monotonic()
+            if left <= 0:
+                break
+            sock.settimeout(left)
+            try:
+                chunk = sock.recv(16 - len(data))
+            except (socket.timeout, TimeoutError):
+                break
+            if not chunk:
+                break
+            data += chunk
+    except OSError as exc:
+        raise InputError("--scheduler", f"{host}:{port} broke the connection: {exc.strerror or exc}") from None
+    finally:
+        sock.close()
+    if not data:
+        raise InputError("--scheduler", f"{host}:{port} accepted the connection but sent no dask handshake within "
+                                        f"{handshake_seconds:g} s: not a dask scheduler (a dask scheduler speaks "
+                                        "first; an HTTP server waits for a request)")
+    if len(data) < 16:
+        raise InputError("--scheduler", f"{host}:{port} is not a dask scheduler: it sent {data[:16]!r} and stopped")
+    total, frames = struct.unpack("<QQ", data)
+    if not (16 <= total <= 2**20 and 1 <= frames <= 64):
+        raise InputError("--scheduler", f"{host}:{port} is not a dask scheduler: it answers with other bytes "
+                                        f"({data[:16]!r}, not dask's frame header)")
+
+
 def connect(scheduler: str | None, workers: int):
     """(client, cluster, name): None/None for "inline", a new LocalCluster for "local"/None,
     else a client of the scheduler at that address, or of the one a scheduler file names
@@ -418,13 +495,31 @@ def connect(scheduler: str | None, workers: int):
         environ.update(OPENBLAS_NUM_THREADS=1, OMP_NUM_THREADS=1, MKL_NUM_THREADS=1)
         # and no statistical profiler in the workers (a thread that samples the task's stack every 10 ms,
         # for the dashboard, which a sweep does not open)
-        with dask.config.set({"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False}):
+        import atexit
+        import logging
+        import tempfile
+
+        # the workers' scratch space (dask-scratch-space, its lock files) in a folder of ours, removed at exit,
+        # also after Ctrl-C or SIGTERM (issue 40: dask left it in $TMPDIR)
+        scratch = tempfile.mkdtemp(prefix="semianalytic-dask-")
+        atexit.register(shutil.rmtree, scratch, True)
+        environ.update(DASK_TEMPORARY_DIRECTORY=scratch)
+        config = {"distributed.nanny.pre-spawn-environ": environ, "distributed.worker.profile.enabled": False,
+                  "temporary-directory": scratch}
+        with dask.config.set(config), deferred_interrupts() as interrupted:
             cluster = LocalCluster(
                 n_workers=workers, threads_per_worker=1, processes=True, dashboard_address=None,
-                silence_logs=40, env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1"},
+                silence_logs=logging.CRITICAL, local_directory=scratch,
+                env={"OPENBLAS_NUM_THREADS": "1", "OMP_NUM_THREADS": "1", "MKL_NUM_THREADS": "1",
+                     "DASK_TEMPORARY_DIRECTORY": scratch},
             )
-        client = Client(cluster)
-        client.run(own_session)
+            client = Client(cluster)
+            client.run(own_session)
+        if interrupted:  # a Ctrl-C or SIGTERM while the cluster started: stop it whole, then say so
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
+            client.close()
+            cluster.close()
+            raise KeyboardInterrupt(interrupted[0])
         return client, cluster, "local"
     client = None
     try:
@@ -435,7 +530,11 @@ def connect(scheduler: str | None, workers: int):
                 raise ValueError(f"not a readable dask scheduler file (no 'address'): {exc}") from None
         else:
             address = sched
-        client = Client(address, timeout="10s")
+        probe_scheduler(address)
+        import dask
+
+        with dask.config.set({"distributed.comm.timeouts.connect": "10s"}):  # the handshake too
+            client = Client(address, timeout="10s")
         client.wait_for_workers(1, timeout=60)
     except (OSError, TimeoutError, ValueError) as exc:
         if client is not None:
@@ -556,6 +655,11 @@ def run_sweep(
     finally:
         store.close()
         if client is not None:
+            import logging
+
+            # a cluster stopped by Ctrl-C or SIGTERM logs its workers' closed connections with tracebacks:
+            # not the user's business (the one line of the dispatcher says what happened)
+            logging.getLogger("distributed").setLevel(logging.CRITICAL)
             client.close()
         if cluster is not None:
             cluster.close()

@@ -142,6 +142,17 @@ class Sampler:
     def column(self) -> str:
         return column_name(self.key, self.unit)
 
+    def support(self) -> tuple[float, float]:
+        """The range the draws cover: the ends of a uniform or triangular distribution; a normal's
+        or lognormal's quantiles of 1e-4 and 1 - 1e-4 (a sweep of up to ~10^4 samples reaches
+        them; the case must be valid there, issue 40)."""
+        p = self.params
+        if self.dist == "normal":
+            return p[0] - SUPPORT_SIGMAS * p[1], p[0] + SUPPORT_SIGMAS * p[1]
+        if self.dist == "lognormal":
+            return p[0] * math.exp(-min(SUPPORT_SIGMAS * p[1], 700.0)), p[0] * math.exp(min(SUPPORT_SIGMAS * p[1], 700.0))
+        return p[0], p[-1]
+
     def draw(self, rng: np.random.Generator, n: int) -> np.ndarray:
         p = self.params
         if self.dist == "normal":
@@ -219,6 +230,10 @@ def parse_sample(text: str, option: str = "--sample") -> Sampler:
         if dist in ("uniform", "triangular") and not params[0] > 0:
             raise InputError(field, f"{dist}(...) reaches values <= 0, and the quantity is positive: give LOW > 0")
     return Sampler(key, dist, tuple(params), unit)
+
+
+# The standard-normal quantile of 1 - 1e-4: the support of a normal or lognormal sample checked up front.
+SUPPORT_SIGMAS = 3.719
 
 
 # A normal distribution of a positive quantity must keep its mean this many standard deviations
