@@ -55,7 +55,11 @@ class Scaled:
 
 @pytest.fixture
 def scaled_model():
-    from semianalytic.penetration.case import ResistanceInput, register_resistance, unregister_resistance
+    from semianalytic.penetration.case import (
+        ResistanceInput,
+        register_resistance,
+        unregister_resistance,
+    )
     from semianalytic.units import Pressure
 
     @register_resistance(calibrate="yield_stress")
@@ -116,7 +120,7 @@ def test_an_unregistered_model_is_refused_again(tmp_path, capsys, scaled_model):
     unregister_resistance("scaled")
     try:
         assert "scaled" not in MODELS
-        code, out, err = run(capsys, "penetrate", path, "--coefficients", "paper")
+        code, _out, err = run(capsys, "penetrate", path, "--coefficients", "paper")
         assert code == 2 and "target.resistance.model" in err and "'scaled'" in err
     finally:
         from semianalytic.penetration.case import register_resistance
@@ -208,14 +212,14 @@ def test_an_unknown_format_names_the_flag_and_the_choices(capsys):
 
 
 def test_csv_only_where_there_are_rows(capsys):
-    code, out, err = run(capsys, "cavity", CAVITY, "--format", "csv")
+    code, _, err = run(capsys, "cavity", CAVITY, "--format", "csv")
     assert code == 2 and err.strip() == "error: --format: must be one of json, text; got 'csv'"
-    code, out, err = run(capsys, "ballistic-limit", ROOT / "cases" / "part4_table3.toml", "--format", "csv")
+    code, _out, err = run(capsys, "ballistic-limit", ROOT / "cases" / "part4_table3.toml", "--format", "csv")
     assert code == 2 and "--format" in err
 
 
 def test_json_and_a_different_format_is_refused(capsys):
-    code, out, err = run(capsys, "cavity", CAVITY, "--json", "--format", "text")
+    code, _out, err = run(capsys, "cavity", CAVITY, "--json", "--format", "text")
     assert code == 2 and err.strip().startswith("error: --format:")
 
 
@@ -231,6 +235,19 @@ def test_penetrate_csv_on_stdout_is_the_csv_file(tmp_path, capsys):
 
 
 def test_text_is_the_default(capsys):
-    code, text, err = run(capsys, "cavity", CAVITY)
-    code2, same, err2 = run(capsys, "cavity", CAVITY, "--format", "text")
+    code, text, _err = run(capsys, "cavity", CAVITY)
+    code2, same, _err2 = run(capsys, "cavity", CAVITY, "--format", "text")
     assert code == code2 == 0 and text == same and text.startswith("AD995")
+
+
+def test_the_tate_model_of_the_worked_example(tmp_path, capsys):
+    """docs/extending.md's model, shipped as semianalytic/penetration/resistances/tate.py: R_t
+    against a hand computation of Tate (1986) at Y_t = 400 MPa, E_t = 68.9 GPa:
+    400e6 (2/3 + ln(0.57 * 172.25)) = 2101.3979 MPa (to 1e-9: the digits carried by hand)."""
+    path = _case(tmp_path, "tate.toml", 'model = "tate"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"\n')
+    code, out, err = run(capsys, "penetrate", path, "--coefficients", "paper", "--json")
+    assert code == 0, err
+    assert json.loads(out)["resistance_Pa"] == pytest.approx(2101.397863e6, rel=1e-9)
+    bad = _case(tmp_path, "bad.toml", 'model = "tate"\nyield_stress = "400 MPa"\nyoungs_modulus = "300 MPa"\n')
+    code, out, err = run(capsys, "penetrate", bad, "--coefficients", "paper")
+    assert code == 2 and err.startswith("error: target.resistance: youngs_modulus: Tate's R_t needs E_t > Y_t"), err

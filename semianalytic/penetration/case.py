@@ -36,7 +36,16 @@ import math
 import typing
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from semianalytic.errors import InputError
 from semianalytic.penetration.resistance import (
@@ -53,8 +62,18 @@ from semianalytic.penetration.resistance import (
 from semianalytic.schema import Section, allowed_values, pydantic_message
 from semianalytic.units import Length, NonNegativePressure, Pressure, Velocity
 
-__all__ = ["DataSection", "ResistanceInput", "ResistanceSpec", "ResistanceField", "parse_resistance", "register_resistance",
-           "unregister_resistance", "resistance_inputs", "calibrated_parameter", "MODELS"]
+__all__ = [
+    "MODELS",
+    "DataSection",
+    "ResistanceField",
+    "ResistanceInput",
+    "ResistanceSpec",
+    "calibrated_parameter",
+    "parse_resistance",
+    "register_resistance",
+    "resistance_inputs",
+    "unregister_resistance",
+]
 
 _NAME = r"^[A-Za-z0-9_.-]+$"
 
@@ -278,7 +297,7 @@ class ConstantInput(_Input):
 
 def _union():
     members = tuple(_REGISTRY.values())
-    return Annotated[Union[members] if len(members) > 1 else members[0], Field(discriminator="model")]
+    return Annotated[Union[members] if len(members) > 1 else members[0], Field(discriminator="model")]  # noqa: UP007 (a tuple)
 
 
 
@@ -319,7 +338,7 @@ def _rebuild_holders(old, new) -> None:
         for name, f in list(c.__pydantic_fields__.items()):
             args = typing.get_args(f.annotation)
             if f.annotation is old or old in args:
-                ann = new if f.annotation is old else typing.Optional[new]
+                ann = new if f.annotation is old else new | None
                 info = FieldInfo.from_annotated_attribute(ann, f.default)
                 info.description = f.description
                 c.__pydantic_fields__[name] = info
