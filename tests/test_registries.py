@@ -251,3 +251,27 @@ def test_the_tate_model_of_the_worked_example(tmp_path, capsys):
     bad = _case(tmp_path, "bad.toml", 'model = "tate"\nyield_stress = "400 MPa"\nyoungs_modulus = "300 MPa"\n')
     code, out, err = run(capsys, "penetrate", bad, "--coefficients", "paper")
     assert code == 2 and err.startswith("error: target.resistance: youngs_modulus: Tate's R_t needs E_t > Y_t"), err
+
+
+def _blocks():
+    import re
+
+    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "extending.md").read_text(encoding="utf-8"), re.S)
+
+
+def test_the_worked_examples_of_the_docs_are_the_code(capsys):
+    """docs/extending.md shows the shipped tate.py (every line of its block is in the file, the
+    comments aside) and its format example runs as shown."""
+    model, fmt, use = _blocks()
+    shipped = (ROOT / "semianalytic" / "penetration" / "resistances" / "tate.py").read_text(encoding="utf-8")
+    for line in model.splitlines():
+        assert line.split("  #")[0].rstrip() in shipped, line
+    from semianalytic.report.formats import FORMATS
+
+    try:
+        exec(compile(fmt, "extending.md", "exec"), {})
+        code, out, err = run(capsys, "cavity", CAVITY, "--format", "keys")
+        assert code == 0 and out.splitlines() == CAVITY_KEYS, err
+    finally:
+        FORMATS.pop("keys", None)
+    assert '"--format", "keys"' in use
