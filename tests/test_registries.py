@@ -275,3 +275,41 @@ def test_the_worked_examples_of_the_docs_are_the_code(capsys):
     finally:
         FORMATS.pop("keys", None)
     assert '"--format", "keys"' in use
+
+
+# -- report formats -------------------------------------------------------------------------
+
+
+@pytest.fixture
+def plain_report_format():
+    from semianalytic.report.report_formats import REPORT_FORMATS, register_report_format
+
+    @register_report_format("plain", suffix=".txt")
+    def plain(markdown, images):
+        return markdown.replace("**", "")
+
+    yield plain
+    del REPORT_FORMATS["plain"]
+
+
+def test_a_registered_report_format_is_written_beside_every_report(tmp_path, plain_report_format):
+    """write_beside (every per-package --report) writes each registered format; the HTML page is
+    the one html_beside wrote before the registry, byte for byte."""
+    from semianalytic.report.html import html_beside
+    from semianalytic.report.report_formats import targets_beside, write_beside
+
+    md = tmp_path / "r.md"
+    md.write_text("# Title\n\nSome **bold** text.\n\n![fig](f.png)\n")
+    (tmp_path / "f.png").write_bytes(b"\x89PNG\r\n\x1a\nnot really")
+    assert targets_beside(md) == [tmp_path / "r.html", tmp_path / "r.txt"]
+    write_beside(md)
+    assert (tmp_path / "r.txt").read_text() == "# Title\n\nSome bold text.\n\n![fig](f.png)\n"
+    html = (tmp_path / "r.html").read_bytes()
+    html_beside(md)
+    assert (tmp_path / "r.html").read_bytes() == html
+
+
+def test_a_registered_report_format_through_a_command(tmp_path, capsys, plain_report_format):
+    code, out, err = run(capsys, "nanostrength", ROOT / "cases" / "part3_table3.toml", "--report", tmp_path)
+    assert code == 0, err
+    assert (tmp_path / "part3_table3.txt").read_text() == (tmp_path / "part3_table3.md").read_text().replace("**", "")
