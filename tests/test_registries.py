@@ -256,7 +256,7 @@ def test_the_tate_model_of_the_worked_example(tmp_path, capsys):
 def _blocks():
     import re
 
-    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "extending.md").read_text(encoding="utf-8"), re.S)
+    return re.findall(r"```python\n(.*?)```", (ROOT / "docs" / "extending.md").read_text(encoding="utf-8"), re.DOTALL)
 
 
 def test_the_worked_examples_of_the_docs_are_the_code(capsys):
@@ -269,7 +269,7 @@ def test_the_worked_examples_of_the_docs_are_the_code(capsys):
     from semianalytic.report.formats import FORMATS
 
     try:
-        exec(compile(fmt, "extending.md", "exec"), {})
+        exec(compile(fmt, "extending.md", "exec"), {})  # noqa: S102 (the page's own example)
         code, out, err = run(capsys, "cavity", CAVITY, "--format", "keys")
         assert code == 0 and out.splitlines() == CAVITY_KEYS, err
     finally:
@@ -282,7 +282,10 @@ def test_the_worked_examples_of_the_docs_are_the_code(capsys):
 
 @pytest.fixture
 def plain_report_format():
-    from semianalytic.report.report_formats import REPORT_FORMATS, register_report_format
+    from semianalytic.report.report_formats import (
+        REPORT_FORMATS,
+        register_report_format,
+    )
 
     @register_report_format("plain", suffix=".txt")
     def plain(markdown, images):
@@ -310,6 +313,6 @@ def test_a_registered_report_format_is_written_beside_every_report(tmp_path, pla
 
 
 def test_a_registered_report_format_through_a_command(tmp_path, capsys, plain_report_format):
-    code, out, err = run(capsys, "nanostrength", ROOT / "cases" / "part3_table3.toml", "--report", tmp_path)
+    code, _, err = run(capsys, "nanostrength", ROOT / "cases" / "part3_table3.toml", "--report", tmp_path)
     assert code == 0, err
     assert (tmp_path / "part3_table3.txt").read_text() == (tmp_path / "part3_table3.md").read_text().replace("**", "")
