@@ -316,3 +316,50 @@ def test_a_registered_report_format_through_a_command(tmp_path, capsys, plain_re
     code, _, err = run(capsys, "nanostrength", ROOT / "cases" / "part3_table3.toml", "--report", tmp_path)
     assert code == 0, err
     assert (tmp_path / "part3_table3.txt").read_text() == (tmp_path / "part3_table3.md").read_text().replace("**", "")
+
+
+# -- nose kinds -----------------------------------------------------------------------------
+
+
+def test_a_nose_kind_registered_before_the_case_layer_is_a_case_nose(tmp_path):
+    """register_nose in geometry's registry (before semianalytic.case is imported) is accepted by
+    [projectile] nose; the nose it builds is the ogive of crh 1 (the same segments), and a key the
+    kind does not list is refused naming the kinds that use it."""
+    import os
+    import subprocess
+
+    case = tmp_path / "c.toml"
+    case.write_text(FIG15A.read_text().replace('nose = "ogive"\ncrh = 3.0', 'nose = "one_caliber"'))
+    code = textwrap.dedent(f'''
+        import semianalytic.geometry as g
+
+        @g.register_nose("one_caliber")
+        def build(sec):
+            return g.ogive_nose(sec.diameter, 1.0)
+
+        from semianalytic.case import load_case
+        from semianalytic.errors import InputError
+        c = load_case({str(case)!r})
+        nose = g.nose_from_section(c.projectile)
+        # a tangent ogive's length: L_h = d sqrt(psi - 1/4) (geometry of the tangent arc)
+        assert abs(nose.length - 7.11e-3 * 0.75 ** 0.5) <= 1e-12 * nose.length, nose.length
+        try:
+            load_case({str(case)!r}.replace("c.toml", "bad.toml"))
+        except InputError as exc:
+            print(exc.field, exc.message)
+    ''')
+    (tmp_path / "bad.toml").write_text(case.read_text().replace('nose = "one_caliber"', 'nose = "one_caliber"\ncrh = 2.0'))
+    env = {**os.environ, "PYTHONPATH": str(ROOT)}
+    proc = subprocess.run([sys.executable, "-c", code], cwd=tmp_path, env=env, capture_output=True, text=True, timeout=120, check=False)
+    assert proc.returncode == 0, proc.stderr[-2000:]
+    assert proc.stdout.startswith("projectile.crh has no use for the 'one_caliber' nose (only for: ogive)"), proc.stdout
+
+
+def test_the_schema_choices_are_the_registered_noses():
+    import typing
+
+    from semianalytic.case import ProjectileSection
+    from semianalytic.geometry import NOSE_KINDS
+
+    assert list(typing.get_args(ProjectileSection.model_fields["nose"].annotation)) == list(NOSE_KINDS)
+    assert list(NOSE_KINDS) == ["ogive", "sphere", "cone", "flat", "table", "power", "spline"]
