@@ -262,7 +262,7 @@ def _blocks():
 def test_the_worked_examples_of_the_docs_are_the_code(capsys):
     """docs/extending.md shows the shipped tate.py (every line of its block is in the file, the
     comments aside) and its format example runs as shown."""
-    model, fmt, use = _blocks()
+    model, fmt, use, report = _blocks()
     shipped = (ROOT / "semianalytic" / "penetration" / "resistances" / "tate.py").read_text(encoding="utf-8")
     for line in model.splitlines():
         assert line.split("  #")[0].rstrip() in shipped, line
@@ -275,6 +275,13 @@ def test_the_worked_examples_of_the_docs_are_the_code(capsys):
     finally:
         FORMATS.pop("keys", None)
     assert '"--format", "keys"' in use
+    from semianalytic.report.report_formats import REPORT_FORMATS
+
+    try:
+        exec(compile(report, "extending.md", "exec"), {})  # noqa: S102 (the page's own example)
+        assert REPORT_FORMATS["plain"].render("**a**", lambda rel: None) == "a"
+    finally:
+        REPORT_FORMATS.pop("plain", None)
 
 
 # -- report formats -------------------------------------------------------------------------
