@@ -300,7 +300,6 @@ def _union():
     return Annotated[Union[members] if len(members) > 1 else members[0], Field(discriminator="model")]  # noqa: UP007 (a tuple)
 
 
-
 def _builds(spec):
     """Case-load check: the inputs must give a model (e.g. eq. (16)'s logarithm positive)."""
     try:
