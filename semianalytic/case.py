@@ -23,6 +23,7 @@ from typing import Any, Literal, Mapping
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from semianalytic.errors import InputError
+from semianalytic.geometry import NOSE_KINDS
 from semianalytic.penetration.case import ResistanceField
 from semianalytic.perforation.case import TargetLayerSection, check_target_layers
 from semianalytic.schema import Section, validate_section
@@ -104,7 +105,7 @@ class ProjectileSection(Section):
     ``shank_length`` is the cylindrical part: total length = shank + nose.
     """
 
-    nose: Literal["ogive", "sphere", "cone", "flat", "table", "power", "spline"]
+    nose: Literal[tuple(NOSE_KINDS)]  # the registered kinds (semianalytic.geometry.register_nose)
     diameter: Length
     shank_length: NonNegativeLength | None = None
     length: Length | None = Field(default=None, description="total length L = shank + nose (instead of shank_length)")
@@ -195,10 +196,8 @@ class ProjectileSection(Section):
         the lengths against it.  Raises ``InputError``."""
         from semianalytic.geometry import nose_from_section
 
-        uses = {"crh": ("ogive",), "half_angle": ("cone",), "corner_radius": ("flat",),
-                "meplat_diameter": ("ogive", "cone"), "tip_radius": ("ogive", "cone"),
-                "points": ("table",), "points_unit": ("table",), "exponent": ("power",), "nose_length": ("power", "spline"),
-                "control_radii": ("spline",)}
+        keys = dict.fromkeys(k for kind in NOSE_KINDS.values() for k in kind.keys)
+        uses = {key: tuple(n for n, kind in NOSE_KINDS.items() if key in kind.keys) for key in keys}
         for key, kinds in uses.items():
             if getattr(self, key) is not None and self.nose not in kinds:
                 raise InputError(f"projectile.{key}", f"has no use for the '{self.nose}' nose (only for: {', '.join(kinds)}); remove it")

@@ -790,23 +790,72 @@ def table_body(points: list[tuple[float, float]], field_name: str = "body.points
     return Meridian((SplineCurve(tuple(pts[:, 0]), tuple(pts[:, 1])),))
 
 
-def nose_from_section(sec) -> Nose:
-    """Build the nose of a ``[projectile]`` case section."""
-    meplat = getattr(sec, "meplat_diameter", None) or 0.0
-    tip = getattr(sec, "tip_radius", None) or 0.0
-    if sec.nose == "ogive":
-        return ogive_nose(sec.diameter, sec.crh, meplat, tip)
-    if sec.nose == "sphere":
-        return ogive_nose(sec.diameter, 0.5)
-    if sec.nose == "cone":
-        return cone_nose(sec.diameter, sec.half_angle, meplat, tip)
-    if sec.nose == "flat":
-        return flat_nose(sec.diameter, sec.corner_radius or 0.0)
-    if sec.nose == "power":
-        return power_nose(sec.diameter, sec.exponent, sec.nose_length)
-    if sec.nose == "spline":
-        return spline_nose(sec.diameter, sec.control_radii, sec.nose_length)
+@dataclass(frozen=True)
+class NoseKind:
+    """A registered nose kind: ``build(section) -> Nose`` from the ``[projectile]`` keys ``keys``."""
+
+    name: str
+    build: object
+    keys: tuple[str, ...] = ()
+
+
+NOSE_KINDS: dict[str, NoseKind] = {}
+"""The nose kinds of ``[projectile] nose``, by name: the case schema's choices and the keys each
+kind uses are read from here (:func:`register_nose`)."""
+
+
+def register_nose(name: str, *, keys: tuple[str, ...] = ()):
+    """Decorator: ``build(section) -> Nose`` is the nose kind ``name``, using the section keys ``keys``
+    (any other nose key given with it is an error).  Register before :mod:`semianalytic.case` is imported."""
+    def decorate(build):
+        NOSE_KINDS[name] = NoseKind(name, build, tuple(keys))
+        return build
+
+    return decorate
+
+
+def _tip(sec) -> tuple[float, float]:
+    return getattr(sec, "meplat_diameter", None) or 0.0, getattr(sec, "tip_radius", None) or 0.0
+
+
+@register_nose("ogive", keys=("crh", "meplat_diameter", "tip_radius"))
+def _ogive_from_section(sec) -> Nose:
+    return ogive_nose(sec.diameter, sec.crh, *_tip(sec))
+
+
+@register_nose("sphere")
+def _sphere_from_section(sec) -> Nose:
+    return ogive_nose(sec.diameter, 0.5)
+
+
+@register_nose("cone", keys=("half_angle", "meplat_diameter", "tip_radius"))
+def _cone_from_section(sec) -> Nose:
+    return cone_nose(sec.diameter, sec.half_angle, *_tip(sec))
+
+
+@register_nose("flat", keys=("corner_radius",))
+def _flat_from_section(sec) -> Nose:
+    return flat_nose(sec.diameter, sec.corner_radius or 0.0)
+
+
+@register_nose("table", keys=("points", "points_unit"))
+def _table_from_section(sec) -> Nose:
     return table_nose(sec.points_si(), sec.diameter)
+
+
+@register_nose("power", keys=("exponent", "nose_length"))
+def _power_from_section(sec) -> Nose:
+    return power_nose(sec.diameter, sec.exponent, sec.nose_length)
+
+
+@register_nose("spline", keys=("control_radii", "nose_length"))
+def _spline_from_section(sec) -> Nose:
+    return spline_nose(sec.diameter, sec.control_radii, sec.nose_length)
+
+
+def nose_from_section(sec) -> Nose:
+    """Build the nose of a ``[projectile]`` case section (its kind's registered builder)."""
+    return NOSE_KINDS[sec.nose].build(sec)
 
 
 @dataclass(frozen=True)

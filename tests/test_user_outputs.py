@@ -53,7 +53,7 @@ def test_wrong_choice_lists_the_valid_ones_in_the_projects_words(tmp_path):
     line = proc.stderr.strip()
     assert line.startswith("error: target.resistance.model: 'elastic_plastic' is not one of"), line
     # the valid values, written here by hand (the models of Part I and the peers' tables)
-    for valid in ("elastic-plastic", "brittle", "hardening", "limestone", "part4", "cavity", "constant"):
+    for valid in ("elastic-plastic", "brittle", "hardening", "limestone", "part4", "cavity", "constant", "tate"):
         assert valid in line
     assert "did you mean 'elastic-plastic'?" in line
     for leak in ("Input tag", "Input should", "expected tags", "pydantic"):

@@ -9,7 +9,8 @@ critical areal density and thickness of Table 4 (eq. (9) with P = rho_p L_p).
 from __future__ import annotations
 
 import argparse
-import json
+import builtins
+import functools
 import math
 
 __all__ = ["add_arguments", "run"]
@@ -20,7 +21,9 @@ COLUMNS = [("V_R1_m_s", "V(R1)"), ("V_R2_m_s", "V(R2)"), ("V_R3_m_s", "V(R3)"),
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", help="TOML case file with a [ballistic_limit] section")
-    parser.add_argument("--json", action="store_true", help="print one JSON object (keys carry units)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print one JSON object (keys carry units)")
 
 
 def _fmt(value) -> str:
@@ -32,11 +35,17 @@ def run(args) -> int:
 
     from semianalytic.ballistic_limit.evaluate import evaluate_case
 
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     case = load_case(args.case)
     result = evaluate_case(case)
-    if args.json:
-        print(json.dumps(result, indent=2, allow_nan=False))
-        return 0
+    emit(Output(data=result, json_options={"indent": 2, "allow_nan": False}, text=lambda s: _text(result, s)), fmt)
+    return 0
+
+
+def _text(result: dict, stream) -> None:
+    print = functools.partial(builtins.print, file=stream)
     c = result["constants"]
     print(f"{result['case']}\n")
     print(f"theory: Part IV eq. (5), R(1) = HM delta_H ({result['hardness_rule']}), R(2) = R(3) delta_H, R(3) eq. (6)")
@@ -56,4 +65,3 @@ def run(args) -> int:
             h = c.get("h_cr_m")
             print(f"  {name:<{width}}  V = {c['V_p_m_s']:.0f} m/s: (rho h)_cr = {c['rhoh_cr_kg_m2'] / 10:.2f} g/cm^2"
                   + (f", h_cr = {h * 1e3:.1f} mm" if h else ""))
-    return 0

@@ -12,14 +12,17 @@ paper's constants 1.52e6, 0.79e6, 1.69e6 come back (errata 26).
 from __future__ import annotations
 
 import argparse
-import json
+import builtins
+import functools
 
 __all__ = ["add_arguments", "run"]
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("data", help="shot table (CSV with '#' header lines)")
-    parser.add_argument("--json", action="store_true", help="print one JSON object (keys carry units)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print one JSON object (keys carry units)")
     parser.add_argument("--method", choices=("mean", "least-squares"), default="mean")
     parser.add_argument("--areal-mass", choices=("mass-per-area", "cylinder", "paper-implied"),
                         default="mass-per-area", help="projectile areal mass P (default m/(pi d^2/4), errata 26)")
@@ -31,6 +34,9 @@ def run(args) -> int:
     from semianalytic.ballistic_limit.tables import load_shots, read_rows
     from semianalytic.errors import InputError
 
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     shots = load_shots(args.data)
     printed7: list[float | None] = [None] * len(shots)
     if args.areal_mass == "paper-implied":
@@ -57,12 +63,15 @@ def run(args) -> int:
         raise InputError("data", "no single-plate row with a measured V_cr to fit")
     fit = fit_constants(samples, args.method)
     out = {"data": str(args.data), "areal_mass_rule": args.areal_mass, **fit.to_json(), "skipped": skipped}
-    if args.json:
-        print(json.dumps(out, indent=2, allow_nan=False))
-        return 0
+    emit(Output(data=out, json_options={"indent": 2, "allow_nan": False},
+                text=lambda s: _text(fit, args, skipped, s)), fmt)
+    return 0
+
+
+def _text(fit, args, skipped, stream) -> None:
+    print = functools.partial(builtins.print, file=stream)
     c = fit.constants
     print(f"{fit.n} rows ({args.method}, P = {args.areal_mass}); skipped: {', '.join(skipped) or 'none'}")
     print(f"C1 = {c.C1:.4g} m^2/s^2           rms error in V {fit.rms_error[0]:.1%}, worst {fit.max_error[0]:+.1%}")
     print(f"C2 = {c.C2_per_GPa:.4g} (m/s)^2/GPa = {c.C2:.4g} m^3/kg   rms {fit.rms_error[1]:.1%}, worst {fit.max_error[1]:+.1%}")
     print(f"C3 = {c.C3:.4g} m^2/s^2           rms error in V {fit.rms_error[2]:.1%}, worst {fit.max_error[2]:+.1%}")
-    return 0

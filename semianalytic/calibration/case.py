@@ -59,10 +59,6 @@ _KINDS = {
     "poisson_ratio": ("dimensionless", "", 1.0), "alpha": ("dimensionless", "", 1.0),
     "hardening_exponent": ("dimensionless", "", 1.0),
 }
-_DEFAULT_PARAMETER = {
-    "elastic-plastic": "yield_stress", "hardening": "yield_stress", "part4": "yield_stress",
-    "brittle": "compressive_strength", "limestone": "psi", "constant": "value",
-}
 
 
 class CalibrationSection(Section):
@@ -102,10 +98,13 @@ def parameter_kind(key: str, resistance, *, eroding: bool = False) -> tuple[str,
 
 
 def default_parameter(resistance) -> str:
-    name = _DEFAULT_PARAMETER.get(resistance.name)
+    from semianalytic.penetration.case import MODELS, calibrated_parameter
+
+    name = calibrated_parameter(resistance.name)
     if name is None:
+        ok = [m for m in MODELS if calibrated_parameter(m) is not None]
         raise InputError("target.resistance.model", f"the '{resistance.name}' resistance cannot be calibrated; "
-                                                    "use elastic-plastic, hardening, part4, brittle, limestone or constant")
+                                                    f"use {', '.join(ok[:-1])} or {ok[-1]}")
     return "target.resistance." + name
 
 

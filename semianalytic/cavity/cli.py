@@ -8,7 +8,6 @@ Soft-condition warnings go to stderr; a rejected material exits with status 2.
 from __future__ import annotations
 
 import argparse
-import json
 import sys
 import warnings
 
@@ -19,7 +18,9 @@ __all__ = ["add_arguments", "run", "format_result"]
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", help="TOML case file with a [material] section")
-    parser.add_argument("--json", action="store_true", help="print one JSON object (keys carry units)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print one JSON object (keys carry units)")
     parser.add_argument("--method", choices=("bracket", "fixed-point"), default=None,
                         help="root finder for eq. (21): bracketed root (default) or the paper's iteration (22); "
                              "overrides [material].solver")
@@ -51,6 +52,9 @@ def run(args) -> int:
     from semianalytic.case import load_case
     from semianalytic.cavity import BrittleMaterial, solve_cavity
 
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     case = load_case(args.case)
     section = case.require("material")
     material = BrittleMaterial.from_section(section)
@@ -60,9 +64,6 @@ def run(args) -> int:
         result = solve_cavity(material, method)
     for note in result.warnings:
         print(f"warning: {note}", file=sys.stderr)
-    if args.json:
-        print(json.dumps({"case": case.title, **result.to_json()}, indent=2, allow_nan=False))
-    else:
-        print(f"{case.title}\n")
-        print(format_result(result))
+    emit(Output(data={"case": case.title, **result.to_json()}, json_options={"indent": 2, "allow_nan": False},
+                text=lambda s: print(f"{case.title}\n\n{format_result(result)}", file=s)), fmt)
     return 0

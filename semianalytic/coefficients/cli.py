@@ -7,7 +7,8 @@ the body in unbounded fluid (with the exact value for a sphere or spheroid).
 
 from __future__ import annotations
 
-import json
+import builtins
+import functools
 import math
 
 from semianalytic.case import load_case
@@ -18,7 +19,9 @@ def add_arguments(parser) -> None:
     from semianalytic.cli_types import integer, number, output_dir
 
     parser.add_argument("case", help="TOML case file with [projectile]+[target] or [body]")
-    parser.add_argument("--json", action="store_true", help="print one JSON object instead of a table")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print one JSON object instead of a table")
     parser.add_argument("--depths", type=integer(8, 2000), default=None,
                         help="a fixed grid of this many depths instead of the adaptive knots (default: adaptive)")
     parser.add_argument("--max-depth", type=number(1.0, 1e6, low_open=True), default=None, help="deepest depth in nose lengths (default 300)")
@@ -36,24 +39,21 @@ def add_arguments(parser) -> None:
 
 def run(args) -> int:
     from semianalytic.coefficients.evaluate import coefficients_output
+    from semianalytic.report.formats import Output, chosen_format, emit
 
+    fmt = chosen_format(args)
     case = load_case(args.case)
     out = coefficients_output(case, at=args.at, interpolated=args.interpolated, reading=args.reading,
                               depths=args.depths, max_depth=args.max_depth, tolerance=args.tolerance,
                               order=args.order, refinement=args.refinement, cache_dir=args.cache_dir,
                               progress=True)  # semianalytic.progress decides: bar, log lines or off
-    if args.json:
-        print(json.dumps(out))
-    elif case.body is not None:
-        _print_body(case, out)
-    elif "rows" in out:
-        _print_rows(case, out)
-    else:
-        _print_table(case, out)
+    printer = _print_body if case.body is not None else _print_rows if "rows" in out else _print_table
+    emit(Output(data=out, text=lambda s: printer(case, out, s)), fmt)
     return 0
 
 
-def _print_body(case, out) -> None:
+def _print_body(case, out, stream=None) -> None:
+    print = functools.partial(builtins.print, file=stream)
     print(f"{case.title}")
     print(f"  added-mass coefficient (added mass / rho V): {out['added_mass_coefficient']:.12f}")
     if "added_mass_coefficient_exact" in out:
@@ -62,7 +62,8 @@ def _print_body(case, out) -> None:
     print(f"  unknowns: {out['unknowns']}")
 
 
-def _print_table(case, out) -> None:
+def _print_table(case, out, stream=None) -> None:
+    print = functools.partial(builtins.print, file=stream)
     d, L = out["diameter_m"], out["nose_length_m"]
     area = math.pi * d**2 / 4
     print(f"{case.title}: {case.projectile.nose} nose, d = {d * 1e3:.4g} mm, L_h = {L * 1e3:.4g} mm")
@@ -106,7 +107,8 @@ def _largest_error_note(out, L) -> str:
             f"it is not the interpolation error between knots{rest}")
 
 
-def _print_rows(case, out) -> None:
+def _print_rows(case, out, stream=None) -> None:
+    print = functools.partial(builtins.print, file=stream)
     print(f"{case.title}: {case.projectile.nose} nose, {out['source']} values (B reading {out['reading']})")
     print(f"{'P [mm]':>10} {'Abar [mm]':>12} {'Bbar':>10} {'Cbar':>9} {'A_err [m3]':>11} {'B_err [m2]':>11}")
     for r in out["rows"]:

@@ -10,8 +10,6 @@ studies (Tables 4-5, Figs. 5-7).  Prints a summary (or JSON with units in the ke
 from __future__ import annotations
 
 import argparse
-import json
-import sys
 import time
 from pathlib import Path
 
@@ -25,7 +23,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     from semianalytic.cli_types import output_dir
 
     parser.add_argument("case", help="TOML case file with a [nanostrength] section")
-    parser.add_argument("--json", action="store_true", help="print the results as JSON (units in the keys)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print the results as JSON (units in the keys)")
     parser.add_argument("--report", metavar="DIR", type=output_dir, help="write DIR/<case stem>.md and its PNG figures")
     parser.add_argument("--force", action="store_true", help="overwrite an existing report")
 
@@ -68,6 +68,9 @@ def _summary(a: Analysis, title: str) -> str:
 
 
 def run(args: argparse.Namespace) -> int:
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     t0 = time.perf_counter()
     case = load_case(args.case)
     section = case.require("nanostrength")
@@ -88,11 +91,11 @@ def run(args: argparse.Namespace) -> int:
                                   elapsed=time.perf_counter() - t0, command=command)
         written = write_report(args.report, stem, text, figs, args.force)
     bar.close()
-    if args.json:
-        json.dump(analysis.to_json(), sys.stdout, indent=2, allow_nan=False)
-        sys.stdout.write("\n")
-    else:
-        print(_summary(analysis, case.title))
+
+    def text(stream) -> None:
+        print(_summary(analysis, case.title), file=stream)
         if args.report:
-            print(f"\nreport: {written[-2]} and {written[-1]} (+ {len(written) - 2} figures)")
+            print(f"\nreport: {written[-2]} and {written[-1]} (+ {len(written) - 2} figures)", file=stream)
+
+    emit(Output(data=analysis.to_json(), json_options={"indent": 2, "allow_nan": False}, text=text), fmt)
     return 0

@@ -456,14 +456,14 @@ def write_report(outdir: str | Path, stem: str, text: str, figs: dict[str, bytes
     """Write ``stem.md`` and the figures into ``outdir``: all targets are checked before any is
     written; existing files are replaced only with ``force``."""
     outdir = Path(outdir)
-    targets = [outdir / f"{stem}.md", outdir / f"{stem}.html"] + [outdir / name for name in figs]
+    from semianalytic.report.report_formats import targets_beside, write_beside
+
+    targets = [outdir / f"{stem}.md", *targets_beside(outdir / f"{stem}.md")] + [outdir / name for name in figs]
     for t in targets:
         check_report_target(t, force)
     written = []
     for name, blob in figs.items():
         written.append(atomic_write_bytes(outdir / name, blob, overwrite=True))
     written.append(atomic_write_text(outdir / f"{stem}.md", text, overwrite=True))
-    from semianalytic.report.html import html_beside
-
-    written.append(html_beside(outdir / f"{stem}.md", text))  # self-contained page, figures embedded
+    written += write_beside(outdir / f"{stem}.md", text)  # the registered formats: the self-contained HTML page
     return written

@@ -61,7 +61,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--workers", type=int, default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--cache-dir", default=None, help="coefficient-table cache folder")
     parser.add_argument("--no-progress", action="store_true")
-    parser.add_argument("--json", action="store_true", help="print the optimum as JSON")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print the optimum as JSON")
 
 
 # the printed objective's unit and meaning (optimize.model: depth_objective, deep_drag)
@@ -71,25 +73,29 @@ OBJECTIVE_MEANING = {"depth": "minus the mean final depth, minimised", "deep_dra
 
 def run(args: argparse.Namespace) -> int:
     from semianalytic.optimize.pipeline import run_optimize
+    from semianalytic.report.formats import Output, chosen_format, emit
 
-    if args.out is None and args.report is None and not args.json:
+    fmt = chosen_format(args)
+    if args.out is None and args.report is None and fmt == "text":
         raise InputError("--out", "give an output folder (--out DIR), --report FILE.md or --json")
     command = "python -m semianalytic optimize " + " ".join(shlex.quote(a) for a in sys.argv[2:])
     result = run_optimize(args, command)
     o = result["optimum"]
-    if args.json:
-        import json
+    from semianalytic.report.output import json_safe
 
-        from semianalytic.report.output import json_safe
-
-        print(json.dumps(json_safe({k: v for k, v in result.items() if k != "history"}), indent=2))
-    else:
-        xs = ", ".join(f"{v['key']} = {x:.6g}" for v, x in zip(result["variables"], o["x"]))
-        unit = OBJECTIVE_UNITS.get(result["objective"], "")
-        print(f"optimum: {xs}; objective {o['objective']:.8g}{unit} ({result['objective']}: "
-              f"{OBJECTIVE_MEANING.get(result['objective'], 'minimised')}); "
-              f"{result['n_designs_total']} designs in {result['seconds_total']:.1f} s")
-        g = result.get("confirmation")
-        if g:
-            print(f"confirmation grid: best {g['best_objective']:.8g}{unit}, confirmed: {'yes' if g['confirmed'] else 'NO'}")
+    emit(Output(data=json_safe({k: v for k, v in result.items() if k != "history"}), json_options={"indent": 2},
+                text=lambda s: _text(result, s)), fmt)
     return 0 if o["status"] == "ok" else 1
+
+
+def _text(result: dict, stream) -> None:
+    o = result["optimum"]
+    xs = ", ".join(f"{v['key']} = {x:.6g}" for v, x in zip(result["variables"], o["x"]))
+    unit = OBJECTIVE_UNITS.get(result["objective"], "")
+    print(f"optimum: {xs}; objective {o['objective']:.8g}{unit} ({result['objective']}: "
+          f"{OBJECTIVE_MEANING.get(result['objective'], 'minimised')}); "
+          f"{result['n_designs_total']} designs in {result['seconds_total']:.1f} s", file=stream)
+    g = result.get("confirmation")
+    if g:
+        print(f"confirmation grid: best {g['best_objective']:.8g}{unit}, confirmed: {'yes' if g['confirmed'] else 'NO'}",
+              file=stream)

@@ -1,8 +1,10 @@
 """The penetration case sections: ``[target.resistance]`` and ``[data]``.
 
-``[target.resistance]`` is a pydantic discriminated union on its ``model`` key; each input
-validates units and ranges and ``build()`` gives the frozen SI model of
-:mod:`semianalytic.penetration.resistance` (see its table of models and keys).
+``[target.resistance]`` is a pydantic discriminated union on its ``model`` key over the
+registered inputs (:func:`register_resistance`: one decorator beside each input class is the
+only list of models; docs/extending.md adds one); each input validates units and ranges and
+``build()`` gives the frozen SI model of :mod:`semianalytic.penetration.resistance` (see its
+table of models and keys).
 
 ``[data]``: experimental data a penetration case is compared with.
 
@@ -31,9 +33,19 @@ both.  Example (the Piekutowski et al. 1999 shots bundled in ``cases/``)::
 from __future__ import annotations
 
 import math
+import typing
 from typing import Annotated, Any, Literal, Union
 
-from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator, model_validator
+from pydantic import (
+    AfterValidator,
+    BaseModel,
+    ConfigDict,
+    Field,
+    TypeAdapter,
+    ValidationError,
+    field_validator,
+    model_validator,
+)
 
 from semianalytic.errors import InputError
 from semianalytic.penetration.resistance import (
@@ -47,10 +59,21 @@ from semianalytic.penetration.resistance import (
     Part4,
     Resistance,
 )
-from semianalytic.schema import Section, pydantic_message
+from semianalytic.schema import Section, allowed_values, pydantic_message
 from semianalytic.units import Length, NonNegativePressure, Pressure, Velocity
 
-__all__ = ["DataSection", "ResistanceSpec", "ResistanceField", "parse_resistance", "MODELS"]
+__all__ = [
+    "MODELS",
+    "DataSection",
+    "ResistanceField",
+    "ResistanceInput",
+    "ResistanceSpec",
+    "calibrated_parameter",
+    "parse_resistance",
+    "register_resistance",
+    "resistance_inputs",
+    "unregister_resistance",
+]
 
 _NAME = r"^[A-Za-z0-9_.-]+$"
 
@@ -106,12 +129,63 @@ class _Input(BaseModel):
     _plausible = field_validator("*", mode="after")(Section._plausible.__func__)  # ranges of issue 27
 
 
+ResistanceInput = _Input
+"""Base class of a ``[target.resistance]`` input: a ``model: Literal[name]`` field, its keys, ``build()``."""
+
+_REGISTRY: dict[str, type[_Input]] = {}
+_CALIBRATED: dict[str, str] = {}
+_BUILT = False  # True once the union below exists: a later registration rebuilds it
+
+
+def register_resistance(cls: type[_Input] | None = None, *, calibrate: str | None = None):
+    """Class decorator: register a ``[target.resistance]`` input under the name of its ``model`` literal.
+
+    The case schema (``[target.resistance]`` and ``[[target.layers]]`` resistance), the list of
+    models in error messages (:data:`MODELS`) and ``calibrate``'s default parameter (``calibrate``:
+    the key calibrated when the case names none; None: the model has no default) all read this
+    registration.  Registering after import rebuilds the schemas that hold the union.
+    """
+    def decorate(cls: type[_Input]) -> type[_Input]:
+        names = allowed_values(cls.model_fields["model"].annotation)
+        if len(names) != 1:
+            raise TypeError(f"{cls.__name__}.model must be one Literal name; got {names}")
+        _REGISTRY[names[0]] = cls
+        _CALIBRATED.pop(names[0], None)
+        if calibrate is not None:
+            _CALIBRATED[names[0]] = calibrate
+        MODELS[:] = list(_REGISTRY)
+        if _BUILT:
+            _refresh()
+        return cls
+
+    return decorate if cls is None else decorate(cls)
+
+
+def unregister_resistance(name: str) -> None:
+    """Remove a registered model (a test's clean-up); the schemas are rebuilt without it."""
+    del _REGISTRY[name]
+    _CALIBRATED.pop(name, None)
+    MODELS[:] = list(_REGISTRY)
+    _refresh()
+
+
+def resistance_inputs() -> dict[str, type[_Input]]:
+    """The registered inputs by model name, in registration order."""
+    return dict(_REGISTRY)
+
+
+def calibrated_parameter(model: str) -> str | None:
+    """The ``[target.resistance]`` key ``calibrate`` fits by default for ``model`` (None: none)."""
+    return _CALIBRATED.get(model)
+
+
 def _nu(v):
     if not (-1.0 < v < 0.5):
         raise ValueError(f"must lie in (-1, 0.5); got {v!r}")
     return v
 
 
+@register_resistance(calibrate='yield_stress')
 class ElasticPlasticInput(_Input):
     model: Literal["elastic-plastic"]
     yield_stress: Pressure
@@ -125,6 +199,7 @@ class ElasticPlasticInput(_Input):
         return ElasticPlastic(self.yield_stress, self.youngs_modulus, self.poisson_ratio)
 
 
+@register_resistance(calibrate='compressive_strength')
 class BrittleInput(_Input):
     model: Literal["brittle"]
     compressive_strength: Pressure
@@ -143,6 +218,7 @@ class BrittleInput(_Input):
         return Brittle(self.compressive_strength, self.tensile_strength, self.youngs_modulus, self.poisson_ratio, self.alpha)
 
 
+@register_resistance(calibrate='yield_stress')
 class HardeningInput(_Input):
     model: Literal["hardening"]
     yield_stress: Pressure
@@ -155,6 +231,7 @@ class HardeningInput(_Input):
         return Hardening(self.yield_stress, self.youngs_modulus, self.hardening_exponent)
 
 
+@register_resistance(calibrate='psi')
 class LimestoneInput(_Input):
     model: Literal["limestone"]
     psi: NonNegativePressure = 607e6
@@ -165,6 +242,7 @@ class LimestoneInput(_Input):
         return Limestone(self.psi, self.phi, self.reference_diameter)
 
 
+@register_resistance(calibrate='yield_stress')
 class Part4Input(_Input):
     model: Literal["part4"]
     yield_stress: Pressure
@@ -176,6 +254,7 @@ class Part4Input(_Input):
         return Part4(self.yield_stress, self.youngs_modulus)
 
 
+@register_resistance
 class CavityInput(_Input):
     model: Literal["cavity"]
     youngs_modulus: Pressure
@@ -207,6 +286,7 @@ class CavityInput(_Input):
         ))
 
 
+@register_resistance(calibrate='value')
 class ConstantInput(_Input):
     model: Literal["constant"]
     value: Pressure
@@ -215,14 +295,9 @@ class ConstantInput(_Input):
         return Constant(self.value)
 
 
-ResistanceSpec = Annotated[
-    Union[
-        ElasticPlasticInput, BrittleInput, HardeningInput, LimestoneInput, Part4Input, CavityInput, ConstantInput
-    ],
-    Field(discriminator="model"),
-]
-"""The ``[target.resistance]`` table (a pydantic discriminated union on ``model``)."""
-
+def _union():
+    members = tuple(_REGISTRY.values())
+    return Annotated[Union[members] if len(members) > 1 else members[0], Field(discriminator="model")]  # noqa: UP007 (a tuple)
 
 
 def _builds(spec):
@@ -234,10 +309,57 @@ def _builds(spec):
     return spec
 
 
+def _refresh() -> None:
+    """The union over the registered inputs, and every section model holding it rebuilt on it."""
+    global ResistanceSpec, ResistanceField, _ADAPTER
+    old = ResistanceField
+    ResistanceSpec = _union()
+    ResistanceField = Annotated[ResistanceSpec, AfterValidator(_builds)]
+    _ADAPTER = TypeAdapter(ResistanceSpec)
+    _rebuild_holders(old, ResistanceField)
+
+
+def _rebuild_holders(old, new) -> None:
+    """Point every project model field annotated with ``old`` (optionally ``| None``) at ``new``,
+    then rebuild those models and every project model that holds one of them."""
+    from pydantic.fields import FieldInfo
+
+    from semianalytic.schema import _models_in
+
+    def subclasses(c):
+        for s in c.__subclasses__():
+            yield s
+            yield from subclasses(s)
+
+    models = [c for c in subclasses(BaseModel) if c.__module__.startswith("semianalytic")]
+    changed = []
+    for c in models:
+        for name, f in list(c.__pydantic_fields__.items()):
+            args = typing.get_args(f.annotation)
+            if f.annotation is old or old in args:
+                ann = new if f.annotation is old else new | None
+                info = FieldInfo.from_annotated_attribute(ann, f.default)
+                info.description = f.description
+                c.__pydantic_fields__[name] = info
+                changed.append(c)
+    done: list = []
+    while changed:
+        c = changed.pop(0)
+        if c in done:
+            continue
+        c.model_rebuild(force=True)
+        done.append(c)
+        changed += [h for h in models if h not in done and any(
+            m in done for f in h.__pydantic_fields__.values() for m in _models_in(f.annotation))]
+
+
+ResistanceSpec = _union()
+"""The ``[target.resistance]`` table (a pydantic discriminated union on ``model`` over the registered inputs)."""
 ResistanceField = Annotated[ResistanceSpec, AfterValidator(_builds)]
 """The annotation of ``TargetSection.resistance`` in :mod:`semianalytic.case`."""
 
 _ADAPTER = TypeAdapter(ResistanceSpec)
+_BUILT = True
 
 
 def _message(err: dict) -> str:
@@ -254,7 +376,7 @@ def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
     Raises :class:`InputError` naming the field (``target.resistance.yield_stress``) and what
     was expected.  An already-parsed input model is accepted too.
     """
-    if isinstance(data, (ElasticPlasticInput, BrittleInput, HardeningInput, LimestoneInput, Part4Input, CavityInput, ConstantInput)):
+    if isinstance(data, tuple(_REGISTRY.values())):
         spec = data
     else:
         if not isinstance(data, dict):
@@ -273,3 +395,13 @@ def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
         return spec.build()
     except InputError as exc:
         raise InputError(exc.field.replace("target.resistance", field, 1), exc.message) from None
+
+
+def _load_added_models() -> None:
+    """The models added one file each (:mod:`semianalytic.penetration.resistances`)."""
+    from semianalytic.penetration.resistances import load_all
+
+    load_all()
+
+
+_load_added_models()

@@ -22,7 +22,6 @@ model's validity is warned on stderr, naming the model and the reason.
 
 from __future__ import annotations
 
-import json
 import math
 import sys
 
@@ -49,7 +48,9 @@ def add_arguments(parser) -> None:
     from semianalytic.penetration.options import W1_MODELS
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target], [impact]")
-    parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, provides=("data", "text", "rows"), json_help="print the results as JSON (SI units in the keys)")
     parser.add_argument(
         "--coefficients", choices=("bem", "paper"), default="bem",
         help="A, B, C from the BEM table of the nose (default) or the paper's quoted constants",
@@ -231,6 +232,9 @@ def run(args) -> int:
 
     from semianalytic.cache import override_coefficients
 
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     cases = [override_coefficients(c, contact=args.contact, tolerance=args.tolerance) for c in _load(args.cases)]
     if args.posterior:  # a bad posterior file stops before any table is built
         from semianalytic.calibration.evaluate import check_posterior_files
@@ -273,11 +277,13 @@ def run(args) -> int:
             from semianalytic.errors import one_line
 
             print(one_line(f"{line} [{case.path or case.title}]"), file=sys.stderr)  # a file name may hold a newline
-    if args.json:
+    if fmt != "text":  # the registered formats (semianalytic.report.formats)
+        from semianalytic.penetration.table_out import depth_csv
         from semianalytic.report.output import json_safe  # strict JSON: a non-finite number is null
 
         objs = [dict(r, coefficients=d) for r, d in zip(results, descs)]
-        print(json.dumps(json_safe(objs[0] if len(objs) == 1 else {"cases": objs}), indent=1, allow_nan=False))
+        emit(Output(data=json_safe(objs[0] if len(objs) == 1 else {"cases": objs}), json_options={"indent": 1, "allow_nan": False},
+                    rows=lambda: depth_csv([(str(c.path.name) if c.path else c.title, r) for c, r in zip(cases, results)])), fmt)
     else:
         from semianalytic.penetration.table_out import shot_table
 
@@ -291,12 +297,12 @@ def run(args) -> int:
         from semianalytic.penetration.table_out import depth_csv
 
         atomic_write_text(args.csv, depth_csv([(str(c.path.name) if c.path else c.title, r) for c, r in zip(cases, results)]))
-        if not args.json:
+        if fmt == "text":
             print(f"csv: {args.csv}")
     if args.report is not None:
         from semianalytic.penetration.report import write_report
 
         path = write_report(args.report, cases, args, name=args.report_name, force=args.force)
-        if not args.json:
+        if fmt == "text":
             print(f"report: {path}")
     return 0

@@ -128,9 +128,9 @@ def write_report(out_dir, cases, args=None, *, name: str | None = None, force: b
         section()
     bar.close()
     atomic_write_text(md_path, to_markdown(doc), overwrite=True)
-    from semianalytic.report.html import html_beside
+    from semianalytic.report.report_formats import write_beside
 
-    html_beside(md_path)  # the same report as one self-contained page (figures embedded)
+    write_beside(md_path)  # the registered formats beside it (the self-contained HTML page, figures embedded)
     return md_path
 
 

@@ -249,7 +249,9 @@ class Constant:
 
 Resistance = ElasticPlastic | Brittle | Hardening | Limestone | Part4 | Cavity | Constant
 
-MODELS = ("elastic-plastic", "brittle", "hardening", "limestone", "part4", "cavity", "constant")
+MODELS: list[str] = []
+"""The names of the registered ``[target.resistance]`` models, in order: kept by
+:func:`semianalytic.penetration.case.register_resistance` (the one list of models)."""
 
 
 def resistance_from_case(case) -> Resistance:

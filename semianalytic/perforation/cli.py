@@ -8,7 +8,6 @@ for one or more cases."""
 
 from __future__ import annotations
 
-import json
 import math
 
 
@@ -16,7 +15,9 @@ def add_arguments(parser) -> None:
     from semianalytic.cli_types import output_dir
 
     parser.add_argument("cases", nargs="+", metavar="CASE.toml", help="case file(s) with [projectile], [target] thickness or layers, [impact]")
-    parser.add_argument("--json", action="store_true", help="print the results as JSON (SI units in the keys)")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, json_help="print the results as JSON (SI units in the keys)")
     parser.add_argument("--no-ballistic-limit", action="store_true", help="skip the ballistic-limit search")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder")
     parser.add_argument("--quiet", action="store_true", help="no progress on stderr")
@@ -51,6 +52,9 @@ def run(args) -> int:
     from semianalytic.case import load_case
     from semianalytic.perforation.evaluate import evaluate_case
 
+    from semianalytic.report.formats import Output, chosen_format, emit
+
+    fmt = chosen_format(args)
     cases = [load_case(p) for p in args.cases]
     for c in cases:
         for sec in ("projectile", "target", "impact"):
@@ -75,8 +79,6 @@ def run(args) -> int:
         path = write_report(results, args.report, argv=["perforate", *args.cases, "--report", str(args.report)])
         print(f"wrote {path}")
         return 0
-    if args.json:
-        print(json.dumps(results[0] if len(results) == 1 else results, indent=1))
-    else:
-        print("\n\n".join(_text(r) for r in results))
+    emit(Output(data=results[0] if len(results) == 1 else results, json_options={"indent": 1},
+                text=lambda s: print("\n\n".join(_text(r) for r in results), file=s)), fmt)
     return 0

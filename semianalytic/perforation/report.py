@@ -231,7 +231,7 @@ def write_report(results: list[dict], out_dir, argv: list[str]) -> Path:
                   "beside Part IV's formulas and the Lambert-Jonas fit of the data itself.", ""]
     path = out / "validation_perforation.md"
     atomic_write_text(path, "\n".join(lines))
-    from semianalytic.report.html import html_beside
+    from semianalytic.report.report_formats import write_beside
 
-    html_beside(path)  # the same report as one self-contained page (figures embedded)
+    write_beside(path)  # the registered formats beside it (the self-contained HTML page, figures embedded)
     return path

@@ -6,7 +6,6 @@ for, into one folder (:func:`semianalytic.run.pipeline.run_case`): ``results.jso
 from __future__ import annotations
 
 import argparse
-import json
 from pathlib import Path
 
 from semianalytic.run.case import ANALYSES
@@ -22,7 +21,9 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                         help=f"run only these analyses (repeatable; one of: {', '.join(ANALYSES)})")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render (VTK files are still written)")
     parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
-    parser.add_argument("--json", action="store_true", help="print results.json to stdout as well")
+    from semianalytic.report.formats import add_format_arguments
+
+    add_format_arguments(parser, provides=("data", "text", "rows"), json_help="print results.json to stdout as well")
     parser.add_argument("--contact", choices=("full", "separated"), default=None,
                         help="contact region of eq. (15) in eq. (11) (default: [coefficients].contact)")
     parser.add_argument("--tolerance", default=None, help="relative error of the coefficient table (default 1e-5)")
@@ -34,8 +35,10 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 def run(args: argparse.Namespace) -> int:
     from semianalytic.case import load_case
     from semianalytic.guards import check_case
+    from semianalytic.report.formats import Output, chosen_format, emit
     from semianalytic.run.pipeline import run_case
 
+    fmt = chosen_format(args)
     check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
     if args.csv is not None:
         from semianalytic.penetration.table_out import check_csv_target
@@ -46,18 +49,21 @@ def run(args: argparse.Namespace) -> int:
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir,
         contact=args.contact, tolerance=args.tolerance, quiet=args.quiet,
     )
+    from semianalytic.penetration.table_out import depth_csv
+
+    pen = results["analyses"].get("penetration") or {}
+    rows = lambda: depth_csv([(Path(args.case).name, pen)] if pen else [])
     if args.csv is not None:
         from semianalytic.io import atomic_write_text
-        from semianalytic.penetration.table_out import depth_csv
 
-        pen = results["analyses"].get("penetration") or {}
-        atomic_write_text(args.csv, depth_csv([(Path(args.case).name, pen)] if pen else []))
-    if args.json:
-        print(json.dumps(results, indent=2, default=str))
-    else:
+        atomic_write_text(args.csv, rows())
+
+    def text(stream) -> None:
         for name, why in results["skipped"].items():
-            print(f"skipped {name}: {why}")
-        print(f"report: {(out / 'report.html').resolve()}")
+            print(f"skipped {name}: {why}", file=stream)
+        print(f"report: {(out / 'report.html').resolve()}", file=stream)
         if args.csv is not None:
-            print(f"csv: {args.csv}" + ("" if results["analyses"].get("penetration") else " (header only: the case has no penetration)"))
+            print(f"csv: {args.csv}" + ("" if pen else " (header only: the case has no penetration)"), file=stream)
+
+    emit(Output(data=results, json_options={"indent": 2, "default": str}, text=text, rows=rows), fmt)
     return 0

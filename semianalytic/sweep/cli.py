@@ -62,19 +62,23 @@ def run(args: argparse.Namespace) -> int:
         full=args.full, fmt=args.fmt, scheduler=args.scheduler, workers=args.workers, batch_size=args.batch_size,
         cache_dir=args.cache_dir, resume=args.resume, force=args.force, progress=not args.no_progress)
     info = summary.to_json()
-    if args.json:
-        print(json.dumps({**info, "statistics": stats}, indent=2))
-    else:
-        print(
-            f"{info['n_run']} cases run ({info['n_ok']} ok, {info['n_invalid']} invalid, {info['n_error']} failed), "
-            f"{info['n_skipped_finished_before']} finished before; {summary.cases_per_second:.0f} cases/s "
-            f"on {info['workers']} worker(s); results: {info['results']}"
-        )
-        for col, st in stats.items():
-            if isinstance(st, dict):
-                print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
-                      f"(n = {st['n']})")
+    from semianalytic.report.formats import Output, emit
+
+    emit(Output(data={**info, "statistics": stats}, json_options={"indent": 2},
+                text=lambda s: _text(summary, info, stats, s)), "json" if args.json else "text")
     return 0 if summary.n_error == 0 else 1
+
+
+def _text(summary, info: dict, stats: dict, stream) -> None:
+    print(
+        f"{info['n_run']} cases run ({info['n_ok']} ok, {info['n_invalid']} invalid, {info['n_error']} failed), "
+        f"{info['n_skipped_finished_before']} finished before; {summary.cases_per_second:.0f} cases/s "
+        f"on {info['workers']} worker(s); results: {info['results']}", file=stream,
+    )
+    for col, st in stats.items():
+        if isinstance(st, dict):
+            print(f"  {col}: mean {st['mean']:.6g}, sd {st['std']:.4g}, 5-95 % [{st['p05']:.6g}, {st['p95']:.6g}] "
+                  f"(n = {st['n']})", file=stream)
 
 
 def sweep_case(case_path: str, out: str, vary: list[str] = (), sample: list[str] = (), *, samples: int = 0,
