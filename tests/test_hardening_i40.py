@@ -237,6 +237,7 @@ def _signalled(tmp_path, argv, sig, ready, timeout=120.0):
     deadline = time.monotonic() + timeout
     while time.monotonic() < deadline and proc.poll() is None and not ready(work):
         time.sleep(0.2)
+    assert proc.poll() is None, "the command ended before the signal could be sent"
     proc.send_signal(sig)
     try:
         _, err = proc.communicate(timeout=90)
@@ -259,8 +260,10 @@ def test_signals_leave_no_temporary_file_and_no_traceback(tmp_path, which, signa
                    "--sample", "target.density=normal(2710 kg/m^3, 20 kg/m^3)", "--batch-size", "200"],
                   lambda w: (w / "out" / "results.csv").exists()),
         # the sampler running (its staging folder made)
-        "calibrate": (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", "out", "--steps", "5000",
-                       "--quiet"], lambda w: any(p.name.startswith(".out.") for p in w.iterdir())),
+        # the sampler running: its output is staged only after sampling, so the signal goes 20 s after the start
+        # (imports and the table take a few seconds; 20000 steps take minutes, even on an idle machine)
+        "calibrate": (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", "out", "--steps", "20000",
+                       "--quiet"], lambda w, t0=time.monotonic(): time.monotonic() - t0 > 20.0),
     }[which]
     rc, err, tmpdir, work, home = _signalled(tmp_path, argv, getattr(signal, signame), ready)
     assert rc == 1, err
