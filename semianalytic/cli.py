@@ -72,6 +72,9 @@ def dispatch(prog: str, commands: dict[str, tuple[str, str]], argv: list[str] | 
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2
     module_name, help_ = commands[name]
+    from semianalytic.bundled import resolve_arguments
+
+    rest = resolve_arguments(rest)  # `cases/X.toml` outside a checkout: the bundled case (one note)
     notes: list[str] = []
 
     def collect(message, category, filename, lineno, file=None, line=None) -> None:
