@@ -111,8 +111,8 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic.cavity.report --out reports --force
 	$(PY) -m semianalytic penetrate $(VALIDATION_CASES) --report reports --force
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force
-	$(PY) -m semianalytic.run.benchmark --force
-	$(PY) -m semianalytic.sweep.benchmark --force
+	$(PY) -m benchmarks.run --force
+	$(PY) -m benchmarks.sweep --force
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340.toml --cross-validate --diagnose --steps 12000 --out reports/calibration_piekutowski1999 --report reports/validation.md --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_eroding.toml --cross-validate --out reports/calibration_piekutowski1999_eroding --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_hardness_regimes.toml --model regimes --cross-validate --transfer cases/piekutowski1999_aermet100_hardness_regimes.toml --out reports/calibration_piekutowski1999_regimes --report reports/validation_regimes.md --force
@@ -120,4 +120,4 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic optimize cases/optimize_power_into_fig15a.toml --report reports/optimize_constrained_power.md --force --vary projectile.exponent=0.3:1 --objective depth --constraint mass --constraint length --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_spline_into_fig15a.toml --report reports/optimize_constrained_spline.md --force --vary projectile.control_radii.0=0.3:0.6 --vary projectile.control_radii.1=0.5:0.8 --vary projectile.control_radii.2=0.7:0.95 --objective depth --constraint mass --constraint length --method de --popsize 6 --maxiter 30 --confirm 3 --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_power_deep_drag.toml --report reports/optimize_power.md --force --vary projectile.exponent=0.3:1 --objective deep_drag --scheduler inline --no-progress
-	$(PY) -m semianalytic.optimize.bench --force
+	$(PY) -m benchmarks.optimize --force
