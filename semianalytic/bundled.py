@@ -6,7 +6,8 @@ wheel installs the same files as ``semianalytic/cases/`` (setup.py maps the pack
 ``semianalytic.cases`` onto ``cases/``).  :func:`resolve_arguments` lets the README's commands run
 verbatim from any folder of an installed package: an argument ``cases/NAME`` (or ``--flag=cases/NAME``)
 that names no file in the working folder but a bundled case is replaced by the bundled file, with
-one note on stderr.  A file of that name in the working folder is always the one read.
+one note on stderr (:func:`semianalytic.case.load_case` does the same for the API and the docs'
+examples).  A file of that name in the working folder is always the one read.
 """
 
 from __future__ import annotations
@@ -14,7 +15,7 @@ from __future__ import annotations
 import sys
 from pathlib import Path
 
-__all__ = ["cases_dir", "case_file", "resolve_arguments"]
+__all__ = ["cases_dir", "case_file", "resolve_path", "resolve_arguments"]
 
 PREFIX = "cases/"
 
@@ -43,18 +44,29 @@ def case_file(name: str) -> Path:
     return (root if root is not None else Path(PREFIX)) / name
 
 
+def resolve_path(value: str | Path, stream=None) -> str | Path:
+    """``value`` itself, or, when it is ``cases/NAME`` (or ``./cases/NAME``) and names no file in
+    the working folder but a bundled case, the bundled file (one note on ``stream``, default
+    stderr)."""
+    text = str(value)
+    name = text[2:] if text.startswith("./") else text
+    if not name.startswith(PREFIX) or "/" in name[len(PREFIX):] or Path(text).exists():
+        return value
+    root = cases_dir()
+    bundled = None if root is None else root / name[len(PREFIX):]
+    if bundled is None or not bundled.is_file() or bundled.resolve() == Path(text).resolve():
+        return value
+    print(f"note: {text} is not in this folder; reading the bundled {bundled}", file=stream or sys.stderr)
+    return bundled if isinstance(value, Path) else str(bundled)
+
+
 def resolve_arguments(argv: list[str], stream=None) -> list[str]:
-    """``argv`` with each ``cases/NAME`` that is missing in the working folder but bundled
-    replaced by the bundled file (one note per replacement on ``stream``, default stderr)."""
+    """``argv`` with each ``cases/NAME`` (also ``--flag=cases/NAME``) that is missing in the
+    working folder but bundled replaced by the bundled file (:func:`resolve_path`)."""
     out = []
     for arg in argv:
         head, sep, value = arg.partition("=") if arg.startswith("--") else ("", "", arg)
-        name = value[2:] if value.startswith("./") else value
-        if name.startswith(PREFIX) and "/" not in name[len(PREFIX):] and not Path(value).exists():
-            root = cases_dir()
-            bundled = None if root is None else root / name[len(PREFIX):]
-            if bundled is not None and bundled.is_file():
-                print(f"note: {value} is not in this folder; reading the bundled {bundled}", file=stream or sys.stderr)
-                arg = f"{head}{sep}{bundled}"
+        if value:
+            arg = f"{head}{sep}{resolve_path(value, stream)}"
         out.append(arg)
     return out
