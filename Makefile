@@ -24,10 +24,11 @@ SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 # whenever _ring.c changes (a library built from another version of it is never loaded).
 BUILD_INPUTS := pyproject.toml setup.py semianalytic/bem/_ring.c
 
-# `make demo`: only what the package needs to run (no test or docs tools).
+# `make demo`: only what the package needs to run (no test or docs tools), and no byte-compiling of
+# every installed module (half of pip's CPU time; the modules a command imports compile on first use).
 $(VENV)/.runtime: $(BUILD_INPUTS)
 	test -x $(PY) || python3 -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -e .
+	$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -e .
 	touch $@
 
 $(VENV)/.installed: $(BUILD_INPUTS)
