@@ -26,7 +26,7 @@ from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")
 
 
 @pytest.fixture
@@ -139,7 +139,7 @@ def test_kernels_match_independent_references(case, tol, path, monkeypatch):
     if path == "numpy":
         monkeypatch.setattr(kernels, "compiled", lambda: None)
     elif kernels.compiled() is None:
-        pytest.skip("no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
+        pytest.skip("no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")
     S, Dl = (float(v) for v in kernels.single_double(*case))
     Se, De = _elliptic_reference(*case)
     Sq, Dq = _quad_reference(*case)
