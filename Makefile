@@ -1,6 +1,11 @@
 # Two entry points (see README): `make demo` and `make test`.
 VENV   ?= .venv
 PY     := $(VENV)/bin/python
+# The second leg of `make test`: the newest supported Python (requires-python in pyproject.toml),
+# from pyenv (`pyenv install 3.13`) unless PYTHON313 names an interpreter.
+VENV313   ?= .venv313
+PYENV_ROOT ?= $(shell pyenv root 2>/dev/null || echo $(HOME)/.pyenv)
+PYTHON313 ?= $(lastword $(sort $(wildcard $(PYENV_ROOT)/versions/3.13*/bin/python3.13)))
 # Small dense BEM solves are much slower with threaded BLAS on a loaded 2-core machine.
 export OPENBLAS_NUM_THREADS ?= 1
 export OMP_NUM_THREADS ?= 1
@@ -8,28 +13,57 @@ export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 export PYVISTA_OFF_SCREEN ?= true
 
-.PHONY: demo test check bench reports clean
+.PHONY: demo test test-311 test-313 check bench reports clean
 
 # The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
 # executable_path (never `playwright install`: no browser download); installed here when missing.
 export CHROMIUM ?= /usr/bin/chromium
 SUDO := $(shell [ "$$(id -u)" = 0 ] || echo sudo)
 
-$(VENV)/.installed: pyproject.toml
+# An editable install builds the compiled ring kernels into semianalytic/bem/ (setup.py): again
+# whenever _ring.c changes (a library built from another version of it is never loaded).
+BUILD_INPUTS := pyproject.toml setup.py semianalytic/bem/_ring.c
+
+# `make demo`: only what the package needs to run (no test or docs tools), and no byte-compiling of
+# every installed module (half of pip's CPU time; the modules a command imports compile on first use).
+$(VENV)/.runtime: $(BUILD_INPUTS)
 	test -x $(PY) || python3 -m venv $(VENV)
-	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	$(PY) -m pip install --quiet --disable-pip-version-check --no-compile -e .
 	touch $@
 
-demo: $(VENV)/.installed
+$(VENV)/.installed: $(BUILD_INPUTS)
+	test -x $(PY) || python3 -m venv $(VENV)
+	$(PY) -m pip install --quiet --disable-pip-version-check -e ".[test]"
+	touch $@ $(VENV)/.runtime
+
+# Before anything runs: the 3.13 leg's interpreter is there, or one line says how to get it.
+.PHONY: python313
+python313:
+	@test -n "$(PYTHON313)" && test -x "$(PYTHON313)" || { echo "error: make test needs Python 3.13 for its second leg: none under $(PYENV_ROOT)/versions/3.13* (pyenv install 3.13, or PYTHON313=/path/to/python3.13)" >&2; exit 2; }
+
+# The 3.13 leg takes the newest releases the dependency ranges allow (--upgrade, eager).
+$(VENV313)/.installed: $(BUILD_INPUTS) | python313
+	test -x $(VENV313)/bin/python || $(PYTHON313) -m venv $(VENV313)
+	$(VENV313)/bin/python -m pip install --quiet --disable-pip-version-check --upgrade --upgrade-strategy eager -e ".[test]"
+	touch $@
+
+demo: $(VENV)/.runtime
 	$(PY) -m semianalytic demo
 
-# The import contracts of pyproject.toml (layers, pure models, fem_check kept apart), then the suite.
-test: $(VENV)/.installed $(CHROMIUM)
+# The whole suite on the oldest and the newest supported Python: 3.11 with the compiled kernels,
+# 3.13 on the numpy kernels (SEMIANALYTIC_KERNEL=numpy: the fallback of a build without a C
+# compiler runs the whole suite too).  The import contracts of pyproject.toml first.
+test: python313 test-311 test-313
+
+test-311: $(VENV)/.installed $(CHROMIUM)
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile
 
+test-313: $(VENV313)/.installed $(CHROMIUM)
+	SEMIANALYTIC_KERNEL=numpy $(VENV313)/bin/python -m pytest -q -n 2 --dist loadfile
+
 # The inner loop (about a minute on two idle cores): the suite without the `long` tests
-# (tests/conftest.py lists them; `make test` runs them too).
+# (tests/conftest.py lists them; `make test` runs them too), on 3.11.
 check: $(VENV)/.installed
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not long"
@@ -54,7 +88,7 @@ reports: bench
 	$(PY) tests/hardening_tally.py --out reports
 
 clean:
-	rm -rf $(VENV) meshes/cache .pytest_cache site
+	rm -rf $(VENV) $(VENV313) meshes/cache .pytest_cache site build dist semianalytic/bem/_ring.*.so
 
 # The documentation site (MkDocs + mkdocstrings, mkdocs.yml) into site/ (ignored by git);
 # warnings are errors, as in tests/test_docs.py.
@@ -78,8 +112,8 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic.cavity.report --out reports --force
 	$(PY) -m semianalytic penetrate $(VALIDATION_CASES) --report reports --force
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force
-	$(PY) -m semianalytic.run.benchmark --force
-	$(PY) -m semianalytic.sweep.benchmark --force
+	$(PY) -m benchmarks.run --force
+	$(PY) -m benchmarks.sweep --force
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340.toml --cross-validate --diagnose --steps 12000 --out reports/calibration_piekutowski1999 --report reports/validation.md --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_eroding.toml --cross-validate --out reports/calibration_piekutowski1999_eroding --force --quiet
 	$(PY) -m semianalytic calibrate cases/piekutowski1999_var4340_hardness_regimes.toml --model regimes --cross-validate --transfer cases/piekutowski1999_aermet100_hardness_regimes.toml --out reports/calibration_piekutowski1999_regimes --report reports/validation_regimes.md --force
@@ -87,4 +121,4 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic optimize cases/optimize_power_into_fig15a.toml --report reports/optimize_constrained_power.md --force --vary projectile.exponent=0.3:1 --objective depth --constraint mass --constraint length --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_spline_into_fig15a.toml --report reports/optimize_constrained_spline.md --force --vary projectile.control_radii.0=0.3:0.6 --vary projectile.control_radii.1=0.5:0.8 --vary projectile.control_radii.2=0.7:0.95 --objective depth --constraint mass --constraint length --method de --popsize 6 --maxiter 30 --confirm 3 --scheduler inline --no-progress
 	$(PY) -m semianalytic optimize cases/optimize_power_deep_drag.toml --report reports/optimize_power.md --force --vary projectile.exponent=0.3:1 --objective deep_drag --scheduler inline --no-progress
-	$(PY) -m semianalytic.optimize.bench --force
+	$(PY) -m benchmarks.optimize --force

@@ -428,7 +428,8 @@ def parse_case(data: Mapping[str, Any], path: Path | None = None) -> Case:
 
 def load_case(path: str | Path) -> Case:
     """Read and validate a TOML case file.  Raises ``InputError`` (exit status 2)."""
+    from semianalytic.bundled import resolve_path
     from semianalytic.schema import read_toml_text
 
-    path = Path(path)
+    path = Path(resolve_path(path))  # `cases/X.toml` outside a checkout: the bundled case (one note)
     return parse_case(read_toml_text(path), path)

@@ -21,7 +21,7 @@ from semianalytic.guards import set_memory_limit
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
     "coefficients": ("semianalytic.coefficients.cli", "BEM drag coefficients A(P), B(P), C(P) (Part I, eqs. 12-15)"),
-    "bench-bem": ("semianalytic.coefficients.bench", "benchmark the BEM against exact solutions; writes reports/bench_bem.md"),
+    "bench-bem": ("benchmarks.bench_bem", "benchmark the BEM against exact solutions; writes reports/bench_bem.md"),
     "penetrate": ("semianalytic.penetration.cli", "depth and time of penetration, critical impact velocity (Part I)"),
     "perforate": ("semianalytic.perforation.cli", "perforation of plates: residual velocity, ballistic limit (Part I eq. 11, Part IV)"),
     "cavity": ("semianalytic.cavity.cli", "brittle spherical-cavity expansion (Part II)"),
@@ -92,6 +92,9 @@ def _dispatch_command(prog: str, commands: dict[str, tuple[str, str]], name: str
         print(f"error: command: unknown command {name!r}; try {prog} --help", file=sys.stderr)
         return 2
     module_name, help_ = commands[name]
+    from semianalytic.bundled import resolve_arguments
+
+    rest = resolve_arguments(rest)  # `cases/X.toml` outside a checkout: the bundled case (one note)
     notes: list[str] = []
 
     def collect(message, category, filename, lineno, file=None, line=None) -> None:
@@ -126,7 +129,12 @@ def _dispatch_command(prog: str, commands: dict[str, tuple[str, str]], name: str
 
 def _run_command(prog: str, name: str, module_name: str, help_: str, rest: list[str]) -> int:
     try:
-        module = importlib.import_module(module_name)
+        if module_name.startswith("benchmarks."):  # not installed: from a checkout only
+            from semianalytic.checkout import import_benchmark
+
+            module = import_benchmark(module_name, f"{prog} {name}")
+        else:
+            module = importlib.import_module(module_name)
         parser = OneLineParser(prog=f"{prog} {name}", description=help_)
         module.add_arguments(parser)
         parser.add_argument("--memory-limit", type=memory_size, default=None, metavar="SIZE",

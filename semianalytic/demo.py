@@ -1,5 +1,5 @@
 """``python -m semianalytic demo`` (``make demo``): run the bundled Fig. 5 case
-``cases/demo_fig5_ogive.toml`` into ``--out`` (default: the folder ``demo`` of the per-user
+``cases/demo_fig5_ogive.toml`` (installed with the package: :mod:`semianalytic.bundled`) into ``--out`` (default: the folder ``demo`` of the per-user
 cache, ``$SEMIANALYTIC_CACHE_DIR/demo`` when set; an earlier demo there is replaced) and print
 the path of ``report.html``.  Nothing is written where the command runs unless asked."""
 
@@ -9,8 +9,9 @@ import argparse
 import time
 from pathlib import Path
 
-ROOT = Path(__file__).resolve().parent.parent
-CASE = ROOT / "cases" / "demo_fig5_ogive.toml"
+from semianalytic.bundled import case_file
+
+CASE = case_file("demo_fig5_ogive.toml")  # the package data semianalytic.cases (cases/ of a checkout)
 
 
 def default_out() -> Path:
@@ -34,7 +35,7 @@ def run(args: argparse.Namespace) -> int:
     from semianalytic.run.pipeline import run_case
 
     if not CASE.is_file():
-        raise InputError("case", f"the bundled demo case {CASE} is missing (run from a checkout of the project)")
+        raise InputError("case", f"the bundled demo case {CASE} is missing (reinstall the package)")
     t0 = time.perf_counter()
     out = Path(args.out) if args.out is not None else default_out()
     command = "python -m semianalytic demo" + ("" if args.out is None else f" --out {out.name}") \

@@ -1,41 +1,43 @@
-"""The per-user cache folder, and C sources compiled there on first use (this project's own).
+"""The per-user cache folder, and the C kernels compiled when the package is built (this project's own).
 
-:func:`cache_root` is the folder of every per-user cache (coefficient tables, fem_check meshes,
-compiled kernels): ``$SEMIANALYTIC_CACHE_DIR`` if set, else platformdirs' user cache folder
-(``~/.cache/semianalytic`` on Linux).  It lives here, at the bottom of the layers, so that the
-models (``bem``) can find their compiled kernels without importing :mod:`semianalytic.cache`.
+:func:`cache_root` is the folder of every per-user cache (coefficient tables, fem_check meshes):
+``$SEMIANALYTIC_CACHE_DIR`` if set, else platformdirs' user cache folder (``~/.cache/semianalytic``
+on Linux).  It lives here, at the bottom of the layers, so that the models (``bem``) need not import
+:mod:`semianalytic.cache`.  Nothing in that folder is ever executed or loaded as code.
 
-:func:`load_library` compiles a C source of the package with the system C compiler (``$CC`` if
-set, else sysconfig's ``CC``, else ``cc``) into ``cache_root()/native/<name>-<hash>.so``, the hash
-being of the source and the compiler flags, and loads it with ctypes; later processes only load
-it (about a millisecond).  The library is written under a temporary name and renamed, so that
-two processes compiling at once (pytest -n 2) never load a half-written file.  Nothing is
-written into the source tree.  No compiler, a failed compilation or an unwritable cache give
-``None`` (one debug line in the log), and the caller keeps its numpy code.
+:func:`load_library` loads, with ctypes, a shared library that ``pip install`` (or ``pip install
+-e``, or ``python -m build``) compiled next to its C source inside the installed package
+(``setup.py``: a setuptools ``Extension`` named after the source, e.g.
+``semianalytic/bem/_ring.cpython-311-x86_64-linux-gnu.so``), and only that file: no compiler runs
+at run time and no path a user can write to is searched.  The library carries the SHA-256 of the
+source it was built from (``ring_source_sha256()``); a library built from another version of the
+source (an editable install whose ``.c`` changed since), a library that does not load, or none at
+all (no compiler when the package was built: the extension is optional) give ``None`` and the
+caller keeps its numpy code; the first two with one warning, the last with one debug line.
 
-Flags: ``-O3 -fPIC -shared -fno-fast-math -ffp-contract=off -fno-math-errno``; not
-``-march=native``.  IEEE arithmetic with each operation rounded as written: no contraction of
-``a*b + c`` into a fused multiply-add (GCC contracts by default wherever the target has FMA,
-aarch64 always, x86-64 with ``-march=native``), so the compiled kernels round like the numpy
-ones, operation for operation, except the polynomials' order of summation.  ``-march=native``
-bought nothing measurable here (the kernel loop calls ``log`` and is not vectorised) and would
-make a library built on one machine crash with an illegal instruction on an older one sharing
-the same home folder (clusters).  ``-fno-math-errno`` only lets ``sqrt`` be one instruction
-(no ``errno`` is read anywhere); the results are the same.
+Flags (setup.py): ``-O3 -fno-fast-math -ffp-contract=off -fno-math-errno``; not ``-march=native``.
+IEEE arithmetic with each operation rounded as written: no contraction of ``a*b + c`` into a fused
+multiply-add (GCC contracts by default wherever the target has FMA, aarch64 always, x86-64 with
+``-march=native``), so the compiled kernels round like the numpy ones, operation for operation,
+except the polynomials' order of summation.  ``-march=native`` would make a wheel built on one
+machine crash with an illegal instruction on an older one; the AVX2 clones of ``_ring.c`` are picked
+by the processor at load time instead.  ``-fno-math-errno`` only lets ``sqrt`` be one instruction (no
+``errno`` is read anywhere); the results are the same.
 """
 
 from __future__ import annotations
 
 import ctypes
+import hashlib
 import os
+import warnings
 from pathlib import Path
 
 _char, _addressof = ctypes.c_char, ctypes.addressof
 
-__all__ = ["CACHE_ENV", "NATIVE_ENV", "cache_root", "native_dir", "load_library", "address", "CFLAGS"]
+__all__ = ["CACHE_ENV", "cache_root", "library_path", "load_library", "address"]
 
 CACHE_ENV = "SEMIANALYTIC_CACHE_DIR"
-CFLAGS = ("-O3", "-fPIC", "-shared", "-fno-fast-math", "-ffp-contract=off", "-fno-math-errno")
 
 
 def address(a) -> int | None:
@@ -72,81 +74,41 @@ def cache_root() -> Path:
     return Path(user_cache_dir("semianalytic", appauthor=False))
 
 
-NATIVE_ENV = "SEMIANALYTIC_NATIVE_DIR"
+def library_path(source: Path) -> Path | None:
+    """The library built from the C ``source`` at install time, next to it (the interpreter's
+    extension-module suffixes, in its order of preference), or None."""
+    import importlib.machinery
 
-
-def native_dir() -> Path:
-    """The folder of the compiled libraries: ``$SEMIANALYTIC_NATIVE_DIR`` if set, else
-    ``cache_root()/native``.  The variable lets processes with their own table caches (the test
-    suite gives many tests a fresh ``$SEMIANALYTIC_CACHE_DIR``) share one compiled library
-    instead of compiling it again in each (about 0.25 s)."""
-    env = os.environ.get(NATIVE_ENV)
-    return Path(env).expanduser() if env else cache_root() / "native"
-
-
-def _compiler() -> list[str] | None:
-    """The C compiler command: ``$CC`` when set (and then only it), else sysconfig's ``CC`` or
-    ``cc``, the first found on the PATH; None when there is none."""
-    import shlex
-    import shutil
-    import sysconfig
-
-    env = os.environ.get("CC")
-    for cand in (env,) if env else (sysconfig.get_config_var("CC"), "cc"):
-        cmd = shlex.split(cand or "")
-        if cmd and shutil.which(cmd[0]):
-            return cmd
+    for suffix in importlib.machinery.EXTENSION_SUFFIXES:
+        path = source.with_name(source.stem + suffix)
+        if path.is_file():
+            return path
     return None
 
 
-def _compile(source: Path, target: Path) -> bool:
-    import subprocess
-    import tempfile
-
-    cmd = _compiler()
-    if cmd is None:
-        _debug("no C compiler found ($CC, sysconfig CC, cc): numpy kernels")
-        return False
-    target.parent.mkdir(parents=True, exist_ok=True)
-    fd, tmp = tempfile.mkstemp(prefix=f".{target.name}.", suffix=".tmp", dir=target.parent)
-    os.close(fd)
-    # the compiler's own temporary files (cc*.s, cc*.o) in a folder of ours, removed whatever happens
-    # (issue 40: a compiler killed by Ctrl-C or SIGTERM left them in $TMPDIR)
-    scratch = tempfile.mkdtemp(prefix=f".{target.name}.cc-", dir=target.parent)
-    try:
-        try:
-            proc = subprocess.run([*cmd, *CFLAGS, "-o", tmp, str(source), "-lm"], capture_output=True, text=True,
-                                  timeout=300, env={**os.environ, "TMPDIR": scratch})
-        except subprocess.SubprocessError as exc:  # a compiler that hangs
-            _debug("compiling %s failed (%s): numpy kernels", source.name, exc)
-            return False
-        if proc.returncode != 0:
-            _debug("compiling %s failed (%s): numpy kernels\n%s", source.name, " ".join(cmd), proc.stderr)
-            return False
-        os.chmod(tmp, 0o755)
-        os.replace(tmp, target)
-        return True
-    finally:
-        if os.path.exists(tmp):
-            os.unlink(tmp)
-        import shutil
-
-        shutil.rmtree(scratch, ignore_errors=True)
-
-
-def load_library(source: Path):
-    """The C ``source`` compiled (on first use) into the per-user cache and loaded (a
-    ``ctypes.CDLL``), or None."""
-    import ctypes
-    import hashlib
-
-    try:
-        data = source.read_bytes()
-        key = hashlib.sha256(data + "\0".join(CFLAGS).encode()).hexdigest()[:20]
-        target = native_dir() / f"{source.stem.lstrip('_')}-{key}.so"
-        if not target.is_file() and not _compile(source, target):
-            return None
-        return ctypes.CDLL(str(target))
-    except OSError as exc:  # unwritable cache, a library that does not load
-        _debug("compiled %s unavailable (%s): numpy kernels", source.name, exc)
+def load_library(source: Path, check: str = "ring_source_sha256"):
+    """The library built from the C ``source`` when the package was installed, loaded (a
+    ``ctypes.CDLL``), or None: not built, not loadable, or built from another version of
+    ``source`` (its function ``check`` returns the SHA-256 of the source it was compiled from)."""
+    path = library_path(source)
+    if path is None:
+        _debug("no compiled %s next to %s (built without a C compiler): numpy kernels", source.stem, source)
         return None
+    try:
+        lib = ctypes.CDLL(str(path))
+        fn = getattr(lib, check)
+    except (OSError, AttributeError) as exc:
+        warnings.warn(f"{path} does not load ({exc}); the numpy kernels are used (reinstall the package)",
+                      RuntimeWarning, stacklevel=3)
+        return None
+    fn.restype, fn.argtypes = ctypes.c_char_p, []
+    try:
+        want = hashlib.sha256(source.read_bytes()).hexdigest()
+    except OSError:  # the source is not installed beside its library: nothing to compare
+        return lib
+    got = (fn() or b"").decode("ascii", "replace")
+    if got != want:
+        warnings.warn(f"{path.name} was built from another version of {source.name}; the numpy kernels are used "
+                      "(rebuild: pip install -e . in a checkout, or reinstall)", RuntimeWarning, stacklevel=3)
+        return None
+    return lib

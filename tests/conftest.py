@@ -15,15 +15,6 @@ try:
 except ImportError:  # the property tests skip themselves without hypothesis
     settings = None
 
-# One folder of compiled kernels for the whole session (and the subprocesses that inherit the
-# environment): many tests give a command a fresh $SEMIANALYTIC_CACHE_DIR, and each would
-# otherwise compile the C ring kernels again (semianalytic/native.py, about 0.25 s each).  The
-# tests of the compilation itself set their own folder.
-if not os.environ.get("SEMIANALYTIC_NATIVE_DIR"):
-    import tempfile
-
-    os.environ["SEMIANALYTIC_NATIVE_DIR"] = os.path.join(tempfile.gettempdir(), f"semianalytic-native-test-{os.getuid()}")
-
 if settings is not None:
     settings.register_profile("ci", derandomize=True, print_blob=True, deadline=None)
     settings.register_profile("dev", print_blob=True, deadline=None)
@@ -92,8 +83,7 @@ LONG = {
     "tests/test_nanostrength_cli.py::test_report_written_and_not_overwritten",
     "tests/test_sweep_external.py::test_sweep_on_an_external_scheduler",
     "tests/test_optimize_plates.py::test_optimize_a_plate_objective",
-    "tests/test_ring_kernel_c.py::test_native_dir_is_shared_across_table_caches",
-    "tests/test_ring_kernel_c.py::test_compiled_once_into_the_cache_folder",
+    "tests/test_ring_kernel_c.py::test_nothing_planted_in_the_cache_is_loaded",
     "tests/test_tables_speed_and_reach.py::test_truncated_ogive_shallow_direct_solve_through_the_cli",
     "tests/test_optimize_spline.py::test_spline_case_fem_against_bem",
     "tests/test_optimize_spline.py::test_spline_optimize_vary_key_checks",

@@ -8,7 +8,7 @@ import pytest
 
 from semianalytic.bem import kernels
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no C compiler: the numpy kernels only")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy): the numpy kernels only")
 
 
 def _nodes(n, seed):

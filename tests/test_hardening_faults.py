@@ -265,7 +265,7 @@ def test_file_name_with_a_newline_is_shown_escaped(tmp_path):
 
 
 def test_bench_bem_quick_names_a_case_that_exists():
-    from semianalytic.coefficients import bench
+    from benchmarks import bench_bem as bench
 
     text = Path(bench.__file__).read_text()
     named = [w.strip('"') for w in text.split() if w.startswith('"cases/') or w.startswith('["cases/')]

@@ -2,12 +2,14 @@
 references independent of both: the ring integrals of Part I, eqs. (20)-(22), by scipy's
 elliptic integrals and by direct azimuthal quadrature (scipy.integrate.quad); the sphere's
 added mass 1/2 (exact) on both paths; the numpy fallback when asked for
-(SEMIANALYTIC_KERNEL=numpy) and when the C compiler is missing or fails.
+(SEMIANALYTIC_KERNEL=numpy); the library built at install time (setup.py) the only one loaded:
+no compiler at run time, nothing in the per-user cache loaded, a library of another source refused.
 """
 
 from __future__ import annotations
 
 import math
+import ast
 import os
 import subprocess
 import sys
@@ -24,7 +26,7 @@ from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")
 
 
 @pytest.fixture
@@ -137,7 +139,7 @@ def test_kernels_match_independent_references(case, tol, path, monkeypatch):
     if path == "numpy":
         monkeypatch.setattr(kernels, "compiled", lambda: None)
     elif kernels.compiled() is None:
-        pytest.skip("no compiled kernels (no C compiler, or SEMIANALYTIC_KERNEL=numpy)")
+        pytest.skip("no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")
     S, Dl = (float(v) for v in kernels.single_double(*case))
     Se, De = _elliptic_reference(*case)
     Sq, Dq = _quad_reference(*case)
@@ -161,11 +163,17 @@ def test_sphere_added_mass_on_both_paths(monkeypatch):
     assert np.allclose(c.phi_nodes, n.phi_nodes, rtol=0, atol=1e-13 * np.max(np.abs(n.phi_nodes)))
 
 
+def _setup_constant(name):
+    """A constant of setup.py, read without running it (setuptools need not be installed)."""
+    tree = ast.parse((ROOT / "setup.py").read_text())
+    (value,) = [n.value for n in tree.body if isinstance(n, ast.Assign) and any(getattr(t, "id", "") == name for t in n.targets)]
+    return ast.literal_eval(value)
+
+
 def _backend_in_fresh_process(tmp_path, **env):
-    # the suite's shared folder of compiled kernels (conftest.py) is left out: each test here
-    # compiles (or not) into its own fresh cache folder, unless it names a folder itself
-    base = {k: v for k, v in os.environ.items() if k != "SEMIANALYTIC_NATIVE_DIR"}
-    full = {**base, "PYTHONPATH": str(ROOT), "SEMIANALYTIC_CACHE_DIR": str(tmp_path), **env}
+    """The kernels' backend in a fresh process with the per-user cache at ``tmp_path`` (and
+    ``env``), after one kernel evaluation checked against scipy's elliptic integrals."""
+    full = {**os.environ, "PYTHONPATH": str(ROOT), "SEMIANALYTIC_CACHE_DIR": str(tmp_path), **env}
     code = ("import logging, warnings; warnings.simplefilter('error');"
             "from semianalytic.bem import kernels; import numpy as np;"
             "S, D = kernels.single_double(0.3, 0.8, -0.2, 0.5, 0.6, 0.8); print(kernels.backend(), float(S))")
@@ -179,35 +187,66 @@ def _backend_in_fresh_process(tmp_path, **env):
 
 def test_numpy_when_asked(tmp_path):
     assert _backend_in_fresh_process(tmp_path, SEMIANALYTIC_KERNEL="numpy") == "numpy"
-    assert not (tmp_path / "native").exists()  # nothing compiled
+    assert not list(tmp_path.iterdir())  # nothing written into the cache
 
 
+@needs_c
 @pytest.mark.parametrize("cc", ["/nonexistent/bin/cc", "false"])
-def test_numpy_when_the_compiler_is_missing_or_fails(tmp_path, cc):
-    assert _backend_in_fresh_process(tmp_path, CC=cc) == "numpy"
-    assert not list(tmp_path.rglob("*.so"))  # no half-written library left behind
+def test_no_compiler_at_run_time(tmp_path, cc):
+    """The kernels were compiled when the package was installed: a missing or failing compiler
+    changes nothing, and nothing is written into the cache folder."""
+    assert _backend_in_fresh_process(tmp_path, CC=cc) == "c"
+    assert not list(tmp_path.iterdir())
+
+
+@pytest.mark.parametrize("content", [b"", b"\x7fELF" + b"\0" * 60, b"not a library"])
+def test_nothing_planted_in_the_cache_is_loaded(tmp_path, content):
+    """Files at the names the run-time compiler once used (``native/ring-<hash>.so`` under the
+    per-user cache: truncated, a bare ELF header, garbage) are never opened: the backend is the
+    one the installed package has, with no warning, no crash."""
+    native = tmp_path / "native"
+    native.mkdir()
+    for name in ("ring-0123456789abcdef0123.so", "ring.so", "_ring.so"):
+        (native / name).write_bytes(content)
+    want = "c" if kernels.compiled() is not None else "numpy"
+    assert _backend_in_fresh_process(tmp_path) == want
+    assert _backend_in_fresh_process(tmp_path, SEMIANALYTIC_NATIVE_DIR=str(native)) == want
 
 
 @needs_c
-def test_compiled_once_into_the_cache_folder(tmp_path):
-    assert _backend_in_fresh_process(tmp_path) == "c"
-    (lib,) = (tmp_path / "native").glob("ring-*.so")
-    assert not list((tmp_path / "native").glob(".*"))  # the temporary file was renamed
-    mtime = lib.stat().st_mtime_ns
-    assert _backend_in_fresh_process(tmp_path, CC="/nonexistent/bin/cc") == "c"  # loaded, not rebuilt
-    assert lib.stat().st_mtime_ns == mtime
-    assert not list((ROOT / "semianalytic" / "bem").glob("*.so"))  # never in the source tree
+def test_library_of_another_source_is_refused(tmp_path):
+    """native.load_library loads a library only beside the source it was built from (its
+    ring_source_sha256 against the source's SHA-256): the installed library beside a copy of
+    _ring.c loads; beside a changed copy (a stale editable build) it is refused with one warning
+    and the caller keeps numpy; a garbage file at the library's name gives one warning, no crash."""
+    import shutil
+    import warnings
 
+    from semianalytic import native
 
-@needs_c
-def test_native_dir_is_shared_across_table_caches(tmp_path):
-    """$SEMIANALYTIC_NATIVE_DIR names the folder of the compiled kernels: a process with another
-    table cache loads the library compiled there instead of compiling its own."""
-    shared = tmp_path / "native-shared"
-    assert _backend_in_fresh_process(tmp_path / "a", SEMIANALYTIC_NATIVE_DIR=str(shared)) == "c"
-    assert len(list(shared.glob("ring-*.so"))) == 1 and not (tmp_path / "a" / "native").exists()
-    # a missing compiler in the second process: it can only have loaded the shared library
-    assert _backend_in_fresh_process(tmp_path / "b", SEMIANALYTIC_NATIVE_DIR=str(shared), CC="/nonexistent/bin/cc") == "c"
+    lib = native.library_path(kernels._SOURCE)
+
+    def beside(folder, text=None, library=None):  # a fresh folder each: a loaded library stays mapped
+        folder.mkdir()
+        src = folder / "_ring.c"
+        src.write_text(kernels._SOURCE.read_text() if text is None else text)
+        if library is None:
+            shutil.copyfile(lib, folder / lib.name)
+        elif library:
+            (folder / lib.name).write_bytes(library)
+        return src
+
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert native.load_library(beside(tmp_path / "same")) is not None
+    with pytest.warns(RuntimeWarning, match="another version"):
+        assert native.load_library(beside(tmp_path / "changed", kernels._SOURCE.read_text() + "\n/* changed */\n")) is None
+    with pytest.warns(RuntimeWarning, match="does not load"):
+        assert native.load_library(beside(tmp_path / "garbage", library=b"not a library")) is None
+    src = beside(tmp_path / "none", library=b"")
+    with warnings.catch_warnings():
+        warnings.simplefilter("error")
+        assert native.load_library(src) is None  # not built: numpy, silently (one debug line)
 
 
 @needs_c
@@ -399,19 +438,23 @@ def test_wide_build_gives_the_baseline_numbers(tmp_path, monkeypatch):
     Exact equality: any difference in operations would show in the last bits of some entry."""
     import ctypes
 
-    from semianalytic import native
     from semianalytic.bem.panels import LayoutOptions, halfspace_layout
     from semianalytic.bem.solve import assemble, plan_assembly
     from semianalytic.coefficients.study import study_nose
 
-    cmd = native._compiler()
-    if cmd is None:
+    import shlex
+    import shutil
+    import sysconfig
+
+    cmd = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
+    if not cmd or shutil.which(cmd[0]) is None:
         pytest.skip("no C compiler")
     cpu = Path("/proc/cpuinfo")
     if not (cpu.is_file() and " avx2" in cpu.read_text()):  # else both builds run the baseline code
         pytest.skip("the processor has no AVX2: the wide clones do not run here")
     so = tmp_path / "ring-baseline.so"
-    proc = subprocess.run([*cmd, *native.CFLAGS, "-DRING_BASELINE", "-o", str(so), str(kernels._SOURCE), "-lm"],
+    flags = _setup_constant("RING_CFLAGS")  # the flags of the installed build
+    proc = subprocess.run([*cmd, *flags, "-fPIC", "-shared", "-DRING_BASELINE", "-o", str(so), str(kernels._SOURCE), "-lm"],
                           capture_output=True, text=True, timeout=300)
     assert proc.returncode == 0, proc.stderr
     baseline = kernels.configured(ctypes.CDLL(str(so)))

@@ -236,7 +236,7 @@ def test_block_sums_of_the_rules_match_adaptive_quadrature(kind, f):
 def test_baseline_only_rewrites_its_section_and_needs_a_baseline(tmp_path):
     """bench-bem --baseline-only replaces the issue-24 section of an existing bench_bem.md (the
     other sections kept, no second copy); without --baseline-python it is bad input (exit 2, one line)."""
-    from semianalytic.coefficients import bench
+    from benchmarks import bench_bem as bench
 
     path = tmp_path / "bench_bem.md"
     path.write_text("# BEM benchmark\n\nintro\n\n" + bench.INTERLEAVED_TITLE + "\n\nold numbers\n\n## Later\n\nkept\n")

@@ -46,10 +46,18 @@ def _md_escape(text: str) -> str:
     return (text or "").replace("|", "\\|").replace("*", "\\*").replace("<", "&lt;").replace("_", "\\_")
 
 
+def _module(module_name: str):
+    if module_name.startswith("benchmarks."):  # the checkout's benchmarks/ (not installed), as the CLI does
+        from semianalytic.checkout import import_benchmark
+
+        return import_benchmark(module_name, module_name)
+    return importlib.import_module(module_name)
+
+
 def _parser(prog: str, name: str, module_name: str, help_: str) -> argparse.ArgumentParser:
     from semianalytic.cli_types import OneLineParser
 
-    module = importlib.import_module(module_name)
+    module = _module(module_name)
     parser = OneLineParser(prog=f"{prog} {name}", description=help_)
     module.add_arguments(parser)
     parser.add_argument("--memory-limit", default=None, metavar="SIZE",
@@ -76,7 +84,7 @@ def command_page(prog: str, name: str, module_name: str, help_: str) -> str:
     parser = _parser(prog, name, module_name, help_)
     usage = parser.format_usage().replace("usage: ", "").strip()
     lines = [f"# `{prog} {name}`", "", _md_escape(help_[:1].upper() + help_[1:]) + ".", ""]
-    doc = inspect.getdoc(importlib.import_module(module_name)) or ""
+    doc = inspect.getdoc(_module(module_name)) or ""
     doc = re.sub(r":\w+:`~?([^`]+)`", r"`\1`", doc).replace("``", "`")  # reST roles and literals as Markdown code
     paragraphs = [p for p in doc.split("\n\n") if p.strip()]
     if paragraphs and paragraphs[0].strip().startswith("`python -m"):

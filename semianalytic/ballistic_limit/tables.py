@@ -20,6 +20,7 @@ from dataclasses import dataclass
 from pathlib import Path
 
 from semianalytic.ballistic_limit.shots import PAPER_PROJECTILE_DENSITY, Layer, Shot
+from semianalytic.bundled import cases_dir
 from semianalytic.errors import InputError
 
 __all__ = [
@@ -39,7 +40,7 @@ __all__ = [
     "load_table5",
 ]
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
+CASES = cases_dir() or Path("cases")  # the bundled cases (semianalytic.bundled)
 GPa, mm, g, g_cm3 = 1e9, 1e-3, 1e-3, 1e3  # unit scales to SI
 
 

@@ -4,8 +4,9 @@
  * dense blocks of assemble() (semianalytic/bem/solve.py: the surface against itself and against
  * its mirror image, once per pair) with the column weights applied, and the near and self rules of
  * PairQuadrature.integrate after the panel geometry (ring_pair_rules, the kernels of the same
- * block() as the others).  The numpy code of kernels.py and solve.py is the reference and the
- * fallback.
+ * block() as the others).  Built when the package is installed (setup.py, a setuptools Extension
+ * loaded with ctypes by semianalytic/native.py); the numpy code of kernels.py and solve.py is the
+ * reference and the fallback.
  *
  * K(1 - q), E(1 - q) from the Cephes approximations (S. L. Moshier; scipy.special.ellipkm1 /
  * ellipe), K = P_K(q) - ln(q) Q_K(q), E = P_E(q) - ln(q) q Q_E(q), by Horner's scheme (the
@@ -31,6 +32,13 @@
 #define WIDE
 #endif
 #define SPLIT_TERMS 10
+
+/* The SHA-256 of this file, given by setup.py when it builds the library (-DRING_SOURCE_SHA256="..."):
+ * semianalytic/native.py loads the library only when it matches the installed source. */
+#ifndef RING_SOURCE_SHA256
+#define RING_SOURCE_SHA256 ""
+#endif
+const char *ring_source_sha256(void) { return RING_SOURCE_SHA256; }
 
 /* The polynomials, filled once by the loader from kernels.py (one home for the numbers):
  * the Cephes P_K, Q_K, P_E (11 coefficients) and Q_E (10), highest power first, and the

@@ -24,10 +24,11 @@ spurious singularity on the axis (where 1 - m -> 1) into both parts of the split
 :func:`single_double`, :func:`single_double_split` and the dense blocks of the assembly
 (:func:`single_double_dense`, and once per pair :func:`single_double_dense_sym` against the
 surface itself and :func:`single_double_dense_mirror` against its mirror image) run compiled
-from ``_ring.c`` (the same polynomials, passed from here, and the same formulas; built on
-first use into the per-user cache by :mod:`semianalytic.native`) when a C compiler is at hand,
-else, or with ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's
-own speed-up; the two agree to a few units of 1e-16).  The same library, under the same
+from ``_ring.c`` (the same polynomials, passed from here, and the same formulas; compiled when
+the package is built or installed, setup.py, and loaded from the package folder by
+:mod:`semianalytic.native`: nothing is compiled at run time) when that library is there, else, or
+with ``SEMIANALYTIC_KERNEL=numpy``, as the numpy code of this module (this project's own speed-up;
+the two agree to a few units of 1e-16; CI runs the whole suite on each, docs/packaging.md).  The same library, under the same
 dispatch, sums the near and self rules of the assembly after the panel geometry
 (:func:`pair_rules_compiled`) and evaluates the geometry of panels on lines, arcs and a table
 nose's cubic spline (``PanelSet.evaluate``, ``relative``).
@@ -182,12 +183,21 @@ _N = ctypes.c_ssize_t
 
 @functools.cache
 def compiled():
-    """The compiled ring kernels (ctypes library), or None: ``$SEMIANALYTIC_KERNEL=numpy``, no C
-    compiler or a failed build (:func:`semianalytic.native.load_library`; cached per user)."""
+    """The compiled ring kernels (ctypes library), or None: ``$SEMIANALYTIC_KERNEL=numpy``, or no
+    library built from this ``_ring.c`` in the package folder (:func:`semianalytic.native.load_library`)."""
     if os.environ.get(KERNEL_ENV, "").strip().lower() == "numpy":
         return None
     lib = load_library(_SOURCE)
-    return None if lib is None else configured(lib)
+    if lib is None:
+        return None
+    try:
+        return configured(lib)
+    except AttributeError as exc:  # a library without one of the kernels: not this _ring.c
+        import warnings
+
+        warnings.warn(f"the compiled ring kernels lack a function ({exc}); the numpy kernels are used",
+                      RuntimeWarning, stacklevel=2)
+        return None
 
 
 def configured(lib):

@@ -243,11 +243,13 @@ def MOVES():
     return [(emcee.moves.DEMove(), 0.8), (emcee.moves.DESnookerMove(), 0.2)]
 RHAT_MAX = 1.01  # Vehtari et al. (2021), Bayesian Analysis 16:667: R-hat < 1.01 and ESS > 400
 ESS_MIN = 400
+TAIL_PROB = (0.05, 0.95)  # the tail ESS: the 5 % and 95 % quantiles' indicators (Vehtari et al. 2021, sec. 4.3)
 
 
 def chain_diagnostics(chains, names) -> dict:
     """Per parameter: arviz's rank-normalised split R-hat and bulk and tail effective sample
-    sizes (Vehtari, Gelman, Simpson, Carpenter & Buerkner 2021, Bayesian Analysis 16:667) of
+    sizes (Vehtari, Gelman, Simpson, Carpenter & Buerkner 2021, Bayesian Analysis 16:667; arviz 0.x
+    or 1.x, the same numbers) of
     ``chains`` (n_chains, n_draws, n_params), and ``warnings`` naming each parameter with R-hat >
     1.01 or an ESS below 400 (the thresholds of that paper)."""
     import warnings as _w
@@ -264,7 +266,8 @@ def chain_diagnostics(chains, names) -> dict:
             x = chains[:, :, j]
             rhat = float(az.rhat(x))
             bulk = float(az.ess(x, method="bulk"))
-            tail = float(az.ess(x, method="tail"))
+            # the tail quantiles given: arviz 1.x has no default for them (0.x: the same 5 % and 95 %)
+            tail = float(az.ess(x, method="tail", prob=TAIL_PROB))
             out[name] = {"r_hat": rhat, "ess_bulk": bulk, "ess_tail": tail}
             if not rhat <= RHAT_MAX:
                 warn.append(f"{name}: R-hat {rhat:.3f} > {RHAT_MAX} (the chains disagree; sample longer or reparametrise)")

@@ -10,7 +10,7 @@ asks for, computed by the models and handed to :mod:`semianalytic.report` as doc
   field and the FEM field of fem_check, the only import of :mod:`fem_check.api`),
   :mod:`.part1` (coefficients, penetration, critical velocity, validation), :mod:`.part2`
   (cavity), :mod:`.parts34` (ballistic limit, nanostrength);
-- :mod:`~semianalytic.run.benchmark`: run times -> ``reports/bench_run.md``.
+- :mod:`~benchmarks.run`: run times -> ``reports/bench_run.md``.
 
 Importing this package is cheap; :mod:`.pipeline` imports the steps.
 """

@@ -5,5 +5,5 @@
 - :mod:`~semianalytic.sweep.engine`: batches on a dask cluster, append-as-completed, resume;
 - :mod:`~semianalytic.sweep.store`: the results file (CSV or Parquet parts);
 - :mod:`~semianalytic.sweep.cli`: the ``sweep`` command;
-- :mod:`~semianalytic.sweep.benchmark`: the throughput benchmark (``reports/bench_sweep.md``).
+- :mod:`~benchmarks.sweep`: the throughput benchmark (``reports/bench_sweep.md``).
 """
