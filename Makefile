@@ -111,6 +111,7 @@ report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic.ballistic_limit.report --out reports --force
 	$(PY) -m semianalytic.cavity.report --out reports --force
 	$(PY) -m semianalytic penetrate $(VALIDATION_CASES) --report reports --force
+	$(PY) -m semianalytic perforate cases/perforation_ogive_6061T651.toml cases/perforation_ogive_6061T651_constant.toml cases/perforation_part4_table3.toml cases/perforation_steel12_hemispherical.toml --report reports
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force
 	$(PY) -m benchmarks.run --force
 	$(PY) -m benchmarks.sweep --force
