@@ -13,7 +13,7 @@ import pytest
 
 from semianalytic.cli import main
 from semianalytic.penetration import regime as rg
-from semianalytic.penetration.peers import tate_penetration
+from tate_reference import tate_penetration_ode as tate_penetration
 from case_blocks import TARGET_6061_T651
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
@@ -23,7 +23,7 @@ ROD = dict(length=0.0711, nose_length=0.0118, diameter=7.11e-3)
 @pytest.mark.parametrize("Y_p, R_t, rho_p", [(1.64e9, 1.45e9, 7830.0), (1.0e9, 1.45e9, 7830.0), (2.48e9, 1.2e9, 7890.0),
                                              (1.0e9, 2.0e9, 2710.0)])
 def test_eroding_depth_against_time_integration(Y_p, R_t, rho_p):
-    """The quadrature in v against peers.tate_penetration (DOP853 in time, rtol 1e-11), off any
+    """The quadrature in v against the time integration of tests/tate_reference.py (DOP853 in time, rtol 1e-11), off any
     grid, Y_p above and below R_t and equal densities: both converge, so 1e-7 relative is a
     loose bound on two methods that agree to ~1e-10."""
     U = np.array([317.0, 733.0, 1411.0, 2333.0, 2987.0])
