@@ -18,6 +18,9 @@ import math
 
 import numpy as np
 
+from semianalytic.penetration.hardness import VICKERS_HALF_ANGLE  # noqa: F401  (re-exported)
+from semianalytic.penetration.hardness import meyer_from_vickers_number as meyer_hardness
+
 __all__ = [
     "VICKERS_HALF_ANGLE",
     "meyer_hardness",
@@ -35,14 +38,8 @@ __all__ = [
     "stopping_thickness",
 ]
 
-# Angle between a face of the Vickers pyramid and its axis (136 deg / 2).
-VICKERS_HALF_ANGLE = math.radians(68.0)
-
-
-def meyer_hardness(HV):
-    """Meyer hardness (load / projected area) from Vickers hardness (load / facet area):
-    HM = HV / sin(68 deg) = 1.0785 HV (errata item 25; used in R(1) of Table 2)."""
-    return np.asarray(HV, dtype=float)[()] / math.sin(VICKERS_HALF_ANGLE)
+# meyer_hardness(HV): HM = HV / sin(68 deg) = 1.0785 HV (errata item 25; used in R(1) of Table 2), from the one
+# home of the conversion and of the 68-degree constant (penetration/hardness.py)
 
 
 def resistance_part4(Y, E):

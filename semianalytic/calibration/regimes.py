@@ -72,8 +72,8 @@ class Options:
     resistance: str = "tate1986"
     rod_strength: str = "static_ultimate"
     deforming: str = "two_stage"
-    discrepancy: str = "shared"
-    rigid_depth: str = "part1"
+    discrepancy: str = "per_regime"
+    rigid_depth: str = "forrestal"
     nose_load: str = "part1"
     deformed_depth: str = "forrestal"
 
@@ -999,6 +999,19 @@ def posterior_json(case, shots: RegimeShots, opt: Options, sample: dict, n_store
     }
 
 
+def posterior_parameters(draws: dict, opt: Options, idx) -> dict:
+    """The keyword arguments of :func:`predict` from a posterior's draws (``samples`` of the JSON) at
+    the indices ``idx``: ``f`` (``nose_load_factor`` of the nose-load model sets, else
+    ``dynamic_factor``), ``sigma`` (n, 2), ``tau``, ``b`` (``breakup_factor`` or None), ``e``
+    (``erosion_factor`` or None).  The interface ``predict_case`` uses."""
+    first = parameter_names(opt)[0]
+    sd = draws.get("sigma_deformed")
+    sig = np.column_stack([draws["sigma"][idx], (sd if sd is not None else draws["sigma"])[idx]])
+    get = (lambda k: np.asarray(draws[k])[idx] if k in draws else None)
+    return {"f": np.asarray(draws[first])[idx], "sigma": sig, "tau": np.asarray(draws["tau"])[idx],
+            "b": get("breakup_factor"), "e": get("erosion_factor")}
+
+
 def is_regimes_posterior(path) -> bool:
     """Whether ``path`` holds a regimes posterior (False for anything else, read or not)."""
     import json
@@ -1022,15 +1035,15 @@ def read_regimes_posterior(path, case) -> dict:
 
     try:
         obj = json.loads(Path(path).read_text())
-        opt = Options(**obj["options"])
-        draws = {k: np.asarray(obj["samples"][k], float) for k in ("dynamic_factor", "sigma", "tau")}
-        for k in ("breakup_factor", "sigma_deformed"):
+        opt = Options.from_dict(obj["options"])
+        draws = {k: np.asarray(obj["samples"][k], float) for k in (parameter_names(opt)[0], "sigma", "tau")}
+        for k in ("breakup_factor", "erosion_factor", "sigma_deformed"):
             if k in obj["samples"]:
                 draws[k] = np.asarray(obj["samples"][k], float)
         sig = obj["signature"]
     except (OSError, ValueError, KeyError, TypeError) as exc:
         raise InputError("--posterior", f"{path}: not a readable regimes posterior ({exc})") from None
-    if obj.get("version") != REGIMES_VERSION:
+    if obj.get("version") not in (1, REGIMES_VERSION):
         raise InputError("--posterior", f"{path}: version {obj.get('version')!r}, expected {REGIMES_VERSION}")
     mine = geometry_signature(case)
     other_nose = []
@@ -1044,12 +1057,11 @@ def read_regimes_posterior(path, case) -> dict:
             continue
         raise InputError("--posterior", f"{path}: fitted for {k} = {v!r}, the case has {w!r} (another target: "
                                         "refit with calibrate --model regimes)")
-    for k, vals in (("onset", rg.ONSET_CRITERIA), ("erosion", rg.EROSION_CRITERIA), ("resistance", rg.RESISTANCE_RELATIONS),
-                    ("rod_strength", rg.ROD_STRENGTHS), ("deforming", rg.DEFORMING_MODELS),
-                    ("discrepancy", DISCREPANCIES), ("rigid_depth", RIGID_DEPTHS)):
+    for k, vals in OPTION_VALUES.items():
         if getattr(opt, k) not in vals:
             raise InputError("--posterior", f"{path}: unknown model set {k} = {getattr(opt, k)!r}")
-    for k, need in (("breakup_factor", _uses_breakup(opt)), ("sigma_deformed", opt.discrepancy == "per_regime")):
+    for k, need in (("breakup_factor", _uses_breakup(opt)), ("erosion_factor", uses_nose_load(opt)),
+                    ("sigma_deformed", opt.discrepancy == "per_regime")):
         if need and (k not in draws or len(draws[k]) != len(draws["sigma"])):
             raise InputError("--posterior", f"{path}: samples.{k} missing or of another length than samples.sigma "
                                             f"(the model set {opt.label()} needs it)")
@@ -1105,10 +1117,8 @@ def predict_case(case, coefficients, path, U, probs=(0.05, 0.25, 0.5, 0.75, 0.95
     shots = shots_at(case, coefficients, U)
     d = post["draws"]
     idx = np.linspace(0, len(d["sigma"]) - 1, min(PREDICTION_DRAWS, len(d["sigma"]))).astype(int)
-    sd = d.get("sigma_deformed")
-    sig = np.column_stack([d["sigma"][idx], (sd if sd is not None else d["sigma"])[idx]])
-    b = d["breakup_factor"][idx] if "breakup_factor" in d else None
-    pred = predict(shots, post["options"], d["dynamic_factor"][idx], sig, d["tau"][idx], probs, b=b)
+    kw = posterior_parameters(d, post["options"], idx)
+    pred = predict(shots, post["options"], kw["f"], kw["sigma"], kw["tau"], probs, b=kw["b"], e=kw["e"])
     lo, hi = post["raw"]["velocity_range_m_s"]
     holds = (shots.velocity >= 0.9 * lo) & (shots.velocity <= 1.1 * hi)
     q = np.where(holds[None, :], pred["quantiles"], np.nan)

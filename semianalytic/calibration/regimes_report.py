@@ -301,7 +301,7 @@ def _nose_sections(doc, result) -> None:
         rows = [[f"{r['hardness_hrc']:g}", f"{r['onset_m_s']:.0f}", f"{r['breakup_m_s']:.0f}", f"{r['erosion_m_s']:.0f}",
                  f"{r['tip_onset_m_s']:.0f}", f"{r['part1_usc_m_s']:.0f}"] for r in ss["rows"]]
         doc.table(["hardness [HRC]", "onset U_y [m/s]", "breakup U_b [m/s]", "erosion U_e [m/s]",
-                   "tip criterion (no geometry) [m/s]", "Part I U_sC at the case's Y_p [m/s]"], rows,
+                   "tip criterion (no geometry) [m/s]", "Part I U_sC, eqs. (33)/(36), at the case's Y_p = f sigma_y [m/s]"], rows,
                   caption=f"{ss['quote']}: beside it, the ogive-fitted criteria for that rod (sphere, L = 74.675 mm, "
                           "rho_p = 8000 kg/m^3) on the case's target.")
         r0 = ss["rows"][-1]
@@ -314,7 +314,10 @@ def _nose_sections(doc, result) -> None:
                  "the seed's. The nose effect has the seed's sign and order of magnitude (hundreds of m/s earlier than "
                  "the ogive's); which stage the seed's 'irreversible changes of shape and instability of motion' names "
                  "(first yield, or the visible deformation we call the breakup) the statement does not say. It is one "
-                 "quoted number and was not fitted.")
+                 "quoted number and was not fitted. Part I's own U_sC (eq. (36)) with the rod's Y_p = f sigma_y of the "
+                 f"case gives {r0['part1_usc_m_s']:.0f} m/s: it rests on the small difference Ybar_p - Rbar_t (tens of "
+                 "MPa here), so it swings by hundreds of m/s with Y_p; with the seed's inferred Y_p = 2135 MPa it "
+                 "returns the 1000 m/s by construction (the Appendix's inverse problem).")
     doc.heading("What stays untested")
     doc.para("No second nose's shots were available here (the bundled shots are all 3-CRH ogives): the nose-load "
              "criteria are fitted and scored on one nose, and their transfer to another nose is checked only by the "

@@ -126,7 +126,7 @@ def _print_text(result: dict, desc: str, file=None) -> None:
           f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
     elif result.get("regime_rule") == "nose_load":
         p(f"  regimes (the nose's own load against the rod's Meyer hardness): rigid below U_y = "
-          f"{_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, bent (Forrestal depth) to U_b = "
+          f"{_fmt(result['transition_velocity_m_s'], 1, 0)} m/s (Forrestal depth), bent (Forrestal depth) to U_b = "
           f"{_fmt(result['breakup_velocity_m_s'], 1, 0)} m/s, eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s; "
           f"Alekseevskii-Tate rod from U_b (Y_p = {result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = "
           f"{result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")

@@ -30,7 +30,8 @@ import numpy as np
 from semianalytic.errors import InputError
 
 __all__ = ["E140_HRC_HV", "HRC_RANGE", "DEFAULT_DYNAMIC_FACTOR", "vickers_from_rockwell_c", "yield_stress_from_vickers",
-           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "dynamic_yield_stress", "parse_hardness"]
+           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "meyer_from_vickers_number",
+           "VICKERS_HALF_ANGLE", "dynamic_yield_stress", "parse_hardness"]
 
 # ASTM E140, Table 1: HRC -> HV (non-austenitic steels), HRC 20..68
 E140_HRC_HV = (
@@ -79,11 +80,20 @@ def ultimate_strength_from_vickers(hv):
     return (-99.8 + 3.734 * np.asarray(hv, float))[()] * 1e6
 
 
-VICKERS_MEYER_RATIO = math.sin(math.radians(68.0))
+VICKERS_HALF_ANGLE = math.radians(68.0)
+"""Angle between a face of the Vickers pyramid and its axis (136 deg / 2, ISO 6507-1): the one home of
+the 68-degree constant (the Meyer conversion here and the indenter of ballistic_limit/indentation.py)."""
+VICKERS_MEYER_RATIO = math.sin(VICKERS_HALF_ANGLE)
 """HV / Meyer hardness of the Vickers pyramid (136 deg between faces, d the indent's diagonal):
 HV = F / (contact surface, d^2 / (2 sin 68 deg)), Meyer hardness = F / (projected area, d^2 / 2),
 so H_M = HV / sin 68 deg = 1.0785 HV (Tabor 1951, The Hardness of Metals, ch. 1 and 6; ISO 6507-1 for the definition of HV)."""
 KGF_MM2 = 9.80665e6  # 1 kgf/mm^2 in Pa (HV is stated in kgf/mm^2)
+
+
+def meyer_from_vickers_number(hv):
+    """H_M / HV in the same units: H_M = HV / sin 68 deg = 1.0785 HV (:data:`VICKERS_MEYER_RATIO`; errata
+    item 25 of Part IV); vectorised.  The one home of the conversion."""
+    return (np.asarray(hv, float) / VICKERS_MEYER_RATIO)[()]
 
 
 def meyer_hardness_from_vickers(hv):
@@ -91,7 +101,7 @@ def meyer_hardness_from_vickers(hv):
     indents plastically) from HV: H_M = HV x 9.80665 MPa / sin 68 deg (:data:`VICKERS_MEYER_RATIO`,
     Tabor 1951).  Tabor's point is that this pressure, about 3 times the flow stress, is itself the
     resistance of the surface to plastic indentation, so no strength conversion enters."""
-    return (np.asarray(hv, float) * KGF_MM2 / VICKERS_MEYER_RATIO)[()]
+    return (meyer_from_vickers_number(hv) * KGF_MM2)[()]
 
 
 def yield_stress_from_hardness(hrc, field: str = "projectile.hardness"):

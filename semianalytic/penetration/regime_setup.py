@@ -137,8 +137,9 @@ of Part I, eqs. (33)/(36), then the shank eroded down to the nose length; this p
 kept as a named option; it lost on transfer.  ``nose_load`` (the default, the ``Options()`` default of
 the regimes calibration, chosen by the leave-one-steel-out transfer among the model sets that order the
 noses and whose eroded depth rises with velocity): the transitions are where the dynamic load of the
-case's own nose reaches kappa (S - s_0), S = H_M, b H_M, e H_M (:mod:`.nose_load`); the depth is Part I's
-while rigid, Forrestal's rigid-nose depth for a bent rod that keeps its nose (U_y <= U_s < U_b), and the
+case's own nose reaches kappa (S - s_0), S = H_M, b H_M, e H_M (:mod:`.nose_load`); the depth is Forrestal's
+rigid-nose depth while rigid and for a bent rod that keeps its nose (U_s < U_b; the peer of ``penetrate``,
+the data authors' cavity constants where ``[data]`` gives them, else A Y = R_t, B = 3/2), and the
 Alekseevskii-Tate rod's from U_b with Tate's (1986) R_t and the rod's static ultimate strength
 (:data:`.regime.ROD_FLOW_FACTOR`)."""
 DEFAULT_REGIME_RULE = "nose_load"
@@ -270,8 +271,8 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
             from semianalytic.penetration.validation import peer_depths
 
             peers = {**(peers or {}), **peer_depths(case, setup, U)}
-        bent = np.asarray(peers["forrestal"], float)
-        depth = np.where(U < U_y, part1, np.where(U < U_b, bent, er.depth))
+        fd = np.asarray(peers["forrestal"], float)  # the rigid and the bent rod (the transfer's choice)
+        depth = np.where(U < U_b, fd, er.depth)
     elif rule in ("tate_tabor", "meyer"):  # Part I below U_b, the eroding rod beyond (tate_tabor: U_b = U_y)
         depth = np.where(U < U_b, part1, er.depth)
     else:
