@@ -148,3 +148,17 @@ def test_regimes_section_and_option_flag(tmp_path, capsys):
     assert code == 2 and "rigid_depth" in err and "forrestal" in err
     with pytest.raises(Exception, match="go together"):
         R.options_for(None, ["onset=meyer_tip"])
+    # penetrate without a posterior follows the [regimes] nose load and depth choices
+    nodata = tmp_path / "nodata.toml"
+    nodata.write_text(p.read_text()[: p.read_text().index("[data]")])
+    plain = tmp_path / "plain.toml"
+    plain.write_text(nodata.read_text().replace('nose_load = "forrestal"\ndeformed_depth = "part1"\n', ""))
+    outs = []
+    for case in (plain, nodata):
+        assert main(["penetrate", str(case), "--json", "--coefficients", "paper"]) == 0
+        outs.append(json.loads(capsys.readouterr().out))
+    assert outs[0]["transition_velocity_m_s"] != pytest.approx(outs[1]["transition_velocity_m_s"], rel=1e-3)
+    d = outs[1]
+    for i, (u, reg) in enumerate(zip(d["striking_velocity_m_s"], d["regime"])):
+        if reg == "deforming" and u < d["breakup_velocity_m_s"]:
+            assert d["depth_m"][i] == d["depth_elastic_exact_rod_m"][i]  # deformed_depth = "part1"

@@ -183,6 +183,12 @@ def _tate_or_part1_resistance(case, setup) -> tuple[float, str]:
     return float(setup.resistance_pa), "Part I (the case's resistance model)"
 
 
+def _regimes_choices(case) -> dict:
+    """The case's ``[regimes]`` keys (penetration/regimes_case.py), {} without the section."""
+    sec = case.section("regimes") if hasattr(case, "section") else None
+    return sec.choices() if sec is not None else {}
+
+
 def _nose_load_labels(case, setup, U, ei: ErodingInputs):
     """``regime_labels`` of the ``nose_load`` rule (:data:`REGIME_RULES`, :data:`NOSE_LOAD_DEFAULTS`)."""
     from semianalytic.calibration.regimes import case_nose_loads
@@ -191,8 +197,9 @@ def _nose_load_labels(case, setup, U, ei: ErodingInputs):
     from semianalytic.penetration.nose_load import transition_velocity
 
     d = NOSE_LOAD_DEFAULTS
+    ch = _regimes_choices(case)
     _, _, f, H_M = rod_strengths(case, setup)
-    L = case_nose_loads(case, setup)[d["nose_load"]]
+    L = case_nose_loads(case, setup)[ch.get("nose_load", d["nose_load"])]
     k = d["kappa"]
     U_y = float(transition_velocity(k, H_M, L.static, L.linear, L.quadratic))
     U_e = max(U_y, float(transition_velocity(k, d["erosion_factor"] * H_M, L.static, L.linear, L.quadratic)))
@@ -207,12 +214,21 @@ def _nose_load_labels(case, setup, U, ei: ErodingInputs):
             from semianalytic.penetration.hardness import vickers_from_yield_stress
 
             HV = float(vickers_from_yield_stress(setup.yield_stress / f))
-        Y_p = rg.ROD_FLOW_FACTOR * float(ultimate_strength_from_vickers(HV))
-        notes.append(f"projectile.dynamic_yield_stress not given: the eroding rod uses Y_p = its static ultimate strength "
-                     f"from the hardness = {Y_p / 1e6:.0f} MPa (Pavlina & Van Tyne 2008, eq. (5); factor "
+        from semianalytic.penetration.hardness import yield_stress_from_vickers
+
+        if ch.get("rod_strength") == "static_yield":
+            Y_p, what = rg.ROD_FLOW_FACTOR * float(yield_stress_from_vickers(HV)), "static yield stress"
+            eq = "(4)"
+        else:
+            Y_p, what, eq = rg.ROD_FLOW_FACTOR * float(ultimate_strength_from_vickers(HV)), "static ultimate strength", "(5)"
+        notes.append(f"projectile.dynamic_yield_stress not given: the eroding rod uses Y_p = its {what} "
+                     f"from the hardness = {Y_p / 1e6:.0f} MPa (Pavlina & Van Tyne 2008, eq. {eq}; factor "
                      f"{rg.ROD_FLOW_FACTOR:g})")
     if getattr(case.target.resistance, "eroding_resistance", None) is None:
-        R_t, src = _tate_or_part1_resistance(case, setup)
+        if ch.get("resistance") == "part1":
+            R_t, src = float(setup.resistance_pa), "Part I, eq. (16) ([regimes] resistance)"
+        else:
+            R_t, src = _tate_or_part1_resistance(case, setup)
         notes.append(f"target.resistance.eroding_resistance not given: the eroding rod uses R_t = {R_t / 1e6:.0f} MPa ({src})")
     ei = ErodingInputs(**{**ei.__dict__, "rod_strength": float(Y_p), "target_resistance": float(R_t),
                           "defaults": tuple(notes)})
@@ -271,8 +287,11 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
             from semianalytic.penetration.validation import peer_depths
 
             peers = {**(peers or {}), **peer_depths(case, setup, U)}
-        fd = np.asarray(peers["forrestal"], float)  # the rigid and the bent rod (the transfer's choice)
-        depth = np.where(U < U_b, fd, er.depth)
+        ch = _regimes_choices(case)
+        pick = {"forrestal": np.asarray(peers["forrestal"], float), "part1": part1}
+        rigid = pick[ch.get("rigid_depth", "forrestal")]  # the transfer's choice: Forrestal for both
+        bent = pick[ch.get("deformed_depth", "forrestal")]
+        depth = np.where(U < U_y, rigid, np.where(U < U_b, bent, er.depth))
     elif rule in ("tate_tabor", "meyer"):  # Part I below U_b, the eroding rod beyond (tate_tabor: U_b = U_y)
         depth = np.where(U < U_b, part1, er.depth)
     else:
