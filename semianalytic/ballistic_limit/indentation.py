@@ -19,8 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semianalytic.ballistic_limit.theory import meyer_hardness
-from semianalytic.penetration.hardness import VICKERS_HALF_ANGLE
+from semianalytic.ballistic_limit.theory import VICKERS_HALF_ANGLE, meyer_hardness
 
 __all__ = [
     "Indenter",

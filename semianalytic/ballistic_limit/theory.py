@@ -18,9 +18,6 @@ import math
 
 import numpy as np
 
-from semianalytic.penetration.hardness import VICKERS_HALF_ANGLE  # noqa: F401  (re-exported)
-from semianalytic.penetration.hardness import meyer_from_vickers_number as meyer_hardness
-
 __all__ = [
     "VICKERS_HALF_ANGLE",
     "meyer_hardness",
@@ -38,8 +35,15 @@ __all__ = [
     "stopping_thickness",
 ]
 
-# meyer_hardness(HV): HM = HV / sin(68 deg) = 1.0785 HV (errata item 25; used in R(1) of Table 2), from the one
-# home of the conversion and of the 68-degree constant (penetration/hardness.py)
+# Angle between a face of the Vickers pyramid and its axis (136 deg / 2): the one home of the 68-degree
+# constant and of the Meyer conversion below (penetration/hardness.py and ballistic_limit/indentation.py use them).
+VICKERS_HALF_ANGLE = math.radians(68.0)
+
+
+def meyer_hardness(HV):
+    """Meyer hardness (load / projected area) from Vickers hardness (load / facet area):
+    HM = HV / sin(68 deg) = 1.0785 HV (errata item 25; used in R(1) of Table 2)."""
+    return np.asarray(HV, dtype=float)[()] / math.sin(VICKERS_HALF_ANGLE)
 
 
 def resistance_part4(Y, E):

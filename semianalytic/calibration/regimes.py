@@ -50,6 +50,7 @@ import numpy as np
 
 from semianalytic.penetration import regime as rg
 from semianalytic.penetration.nose_load import NOSE_LOADS, transition_velocity
+from semianalytic.penetration.regime_setup import case_nose_loads
 
 __all__ = ["RegimeShots", "Options", "DEFAULT_OPTIONS", "OPTION_SETS", "F_PRIOR", "SIGMA_PRIOR_SCALE",
            "model_outcome", "grid_posterior", "predict", "transfer_scores", "sample_regimes"]
@@ -746,26 +747,6 @@ def _tate1986_resistance(case) -> float:
     res = case.target.resistance
     return (rg.tate_resistance(res.yield_stress, res.youngs_modulus)
             if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress") else math.nan)
-
-
-def case_nose_loads(case, setup, law=None) -> dict:
-    """{kind: NoseLoad} of the case's nose and target (:mod:`.nose_load`): Part I's deep-limit
-    Bbar, Cbar and R_t of the case's coefficients; the cavity-expansion law of the Forrestal peer
-    (:func:`.validation.peer_inputs`: the data authors' constants where ``[data]`` gives them, else
-    A Y = R_t, B = 3/2) with the nose factors N_1, N_2 of the actual nose."""
-    from semianalytic.geometry import nose_from_section
-    from semianalytic.penetration import peers
-    from semianalytic.penetration.nose_load import nose_load_of
-    from semianalytic.penetration.validation import peer_inputs
-
-    ci = setup.critical_inputs()
-    area = math.pi * ci.diameter**2 / 4.0
-    N1, N2 = peers.nose_factors(nose_from_section(case.require("projectile")))
-    if law is None:
-        law, _ = peer_inputs(case, setup)
-    kw = dict(Bbar=ci.B / area, Cbar=ci.C / area, resistance=ci.resistance_pa, target_density=ci.target_density,
-              cavity=law, N1=N1, N2=N2)
-    return {k: nose_load_of(k, **kw) for k in NOSE_LOADS}
 
 
 def regime_shots(case, coefficients) -> RegimeShots:

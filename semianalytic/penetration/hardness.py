@@ -27,6 +27,8 @@ import math
 
 import numpy as np
 
+from semianalytic.ballistic_limit.theory import VICKERS_HALF_ANGLE  # the one home of the 68-degree constant
+from semianalytic.ballistic_limit.theory import meyer_hardness as meyer_from_vickers_number  # HM = HV / sin 68 deg
 from semianalytic.errors import InputError
 
 __all__ = ["E140_HRC_HV", "HRC_RANGE", "DEFAULT_DYNAMIC_FACTOR", "vickers_from_rockwell_c", "yield_stress_from_vickers",
@@ -80,9 +82,6 @@ def ultimate_strength_from_vickers(hv):
     return (-99.8 + 3.734 * np.asarray(hv, float))[()] * 1e6
 
 
-VICKERS_HALF_ANGLE = math.radians(68.0)
-"""Angle between a face of the Vickers pyramid and its axis (136 deg / 2, ISO 6507-1): the one home of
-the 68-degree constant (the Meyer conversion here and the indenter of ballistic_limit/indentation.py)."""
 VICKERS_MEYER_RATIO = math.sin(VICKERS_HALF_ANGLE)
 """HV / Meyer hardness of the Vickers pyramid (136 deg between faces, d the indent's diagonal):
 HV = F / (contact surface, d^2 / (2 sin 68 deg)), Meyer hardness = F / (projected area, d^2 / 2),
@@ -90,18 +89,12 @@ so H_M = HV / sin 68 deg = 1.0785 HV (Tabor 1951, The Hardness of Metals, ch. 1 
 KGF_MM2 = 9.80665e6  # 1 kgf/mm^2 in Pa (HV is stated in kgf/mm^2)
 
 
-def meyer_from_vickers_number(hv):
-    """H_M / HV in the same units: H_M = HV / sin 68 deg = 1.0785 HV (:data:`VICKERS_MEYER_RATIO`; errata
-    item 25 of Part IV); vectorised.  The one home of the conversion."""
-    return (np.asarray(hv, float) / VICKERS_MEYER_RATIO)[()]
-
-
 def meyer_hardness_from_vickers(hv):
     """Meyer hardness [Pa] (the mean contact pressure over the projected area at which a steel
     indents plastically) from HV: H_M = HV x 9.80665 MPa / sin 68 deg (:data:`VICKERS_MEYER_RATIO`,
     Tabor 1951).  Tabor's point is that this pressure, about 3 times the flow stress, is itself the
     resistance of the surface to plastic indentation, so no strength conversion enters."""
-    return (meyer_from_vickers_number(hv) * KGF_MM2)[()]
+    return (np.asarray(meyer_from_vickers_number(hv), float) * KGF_MM2)[()]
 
 
 def yield_stress_from_hardness(hrc, field: str = "projectile.hardness"):

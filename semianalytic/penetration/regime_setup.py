@@ -24,7 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from semianalytic.errors import InputError
+from semianalytic.penetration import peers
 from semianalytic.penetration import regime as rg
+from semianalytic.penetration.nose_load import NOSE_LOADS, nose_load_of
 
 __all__ = [
     "RESPONSE_REGIME",
@@ -183,6 +185,24 @@ def _tate_or_part1_resistance(case, setup) -> tuple[float, str]:
     return float(setup.resistance_pa), "Part I (the case's resistance model)"
 
 
+def case_nose_loads(case, setup, law=None) -> dict:
+    """{kind: NoseLoad} of the case's nose and target (:mod:`.nose_load`): Part I's deep-limit
+    Bbar, Cbar and R_t of the case's coefficients; the cavity-expansion law of the Forrestal peer
+    (:func:`.validation.peer_inputs`: the data authors' constants where ``[data]`` gives them, else
+    A Y = R_t, B = 3/2) with the nose factors N_1, N_2 of the actual nose."""
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.penetration.validation import peer_inputs
+
+    ci = setup.critical_inputs()
+    area = math.pi * ci.diameter**2 / 4.0
+    N1, N2 = peers.nose_factors(nose_from_section(case.require("projectile")))
+    if law is None:
+        law, _ = peer_inputs(case, setup)
+    kw = dict(Bbar=ci.B / area, Cbar=ci.C / area, resistance=ci.resistance_pa, target_density=ci.target_density,
+              cavity=law, N1=N1, N2=N2)
+    return {k: nose_load_of(k, **kw) for k in NOSE_LOADS}
+
+
 def _regimes_choices(case) -> dict:
     """The case's ``[regimes]`` keys (penetration/regimes_case.py), {} without the section."""
     sec = case.section("regimes") if hasattr(case, "section") else None
@@ -191,7 +211,6 @@ def _regimes_choices(case) -> dict:
 
 def _nose_load_labels(case, setup, U, ei: ErodingInputs):
     """``regime_labels`` of the ``nose_load`` rule (:data:`REGIME_RULES`, :data:`NOSE_LOAD_DEFAULTS`)."""
-    from semianalytic.calibration.regimes import case_nose_loads
     from semianalytic.penetration.hardness import (parse_hardness, ultimate_strength_from_vickers,
                                                    vickers_from_rockwell_c)
     from semianalytic.penetration.nose_load import transition_velocity
