@@ -305,19 +305,26 @@ def _nose_sections(doc, result) -> None:
                   caption=f"{ss['quote']}: beside it, the ogive-fitted criteria for that rod (sphere, L = 74.675 mm, "
                           "rho_p = 8000 kg/m^3) on the case's target.")
         r0 = ss["rows"][-1]
+        v = ss["seed_velocity_m_s"]
+        where = ("below the predicted onset" if v < r0["onset_m_s"] else
+                 "in the predicted band where the rod bends but keeps its nose (onset to breakup)" if v < r0["breakup_m_s"] else
+                 "in the predicted band where the rod has broken up but is not yet eroding (breakup to erosion)"
+                 if v < r0["erosion_m_s"] else "above the predicted erosion velocity")
         doc.para(f"Discussion: the seed puts the irreversible deformation and unstable motion of this rod at about "
-                 f"{ss['seed_velocity_m_s']:.0f} m/s. The ogive-fitted nose-load criteria put its onset at {r0['onset_m_s']:.0f} "
-                 f"m/s, its breakup at {r0['breakup_m_s']:.0f} m/s and its erosion at {r0['erosion_m_s']:.0f} m/s "
-                 f"({r0['hardness_hrc']:g} HRC): the seed's velocity lies between the predicted onset and erosion, i.e. "
-                 "in the predicted deforming band, while the criterion without geometry (Tate's tip pressure against the "
-                 f"Meyer hardness) puts the onset at {r0['tip_onset_m_s']:.0f} m/s, later than the ogive's and later than "
-                 "the seed's. The nose effect has the seed's sign and order of magnitude (hundreds of m/s earlier than "
-                 "the ogive's); which stage the seed's 'irreversible changes of shape and instability of motion' names "
-                 "(first yield, or the visible deformation we call the breakup) the statement does not say. It is one "
-                 "quoted number and was not fitted. Part I's own U_sC (eq. (36)) with the rod's Y_p = f sigma_y of the "
-                 f"case gives {r0['part1_usc_m_s']:.0f} m/s: it rests on the small difference Ybar_p - Rbar_t (tens of "
-                 "MPa here), so it swings by hundreds of m/s with Y_p; with the seed's inferred Y_p = 2135 MPa it "
-                 "returns the 1000 m/s by construction (the Appendix's inverse problem).")
+                 f"{v:.0f} m/s. The ogive-fitted nose-load criteria put its onset at {r0['onset_m_s']:.0f} m/s, its "
+                 f"breakup at {r0['breakup_m_s']:.0f} m/s and its erosion at {r0['erosion_m_s']:.0f} m/s "
+                 f"({r0['hardness_hrc']:g} HRC): the seed's velocity lies {where}; the predicted onset is "
+                 f"{v - r0['onset_m_s']:.0f} m/s ({100 * (r0['onset_m_s'] / v - 1):+.0f} %) from it. The criterion without "
+                 f"geometry (Tate's tip pressure against the Meyer hardness) puts the onset at {r0['tip_onset_m_s']:.0f} m/s, "
+                 f"{r0['tip_onset_m_s'] - v:+.0f} m/s from the seed's value and later than the ogive's. The nose effect has "
+                 "the seed's sign (the sphere well before the ogive, whose onset is about 1270 m/s at 38 HRC); in size "
+                 "the ogive-fitted constants move the sphere's transitions further than the seed's one number suggests "
+                 "(which stage its 'irreversible changes of shape and instability of motion' names, first yield or "
+                 "visible deformation, the statement does not say). It is one quoted number and was not fitted. "
+                 "Part I's own U_sC (eq. (36)) with the rod's Y_p = f sigma_y of the case gives "
+                 f"{r0['part1_usc_m_s']:.0f} m/s: it rests on the small difference Ybar_p - Rbar_t (tens of MPa here), so "
+                 "it swings by hundreds of m/s with Y_p; with the seed's inferred Y_p = 2135 MPa it returns the 1000 m/s "
+                 "by construction (the Appendix's inverse problem).")
     doc.heading("What stays untested")
     doc.para("No second nose's shots were available here (the bundled shots are all 3-CRH ogives): the nose-load "
              "criteria are fitted and scored on one nose, and their transfer to another nose is checked only by the "
