@@ -327,6 +327,7 @@ SECTIONS: dict[str, str] = {
     "run": "semianalytic.run.case:RunSection",
     "calibration": "semianalytic.calibration.case:CalibrationSection",
     "perforation": "semianalytic.perforation.case:PerforationSection",
+    "regimes": "semianalytic.penetration.regimes_case:RegimesSection",
 }
 
 _CORE = {

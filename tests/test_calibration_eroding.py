@@ -2,7 +2,7 @@
 
 Checked against what the code under test does not produce: the closed-form I(v) against a
 numerical quadrature of its integrand, the vectorised depth over draws against the time
-integration of Alekseevskii-Tate (peers.tate_penetration), and the calibrated predictions
+integration of Alekseevskii-Tate (tests/tate_reference.py), and the calibrated predictions
 against the measured depths of the eroded VAR 4340 shots of Piekutowski et al. (1999) (the
 issue's leave-one-out target), through the command line; bad input exits 2 naming the field.
 """
@@ -52,11 +52,11 @@ def test_tate_integral_closed_form_against_quadrature(Y_p, R_t, rho_p):
 
 
 def test_eroding_depths_over_draws_against_time_integration():
-    """ErodingDepths (every draw and shot at once) against peers.tate_penetration (DOP853 in
+    """ErodingDepths (every draw and shot at once) against the time integration of tests/tate_reference.py (DOP853 in
     time, rtol 1e-11) at draws on both sides of Y_p = R_t and with one parameter held fixed:
     two converged methods, 1e-7 relative."""
     from semianalytic.calibration.models import ErodingDepths, ThetaColumn
-    from semianalytic.penetration.peers import tate_penetration
+    from tate_reference import tate_penetration_ode as tate_penetration
 
     U = np.array([1977.0, 2570.0, 2988.0])
     L0 = np.array([0.0655, 0.0656, 0.0654])

@@ -166,3 +166,50 @@ def test_one_table_loader():
     for name in ("load_shots", "load_table1", "load_table2", "load_table3", "load_table4", "load_table5"):
         body = src[src.index(f"def {name}("):].split("\n\n\n")[0]
         assert "load_rows(" in body, name
+
+
+# --- Alekseevskii-Tate and the Meyer conversion (issue 39): one home each ----------------------------
+
+# the interface balance solved for u (any spelling of the discriminant rho_p rho_t v^2 + 2 (rho_p - rho_t)(R - Y)),
+# a time integration of dL/dt = -(v - u), and the 68-degree constant
+AT_PATTERNS = [
+    r"rho_p\s*\*\s*rho_t\s*\*\s*v\s*\*\*\s*2\s*\+\s*2\.0\s*\*\s*\(rho_p\s*-\s*rho_t\)",
+    r"\(\s*-\s*Y_p\s*/\s*\(rho_p\s*\*\s*L\)\s*,\s*-\(v\s*-\s*u\)",  # the right-hand side of a time integration
+]
+VICKERS_PATTERN = r"radians\(68(\.0)?\)|sin\(math\.radians\(68|1\.0785\d*\s*\*"
+
+
+def _code_hits(pattern):
+    """Hits outside docstrings and comments (a line whose code part matches)."""
+    out = []
+    for h in _hits(pattern):
+        code = h.split(": ", 1)[1].split("#")[0]
+        if re.search(pattern, code) and not code.lstrip().startswith(('"', "'")) and '"""' not in code:
+            out.append(h)
+    return out
+
+
+def test_alekseevskii_tate_has_one_home():
+    hits = [h for p in AT_PATTERNS for h in _code_hits(p)]
+    assert hits and all(h.startswith("semianalytic/penetration/regime.py") for h in hits), hits
+    peers = _text("semianalytic/penetration/peers.py")
+    body = peers[peers.index("def tate_penetration("):].split("\n\n\n")[0]
+    assert "eroding_depth_per_length(" in body and "solve_ivp" not in peers
+
+
+def test_the_alekseevskii_tate_patterns_catch_the_old_copies():
+    old = ["        disc = rho_p * rho_t * v**2 + 2.0 * (rho_p - rho_t) * (R_t - Y_p)",
+           "        return (-Y_p / (rho_p * L), -(v - u), u)"]
+    assert all(any(re.search(p, line) for p in AT_PATTERNS) for line in old)
+
+
+def test_meyer_conversion_has_one_home():
+    hits = _code_hits(VICKERS_PATTERN)
+    assert len(hits) == 1 and hits[0].startswith("semianalytic/ballistic_limit/theory.py"), hits
+    assert re.search(VICKERS_PATTERN, 'VICKERS_DIAMOND = Indenter("Vickers diamond", math.radians(68.0), 1140e9, 0.07)')
+    from semianalytic.ballistic_limit.theory import meyer_hardness
+    from semianalytic.penetration.hardness import meyer_hardness_from_vickers
+
+    # HV 372 (38 HRC): H_M = 372 / sin 68 deg kgf/mm^2 by hand, in both units
+    assert meyer_hardness(372.0) == pytest.approx(372.0 / 0.9271838545667874, rel=1e-14)
+    assert meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 / 0.9271838545667874 * 9.80665e6, rel=1e-14)

@@ -13,7 +13,7 @@ import pytest
 
 from semianalytic.cli import main
 from semianalytic.penetration import regime as rg
-from semianalytic.penetration.peers import tate_penetration
+from tate_reference import tate_penetration_ode as tate_penetration
 from case_blocks import TARGET_6061_T651
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
@@ -23,7 +23,7 @@ ROD = dict(length=0.0711, nose_length=0.0118, diameter=7.11e-3)
 @pytest.mark.parametrize("Y_p, R_t, rho_p", [(1.64e9, 1.45e9, 7830.0), (1.0e9, 1.45e9, 7830.0), (2.48e9, 1.2e9, 7890.0),
                                              (1.0e9, 2.0e9, 2710.0)])
 def test_eroding_depth_against_time_integration(Y_p, R_t, rho_p):
-    """The quadrature in v against peers.tate_penetration (DOP853 in time, rtol 1e-11), off any
+    """The quadrature in v against the time integration of tests/tate_reference.py (DOP853 in time, rtol 1e-11), off any
     grid, Y_p above and below R_t and equal densities: both converge, so 1e-7 relative is a
     loose bound on two methods that agree to ~1e-10."""
     U = np.array([317.0, 733.0, 1411.0, 2333.0, 2987.0])
@@ -287,15 +287,15 @@ def test_cli_regimes_report(tmp_path, capsys):
 
 
 @pytest.mark.parametrize("nose, keys", [("ogive", "crh = 3.0"), ("sphere", "")])
-def test_default_regime_rule_is_meyer(tmp_path, capsys, nose, keys):
-    """The default labels (chosen by transfer, reports/validation_regimes.md): rigid below
+def test_regime_rule_meyer_by_hand(tmp_path, capsys, nose, keys):
+    """--regime-rule meyer (the previous default): rigid below
     U_y = sqrt(2 (H_M - R_t) / rho_t) (Tate 1967's tip pressure against the rod's static Meyer
     hardness H_M = HV x 9.80665 MPa / sin 68 deg), the depth Part I's below the breakup
     U_b = sqrt(2 (1.15 H_M - R_t) / rho_t) and the Alekseevskii-Tate rod's above, eroding from
     U_e with 3 x the dynamic ultimate strength of Pavlina & Van Tyne (2008).  Every velocity is
     recomputed here by hand from the printed R_t, Y_p and the case's density (independent of the
     code's path); HV from Y_p through Pavlina & Van Tyne's eq. (4) inverted."""
-    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper")
+    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper", "--regime-rule", "meyer")
     assert code == 0, err
     res = json.loads(out)
     rho_t = 2710.0
@@ -317,6 +317,45 @@ def test_default_regime_rule_is_meyer(tmp_path, capsys, nose, keys):
         assert res["depth_m"][i] == expect
     assert all(res["valid"]["regime_aware"])
     assert "Tate 1967" in err and "Meyer hardness" in err
+
+
+@pytest.mark.parametrize("nose, keys, bbar", [("ogive", "crh = 3.0", 0.11), ("sphere", "", 0.58)])
+def test_default_regime_rule_is_the_nose_load(tmp_path, capsys, nose, keys, bbar):
+    """The default labels (chosen by transfer, reports/validation_regimes.md): the nose's own load
+    rho_t Bbar U^2 / 2 (Part I, the paper's Bbar of the nose: 0.11 ogive, 0.58 sphere) reaches
+    kappa (S - Cbar R_t) at S = H_M (onset), b H_M (breakup), e H_M (erosion), kappa, b, e the stated
+    defaults; the depth Forrestal's below the breakup, the Alekseevskii-Tate rod's (Y_p = the static
+    ultimate strength, R_t of Tate 1986) above.  Recomputed by hand from the printed Y_p, R_t, Bbar and
+    the case's target (Y = 400 MPa, E = 68.9 GPa); the sphere's transitions come earlier."""
+    from semianalytic.penetration.regime_setup import NOSE_LOAD_DEFAULTS as D
+
+    code, out, err = _run(capsys, _case(tmp_path, nose, keys), "--json", "--coefficients", "paper")
+    assert code == 0, err
+    res = json.loads(out)
+    rho_t = 2710.0
+    Y, R = res["yield_stress_Pa"], res["resistance_Pa"]
+    assert res["deep_B_bar"] == pytest.approx(bbar, rel=1e-12) and res["deep_C_bar"] == pytest.approx(1.0, abs=1e-12)
+    HV = (Y / 1.5e6 + 90.7) / 2.876
+    H_M = HV * 9.80665e6 / math.sin(math.radians(68.0))
+
+    def U(S):
+        return math.sqrt(2.0 * D["kappa"] * (S - R) / (rho_t * bbar))
+
+    U_y, U_b, U_e = U(H_M), U(D["breakup_factor"] * H_M), U(D["erosion_factor"] * H_M)
+    assert res["regime_rule"] == "nose_load"
+    assert res["transition_velocity_m_s"] == pytest.approx(U_y, rel=1e-12)
+    assert res["breakup_velocity_m_s"] == pytest.approx(U_b, rel=1e-12)
+    assert res["erosion_velocity_m_s"] == pytest.approx(U_e, rel=1e-12)
+    assert res["eroding_inputs"]["rod_strength_Pa"] == pytest.approx((3.734 * HV - 99.8) * 1e6, rel=1e-12)
+    assert res["eroding_inputs"]["target_resistance_Pa"] == pytest.approx(0.4e9 * (2 / 3 + math.log(0.57 * 68.9 / 0.4)), rel=1e-12)
+    V = res["striking_velocity_m_s"]
+    assert [r == "rigid" for r in res["regime"]] == [u < U_y for u in V]
+    assert [r == "eroding" for r in res["regime"]] == [u >= U_e for u in V]
+    for i, u in enumerate(V):
+        expect = res["depth_forrestal_m"][i] if u < U_b else res["depth_eroding_m"][i]
+        assert res["depth_m"][i] == expect
+    if nose == "sphere":  # a blunter nose: every transition earlier than the ogive's (sqrt(0.11/0.58) = 0.44 x)
+        assert U_y < 0.5 * math.sqrt(2.0 * D["kappa"] * (H_M - R) / (rho_t * 0.11))
 
 
 @pytest.mark.parametrize("nose, keys", [("ogive", "crh = 3.0")])

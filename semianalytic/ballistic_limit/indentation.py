@@ -19,7 +19,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semianalytic.ballistic_limit.theory import meyer_hardness
+from semianalytic.ballistic_limit.theory import VICKERS_HALF_ANGLE, meyer_hardness
 
 __all__ = [
     "Indenter",
@@ -54,7 +54,7 @@ class Indenter:
 
 # Diamond Vickers pyramid: 136 deg between opposite faces; E = 1140 GPa, nu = 0.07 are the
 # values commonly used for diamond indenters (Oliver & Pharr, J. Mater. Res. 7 (1992) 1564).
-VICKERS_DIAMOND = Indenter("Vickers diamond", math.radians(68.0), 1140e9, 0.07)
+VICKERS_DIAMOND = Indenter("Vickers diamond", VICKERS_HALF_ANGLE, 1140e9, 0.07)
 
 
 def effective_modulus(E1, nu1, E2, nu2):

@@ -35,7 +35,8 @@ __all__ = [
     "stopping_thickness",
 ]
 
-# Angle between a face of the Vickers pyramid and its axis (136 deg / 2).
+# Angle between a face of the Vickers pyramid and its axis (136 deg / 2): the one home of the 68-degree
+# constant and of the Meyer conversion below (penetration/hardness.py and ballistic_limit/indentation.py use them).
 VICKERS_HALF_ANGLE = math.radians(68.0)
 
 

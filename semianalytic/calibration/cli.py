@@ -40,6 +40,10 @@ def add_arguments(parser) -> None:
     parser.add_argument("--quiet", action="store_true", help="no progress bar")
     parser.add_argument("--quick", action="store_true",
                         help="--model regimes --cross-validate: the transfer of the default model set only (no comparison)")
+    parser.add_argument("--option", action="append", default=[], metavar="KEY=VALUE",
+                        help="--model regimes: a choice of the model set over the case's [regimes] keys (repeatable), e.g. "
+                             "nose_load=forrestal; keys: onset, erosion, nose_load, resistance, rod_strength, deforming, "
+                             "deformed_depth, rigid_depth, discrepancy")
     parser.add_argument("--force", action="store_true", help="replace an existing DIR")
 
 
@@ -83,8 +87,9 @@ def _run_regimes(args, command: str) -> int:
     print(f"wrote {Path(args.out) / 'posterior.json'} and {Path(args.out) / (args.report_name + '.md')}")
     s = post["summary"]
     diag = post["diagnostics"]["parameters"]
-    print(f"  regimes ({', '.join(f'{k}={v}' for k, v in post['options'].items())}): dynamic factor median "
-          f"{s['dynamic_factor']['q50']:.3f} [{s['dynamic_factor']['q05']:.3f}, {s['dynamic_factor']['q95']:.3f}], sigma "
+    first = next(iter(s))  # dynamic_factor (legacy model sets) or nose_load_factor
+    print(f"  regimes ({', '.join(f'{k}={v}' for k, v in post['options'].items())}): {first.replace('_', ' ')} median "
+          f"{s[first]['q50']:.3f} [{s[first]['q05']:.3f}, {s[first]['q95']:.3f}], sigma "
           f"{s['sigma']['q50']:.3f}, tau {s['tau']['q50']:.3f}; R-hat "
           + ", ".join(f"{k} {d['r_hat']:.3f}" for k, d in diag.items()) + "; ESS "
           + ", ".join(f"{k} {min(d['ess_bulk'], d['ess_tail']):.0f}" for k, d in diag.items()))

@@ -45,31 +45,56 @@ def run_regimes(args, command: str) -> dict:
             raise InputError("--transfer", f"{p}: another nose or target than {args.case}; transfer is between "
                                            "projectile materials of one geometry")
         others.append(c)
+    opt = R.options_for(case, getattr(args, "option", None) or ())
     coef = coefficients_for_case(case, args.coefficients, args.cache_dir)[0]
     shots = R.regime_shots(case, coef)
-    steps = args.steps or 4500  # R-hat <= 1.01 on the bundled data needs about 4000 (reports/validation_regimes.md)
-    sample = R.sample_regimes(shots, R.DEFAULT_OPTIONS, steps=steps, burn=steps // 3)
-    posterior = R.posterior_json(case, shots, R.DEFAULT_OPTIONS, sample)
-    result = {"posterior": posterior, "shots": shots, "command": command, "transfer": None, "curves": {}}
+    # R-hat <= 1.01 on the bundled data: 4500 steps left tau and e at 1.010-1.011 with the nose-load model set
+    # (6 parameters, 14 walkers per ensemble); 9000 steps (reports/validation_regimes.md)
+    steps = args.steps or 9000
+    sample = R.sample_regimes(shots, opt, steps=steps, burn=steps // 3)
+    posterior = R.posterior_json(case, shots, opt, sample)
+    result = {"posterior": posterior, "shots": shots, "command": command, "transfer": None, "curves": {}, "options": opt}
+    med = posterior["summary"]
+    first = R.parameter_names(opt)[0]
+    pb = med.get("breakup_factor", {}).get("q50")
+    pe = med.get("erosion_factor", {}).get("q50")
+
+    def _coef(c):
+        return coefficients_for_case(c, args.coefficients, args.cache_dir)[0]
+
+    # the nose checks (issue 36, item 4): the fitted constants on five noses, the case's rod
+    if R.uses_nose_load(opt):
+        result["noses"] = {kind: R.nose_ordering_study(case, _coef, R.dataclasses_replace(opt, nose_load=kind),
+                                                       med[first]["q50"], pb, pe)
+                           for kind in (opt.nose_load,)}
+        result["seed_sphere"] = R.seed_sphere_statement(case, _coef, opt, med[first]["q50"], pb, pe)
+    result["eroding_trend"] = R.eroding_trend(shots, opt, med[first]["q50"])
     if args.cross_validate:
         if not others:
             raise InputError("--cross-validate", "with --model regimes needs --transfer CASE.toml (the other material)")
         cases = [case, *others]
         coefs = [coef, *[coefficients_for_case(c, args.coefficients, args.cache_dir)[0] for c in others]]
         groups = [shots, *[R.regime_shots(c, k) for c, k in zip(others, coefs)]]
-        result["transfer"] = R.transfer_study(groups, R.OPTION_SETS if not args.quick else (R.DEFAULT_OPTIONS,))
+        result["transfer"] = R.transfer_study(groups, R.OPTION_SETS if not args.quick else (opt,), chosen_among=opt)
         # curves: each material predicted from the fit on the other(s) (the transfer the figures show)
-        posts = {g.group: R.grid_posterior(g, R.DEFAULT_OPTIONS) for g in groups}
+        posts = {g.group: R.grid_posterior(g, opt) for g in groups}
         from semianalytic.penetration.hardness import DEFAULT_DYNAMIC_FACTOR
         from semianalytic.penetration.regime import DEFAULT_BREAKUP_FACTOR
+        from semianalytic.penetration.regime_setup import NOSE_LOAD_DEFAULTS
 
-        result["defaults"] = R.default_constants_study(groups, R.DEFAULT_OPTIONS, posts, DEFAULT_DYNAMIC_FACTOR,
-                                                       DEFAULT_BREAKUP_FACTOR if R.DEFAULT_OPTIONS.deforming == "two_stage" else None)
+        if R.uses_nose_load(opt):
+            result["defaults"] = R.default_constants_study(
+                groups, opt, posts, NOSE_LOAD_DEFAULTS["kappa"],
+                NOSE_LOAD_DEFAULTS["breakup_factor"] if opt.deforming == "two_stage" else None,
+                NOSE_LOAD_DEFAULTS["erosion_factor"])
+        else:
+            result["defaults"] = R.default_constants_study(groups, opt, posts, DEFAULT_DYNAMIC_FACTOR,
+                                                           DEFAULT_BREAKUP_FACTOR if opt.deforming == "two_stage" else None)
         for c, k, g in zip(cases, coefs, groups):
             fit = next(h for h in groups if h is not g)
-            f, s, t, b = R.draws_from_grid(posts[fit.group], 1000)
+            f, s, t, b, e = R.draws_from_grid(posts[fit.group], 1000)
             pts = R.shots_at(c, k, CURVE_VELOCITIES)
-            pred = R.predict(pts, R.DEFAULT_OPTIONS, f, s, t, b=b)
+            pred = R.predict(pts, opt, f, s, t, b=b, e=e)
             result["curves"][g.group] = {"fit": fit.group, "velocity_m_s": CURVE_VELOCITIES.tolist(),
                                          "q05_m": pred["quantiles"][0].tolist(), "q50_m": pred["quantiles"][1].tolist(),
                                          "q95_m": pred["quantiles"][2].tolist(),

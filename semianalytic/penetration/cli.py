@@ -71,8 +71,10 @@ def add_arguments(parser) -> None:
                         help="add predictive depth quantiles (depth_quantiles_m, with 'regime_aware') from a posterior "
                              "written by calibrate; repeat it to add the eroding rod's posterior (calibrate --model eroding); a "
                              "posterior of calibrate --model regimes adds regime_probability and the regime mixture")
-    parser.add_argument("--regime-rule", choices=("meyer", "tate_tabor", "nose_length"), default="meyer",
-                        help="regime labels without a posterior: meyer (default, chosen by transfer: Tate's tip "
+    parser.add_argument("--regime-rule", choices=("nose_load", "meyer", "tate_tabor", "nose_length"), default="nose_load",
+                        help="regime labels without a posterior: nose_load (default, chosen by transfer: the dynamic load "
+                             "of the case's own nose against kappa x the rod's Meyer hardness surplus, penetration/nose_load.py), "
+                             "meyer (the previous default: Tate's tip "
                              "pressure against the rod's static Meyer hardness for the onset, a breakup factor times it "
                              "(printed, and breakup_factor in the JSON) for the breakup where the depth drops to the eroding rod's, 3 x the dynamic ultimate strength for erosion), "
                              "tate_tabor (the previous default: 3 x the dynamic yield stress for the onset) or nose_length "
@@ -123,6 +125,12 @@ def _print_text(result: dict, desc: str, file=None) -> None:
           f"eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s (Alekseevskii-Tate, Y_p = "
           f"{result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = {result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa), "
           f"deforming between; depth = {result['part1_model']} below U_e, eroding above")
+    elif result.get("regime_rule") == "nose_load":
+        p(f"  regimes (the nose's own load against the rod's Meyer hardness): rigid below U_y = "
+          f"{_fmt(result['transition_velocity_m_s'], 1, 0)} m/s (Forrestal depth), bent (Forrestal depth) to U_b = "
+          f"{_fmt(result['breakup_velocity_m_s'], 1, 0)} m/s, eroding from U_e = {_fmt(result['erosion_velocity_m_s'], 1, 0)} m/s; "
+          f"Alekseevskii-Tate rod from U_b (Y_p = {result['eroding_inputs']['rod_strength_Pa'] / 1e6:.0f} MPa, R_t = "
+          f"{result['eroding_inputs']['target_resistance_Pa'] / 1e6:.0f} MPa)")
     elif result.get("regime_rule") == "meyer":
         p(f"  regimes (Tate 1967 tip pressure against the rod's Meyer hardness H_M and 3 x its dynamic ultimate strength, "
           f"Tabor 1951): rigid below U_y = {_fmt(result['transition_velocity_m_s'], 1, 0)} m/s, the rod breaks up "

@@ -27,10 +27,13 @@ import math
 
 import numpy as np
 
+from semianalytic.ballistic_limit.theory import VICKERS_HALF_ANGLE  # the one home of the 68-degree constant
+from semianalytic.ballistic_limit.theory import meyer_hardness as meyer_from_vickers_number  # HM = HV / sin 68 deg
 from semianalytic.errors import InputError
 
 __all__ = ["E140_HRC_HV", "HRC_RANGE", "DEFAULT_DYNAMIC_FACTOR", "vickers_from_rockwell_c", "yield_stress_from_vickers",
-           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "dynamic_yield_stress", "parse_hardness"]
+           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "meyer_from_vickers_number",
+           "VICKERS_HALF_ANGLE", "dynamic_yield_stress", "parse_hardness"]
 
 # ASTM E140, Table 1: HRC -> HV (non-austenitic steels), HRC 20..68
 E140_HRC_HV = (
@@ -79,7 +82,7 @@ def ultimate_strength_from_vickers(hv):
     return (-99.8 + 3.734 * np.asarray(hv, float))[()] * 1e6
 
 
-VICKERS_MEYER_RATIO = math.sin(math.radians(68.0))
+VICKERS_MEYER_RATIO = math.sin(VICKERS_HALF_ANGLE)
 """HV / Meyer hardness of the Vickers pyramid (136 deg between faces, d the indent's diagonal):
 HV = F / (contact surface, d^2 / (2 sin 68 deg)), Meyer hardness = F / (projected area, d^2 / 2),
 so H_M = HV / sin 68 deg = 1.0785 HV (Tabor 1951, The Hardness of Metals, ch. 1 and 6; ISO 6507-1 for the definition of HV)."""
@@ -91,7 +94,7 @@ def meyer_hardness_from_vickers(hv):
     indents plastically) from HV: H_M = HV x 9.80665 MPa / sin 68 deg (:data:`VICKERS_MEYER_RATIO`,
     Tabor 1951).  Tabor's point is that this pressure, about 3 times the flow stress, is itself the
     resistance of the surface to plastic indentation, so no strength conversion enters."""
-    return (np.asarray(hv, float) * KGF_MM2 / VICKERS_MEYER_RATIO)[()]
+    return (np.asarray(meyer_from_vickers_number(hv), float) * KGF_MM2)[()]
 
 
 def yield_stress_from_hardness(hrc, field: str = "projectile.hardness"):

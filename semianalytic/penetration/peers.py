@@ -151,57 +151,28 @@ class TateResult:
     transition_velocity: float
 
 
-def tate_interface_velocity(v, rho_p, Y_p, rho_t, R_t):
-    """Penetration velocity u of the eroding rod from (1/2) rho_p (v-u)^2 + Y_p = (1/2) rho_t u^2 + R_t
-    (the root with u <= v; 0 where the target does not yield)."""
-    v = np.asarray(v, float)
-    if math.isclose(rho_p, rho_t, rel_tol=1e-12):
-        u = 0.5 * v + (Y_p - R_t) / (rho_p * v)
-    else:
-        disc = rho_p * rho_t * v**2 + 2.0 * (rho_p - rho_t) * (R_t - Y_p)
-        u = (rho_p * v - np.sqrt(np.maximum(disc, 0.0))) / (rho_p - rho_t)
-    return np.clip(u, 0.0, v)[()]
-
-
 def tate_penetration(length: float, rod_density: float, rod_strength: float, target_density: float,
                      target_resistance: float, V: float, *, rtol: float = 1e-10) -> TateResult:
-    """Alekseevskii-Tate penetration of a rod of length L at striking velocity V (module docstring)."""
-    rho_p, Y_p, rho_t, R_t = rod_density, rod_strength, target_density, target_resistance
-    v_rigid = math.sqrt(2.0 * (Y_p - R_t) / rho_t) if Y_p > R_t else 0.0
-    if V <= v_rigid:  # never erodes: rigid rod, Part IV eq. (3)
-        P = rho_p * length / rho_t * math.log1p(rho_t * V**2 / (2.0 * R_t))
-        a = math.sqrt(2.0 * R_t / rho_t)
-        T = 2.0 * rho_p * length / (rho_t * a) * math.atan(V / a)
-        return TateResult(P, length, T, False, math.nan)
-    v_stall = math.sqrt(2.0 * (R_t - Y_p) / rho_p) if R_t > Y_p else 0.0
-    if V <= v_stall:  # the target never yields (u = 0): the rod erodes on the surface, no penetration
-        return TateResult(0.0, length * math.exp(-rho_p * V**2 / (2.0 * Y_p)), length * rho_p * V / Y_p, True, 0.0)
+    """Alekseevskii-Tate penetration of a rod of length L at striking velocity V (module docstring):
+    the one home of the equations, :mod:`semianalytic.penetration.regime` (the quadrature in v and its
+    time integral); ``rtol`` is accepted for compatibility (the quadrature's error is below 1e-9)."""
+    from semianalytic.penetration import regime as rg
 
-    def rhs(t, y):
-        v, L, _ = y
-        u = tate_interface_velocity(v, rho_p, Y_p, rho_t, R_t)
-        return (-Y_p / (rho_p * L), -(v - u), u)
+    d, r, eroded = rg.eroding_depth_per_length(V, density=rod_density, target_density=target_density,
+                                               target_resistance=target_resistance, rod_strength=rod_strength)
+    t = rg.eroding_time_per_length(V, density=rod_density, target_density=target_density,
+                                   target_resistance=target_resistance, rod_strength=rod_strength)
+    eroded = bool(eroded)
+    v_e = float(rg._erosion_end_array(rod_density, rod_strength, target_density, target_resistance))
+    residual = float(r) * length
+    if eroded and residual < 1e-9 * length:
+        residual = 0.0
+    trans = math.nan if not eroded else (v_e if rod_strength > target_resistance and residual > 0 else 0.0)
+    return TateResult(float(d) * length, residual, float(t) * length, eroded, trans)
 
-    def erosion_ends(t, y):  # v = u (Y_p > R_t) or u = 0 (Y_p <= R_t)
-        return y[0] - max(v_rigid, math.sqrt(2.0 * max(R_t - Y_p, 0.0) / rho_p)) * (1.0 + 1e-12)
 
-    def consumed(t, y):
-        return y[1] - 1e-9 * length
+def tate_interface_velocity(v, rho_p, Y_p, rho_t, R_t):
+    """u of the eroding rod (:func:`semianalytic.penetration.regime.tate_interface_velocity`)."""
+    from semianalytic.penetration.regime import tate_interface_velocity as home
 
-    for ev in (erosion_ends, consumed):
-        ev.terminal, ev.direction = True, -1
-    t_scale = length / V
-    from scipy.integrate import solve_ivp  # loaded on use: loading a case stays light
-
-    sol = solve_ivp(rhs, (0.0, 1e4 * t_scale), [V, length, 0.0], method="DOP853", rtol=rtol,
-                    atol=[rtol * V, rtol * length, rtol * length], events=(erosion_ends, consumed))
-    v, L, P = sol.y[:, -1]
-    t = sol.t[-1]
-    if len(sol.t_events[1]):  # rod consumed
-        return TateResult(P, 0.0, t, True, 0.0)
-    if Y_p > R_t:  # rigid phase of the residual rod, Part IV eqs. (2)-(3)
-        a = math.sqrt(2.0 * R_t / rho_t)
-        P += rho_p * L / rho_t * math.log1p(rho_t * v**2 / (2.0 * R_t))
-        t += 2.0 * rho_p * L / (rho_t * a) * math.atan(v / a)
-        return TateResult(P, L, t, True, v)
-    return TateResult(P, L, t, True, 0.0)  # u = 0: the rest of the rod erodes on the crater floor
+    return home(v, rho_p, Y_p, rho_t, R_t)

@@ -24,7 +24,9 @@ from dataclasses import dataclass
 import numpy as np
 
 from semianalytic.errors import InputError
+from semianalytic.penetration import peers
 from semianalytic.penetration import regime as rg
+from semianalytic.penetration.nose_load import NOSE_LOADS, nose_load_of
 
 __all__ = [
     "RESPONSE_REGIME",
@@ -120,7 +122,7 @@ def _velocities(U, mask) -> str:
     return summarise(np.asarray(U)[mask].tolist())  # 1000 velocities: count, range, ends
 
 
-REGIME_RULES = ("meyer", "tate_tabor", "nose_length")
+REGIME_RULES = ("nose_load", "meyer", "tate_tabor", "nose_length")
 """How ``penetrate`` labels the regimes without a posterior.  ``meyer`` (default, chosen by the
 leave-one-material-out transfer of reports/validation_regimes.md, the ``Options()`` default of
 semianalytic/calibration/regimes.py): rigid while Tate's (1967) tip pressure (1/2) rho_t U^2 + R_t
@@ -136,8 +138,19 @@ C f sigma_u (the dynamic ultimate strength), the Alekseevskii-Tate rod (Y_p = f 
 Part I) giving the depth beyond the onset; the combination of Tate's criterion with Tabor's factor
 is this project's reading of the two published relations.  ``nose_length``: the earlier rule (U_sC
 of Part I, eqs. (33)/(36), then the shank eroded down to the nose length; this project's own),
-kept as a named option; it lost on transfer."""
-DEFAULT_REGIME_RULE = "meyer"
+kept as a named option; it lost on transfer.  ``nose_load`` (the default, the ``Options()`` default of
+the regimes calibration, chosen by the leave-one-steel-out transfer among the model sets that order the
+noses and whose eroded depth rises with velocity): the transitions are where the dynamic load of the
+case's own nose reaches kappa (S - s_0), S = H_M, b H_M, e H_M (:mod:`.nose_load`); the depth is Forrestal's
+rigid-nose depth while rigid and for a bent rod that keeps its nose (U_s < U_b; the peer of ``penetrate``,
+the data authors' cavity constants where ``[data]`` gives them, else A Y = R_t, B = 3/2), and the
+Alekseevskii-Tate rod's from U_b with Tate's (1986) R_t and the rod's static ultimate strength
+(:data:`.regime.ROD_FLOW_FACTOR`)."""
+DEFAULT_REGIME_RULE = "nose_load"
+NOSE_LOAD_DEFAULTS = {"nose_load": "part1", "kappa": 0.10, "breakup_factor": 1.2, "erosion_factor": 1.6}
+"""The stated constants of ``nose_load`` without a posterior: the load of Part I's coefficients and
+kappa, b, e rounded between the posterior medians fitted on each steel of Piekutowski et al. (1999)
+(reports/validation_regimes.md, where each is scored on the other steel)."""
 
 
 def rod_strengths(case, setup) -> tuple[float, float, float, float]:
@@ -165,6 +178,84 @@ def rod_strengths(case, setup) -> tuple[float, float, float, float]:
     return float(Y), float(f * ultimate_strength_from_vickers(HV)), f, float(meyer_hardness_from_vickers(HV))
 
 
+def _tate_or_part1_resistance(case, setup) -> tuple[float, str]:
+    """R_t of the eroding rod: Tate (1986) from the target's yield stress and Young's modulus, else
+    the Part I R_t of the case's resistance model."""
+    res = case.target.resistance
+    if hasattr(res, "youngs_modulus") and hasattr(res, "yield_stress"):
+        return rg.tate_resistance(res.yield_stress, res.youngs_modulus), "Tate (1986), Y_t (2/3 + ln(0.57 E_t/Y_t))"
+    return float(setup.resistance_pa), "Part I (the case's resistance model)"
+
+
+def case_nose_loads(case, setup, law=None) -> dict:
+    """{kind: NoseLoad} of the case's nose and target (:mod:`.nose_load`): Part I's deep-limit
+    Bbar, Cbar and R_t of the case's coefficients; the cavity-expansion law of the Forrestal peer
+    (:func:`.validation.peer_inputs`: the data authors' constants where ``[data]`` gives them, else
+    A Y = R_t, B = 3/2) with the nose factors N_1, N_2 of the actual nose."""
+    from semianalytic.geometry import nose_from_section
+    from semianalytic.penetration.validation import peer_inputs
+
+    ci = setup.critical_inputs()
+    area = math.pi * ci.diameter**2 / 4.0
+    N1, N2 = peers.nose_factors(nose_from_section(case.require("projectile")))
+    if law is None:
+        law, _ = peer_inputs(case, setup)
+    kw = dict(Bbar=ci.B / area, Cbar=ci.C / area, resistance=ci.resistance_pa, target_density=ci.target_density,
+              cavity=law, N1=N1, N2=N2)
+    return {k: nose_load_of(k, **kw) for k in NOSE_LOADS}
+
+
+def _regimes_choices(case) -> dict:
+    """The case's ``[regimes]`` keys (penetration/regimes_case.py), {} without the section."""
+    sec = case.section("regimes") if hasattr(case, "section") else None
+    return sec.choices() if sec is not None else {}
+
+
+def _nose_load_labels(case, setup, U, ei: ErodingInputs):
+    """``regime_labels`` of the ``nose_load`` rule (:data:`REGIME_RULES`, :data:`NOSE_LOAD_DEFAULTS`)."""
+    from semianalytic.penetration.hardness import (parse_hardness, ultimate_strength_from_vickers,
+                                                   vickers_from_rockwell_c)
+    from semianalytic.penetration.nose_load import transition_velocity
+
+    d = NOSE_LOAD_DEFAULTS
+    ch = _regimes_choices(case)
+    _, _, f, H_M = rod_strengths(case, setup)
+    L = case_nose_loads(case, setup)[ch.get("nose_load", d["nose_load"])]
+    k = d["kappa"]
+    U_y = float(transition_velocity(k, H_M, L.static, L.linear, L.quadratic))
+    U_e = max(U_y, float(transition_velocity(k, d["erosion_factor"] * H_M, L.static, L.linear, L.quadratic)))
+    U_b = float(np.clip(transition_velocity(k, d["breakup_factor"] * H_M, L.static, L.linear, L.quadratic), U_y, U_e))
+    psec = case.projectile
+    notes = [x for x in ei.defaults if "dynamic_yield_stress" not in x and "eroding_resistance" not in x]
+    Y_p, R_t = ei.rod_strength, ei.target_resistance
+    if psec.dynamic_yield_stress is None:
+        if getattr(psec, "hardness", None) is not None:
+            HV = float(vickers_from_rockwell_c(parse_hardness(psec.hardness)))
+        else:
+            from semianalytic.penetration.hardness import vickers_from_yield_stress
+
+            HV = float(vickers_from_yield_stress(setup.yield_stress / f))
+        from semianalytic.penetration.hardness import yield_stress_from_vickers
+
+        if ch.get("rod_strength") == "static_yield":
+            Y_p, what = rg.ROD_FLOW_FACTOR * float(yield_stress_from_vickers(HV)), "static yield stress"
+            eq = "(4)"
+        else:
+            Y_p, what, eq = rg.ROD_FLOW_FACTOR * float(ultimate_strength_from_vickers(HV)), "static ultimate strength", "(5)"
+        notes.append(f"projectile.dynamic_yield_stress not given: the eroding rod uses Y_p = its {what} "
+                     f"from the hardness = {Y_p / 1e6:.0f} MPa (Pavlina & Van Tyne 2008, eq. {eq}; factor "
+                     f"{rg.ROD_FLOW_FACTOR:g})")
+    if getattr(case.target.resistance, "eroding_resistance", None) is None:
+        if ch.get("resistance") == "part1":
+            R_t, src = float(setup.resistance_pa), "Part I, eq. (16) ([regimes] resistance)"
+        else:
+            R_t, src = _tate_or_part1_resistance(case, setup)
+        notes.append(f"target.resistance.eroding_resistance not given: the eroding rod uses R_t = {R_t / 1e6:.0f} MPa ({src})")
+    ei = ErodingInputs(**{**ei.__dict__, "rod_strength": float(Y_p), "target_resistance": float(R_t),
+                          "defaults": tuple(notes)})
+    return rg.classify_regimes(U, U_y, U_e), U_y, U_e, ei, U_b
+
+
 def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
     """(regimes per velocity, U_y, U_e [m/s], the eroding rod's inputs, U_b [m/s]: where the depth
     becomes the eroding rod's) by the rule ``rule`` (:data:`REGIME_RULES`); the one place both
@@ -174,6 +265,8 @@ def regime_labels(case, setup, U, rule: str = DEFAULT_REGIME_RULE):
     U = np.atleast_1d(np.asarray(U, float))
     ei = eroding_inputs(case, setup)
     U_b = None
+    if rule == "nose_load":
+        return _nose_load_labels(case, setup, U, ei)
     if rule in ("tate_tabor", "meyer"):
         Y_dyn, Yu_dyn, f, H_M = rod_strengths(case, setup)
         R1 = setup.resistance_pa  # the onset criteria are about the rigid nose: Part I's R_t
@@ -210,7 +303,17 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     regimes, U_y, U_e, ei, U_b = regime_labels(case, setup, U, rule)
     er = rg.eroding_depth(U, **ei.kwargs(mass=setup.mass))
     reg = np.asarray(regimes)
-    if rule in ("tate_tabor", "meyer"):  # Part I below U_b, the eroding rod beyond (tate_tabor: U_b = U_y)
+    if rule == "nose_load":  # Part I while rigid, Forrestal's rigid-nose depth while bent, eroding from U_b
+        if peers is None or "forrestal" not in peers:
+            from semianalytic.penetration.validation import peer_depths
+
+            peers = {**(peers or {}), **peer_depths(case, setup, U)}
+        ch = _regimes_choices(case)
+        pick = {"forrestal": np.asarray(peers["forrestal"], float), "part1": part1}
+        rigid = pick[ch.get("rigid_depth", "forrestal")]  # the transfer's choice: Forrestal for both
+        bent = pick[ch.get("deformed_depth", "forrestal")]
+        depth = np.where(U < U_y, rigid, np.where(U < U_b, bent, er.depth))
+    elif rule in ("tate_tabor", "meyer"):  # Part I below U_b, the eroding rod beyond (tate_tabor: U_b = U_y)
         depth = np.where(U < U_b, part1, er.depth)
     else:
         depth = rg.regime_depth(regimes, part1, er.depth)
@@ -218,7 +321,7 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
     valid = {k: rigid_ok.tolist() for k in PART1_MODELS}
     if peers is not None:
         valid.update({k: rigid_ok.tolist() for k in ("forrestal", "chen_li")})
-    if rule in ("tate_tabor", "meyer"):
+    if rule in ("tate_tabor", "meyer", "nose_load"):
         valid["eroding"] = (U >= U_b).tolist()
         valid["regime_aware"] = [True] * len(reg)
     else:
@@ -238,15 +341,17 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         why = (f"U_s >= U_sC = {U_y:.0f} m/s: the projectile yields (Part I, eqs. (33)/(36))" if rule == "nose_length" else
                f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches the rod's Meyer hardness "
                "(Tate 1967, Tabor 1951): the nose yields" if rule == "meyer" else
+               f"U_s >= U_y = {U_y:.0f} m/s: the dynamic load of the nose reaches kappa (H_M - s_0) "
+               f"(kappa = {NOSE_LOAD_DEFAULTS['kappa']:g}, penetration/nose_load.py): the nose yields" if rule == "nose_load" else
                f"U_s >= U_y = {U_y:.0f} m/s: the tip pressure (1/2) rho_t U^2 + R_t reaches 3 Y_p (Tate 1967, Tabor 1951): "
                "the nose yields")
         for k in valid:
             if k not in ("eroding", "regime_aware"):
                 warnings.append(f"{_LABEL[k]}: depth outside the model's validity at U_s = {_velocities(U, ~rigid_ok)} m/s; {why}")
-    bad_eroding = (U < U_b) if rule in ("tate_tabor", "meyer") else (reg != "eroding")
+    bad_eroding = (U < U_b) if rule in ("tate_tabor", "meyer", "nose_load") else (reg != "eroding")
     if np.any(bad_eroding):
         why = ((f"U_s < U_y = {U_y:.0f} m/s: the projectile stays rigid" if rule == "tate_tabor" else
-                f"U_s < U_b = {U_b:.0f} m/s: the rod keeps its nose (rigid, or bent but not broken)" if rule == "meyer" else
+                f"U_s < U_b = {U_b:.0f} m/s: the rod keeps its nose (rigid, or bent but not broken)" if rule in ("meyer", "nose_load") else
                 f"U_s < U_e = {U_e:.0f} m/s: the eroding rod keeps more than its nose length, the projectile is "
                 "rigid or deforming, not eroding") if math.isfinite(U_e) else "no erosion predicted")
         warnings.append(f"{_LABEL['eroding']}: depth outside the model's validity at U_s = "
@@ -256,6 +361,10 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
                         f"{U_y:.0f} <= U_s < {U_e:.0f} m/s): no model holds; the {_LABEL[part1_model]} depth is given "
                         "as the upper bound, depth_eroding_m is the lower bound")
     notes = list(ei.defaults) if np.any(reg != "rigid") else []
+    if rule == "nose_load" and ei.rod_strength > ei.target_resistance and np.any(U >= U_b):
+        warnings.append(f"{_LABEL['eroding']}: Y_p = {ei.rod_strength / 1e6:.0f} MPa > R_t = {ei.target_resistance / 1e6:.0f} MPa: "
+                        "the eroded depth falls with the striking velocity towards the hydrodynamic limit from above "
+                        "(the measured eroded depths of steel rods into aluminium rise)")
     return {
         "regime": regimes,
         "depth_m": depth.tolist(),
@@ -264,7 +373,9 @@ def regime_prediction(case, setup, U, curve: dict, peers: dict | None = None, *,
         "transition_velocity_m_s": U_y,
         "erosion_velocity_m_s": U_e,
         "breakup_velocity_m_s": U_b,
-        "breakup_factor": rg.DEFAULT_BREAKUP_FACTOR if rule == "meyer" else None,
+        "breakup_factor": (rg.DEFAULT_BREAKUP_FACTOR if rule == "meyer" else
+                           NOSE_LOAD_DEFAULTS["breakup_factor"] if rule == "nose_load" else None),
+        "nose_load": ({k: v for k, v in NOSE_LOAD_DEFAULTS.items()} if rule == "nose_load" else None),
         "part1_model": part1_model,
         "regime_rule": rule,
         "eroding_inputs": {"rod_strength_Pa": ei.rod_strength, "target_resistance_Pa": ei.target_resistance,
