@@ -41,15 +41,7 @@ __all__ = [
     "leave_one_out_eroding",
 ]
 
-RESPONSE_REGIME = {
-    "rigid": "rigid",
-    "curved": "deforming",
-    "exited": "deforming",
-    "turned_around": "deforming",
-    "broken": "deforming",
-    "eroded": "eroding",
-    "broken_eroding": "eroding",
-}
+from semianalytic.penetration.validation import RESPONSE_REGIME  # noqa: E402  (the data labels, defined with the data reader)
 
 PART1_MODELS = ("rigid", "quasi_rigid", "elastic", "elastic_exact_rod")
 DEFAULT_PART1_MODEL = "elastic_exact_rod"  # the physically consistent Part I projectile (errata item 5)

@@ -43,6 +43,18 @@ class Shot:
     row: dict
 
 
+
+RESPONSE_REGIME = {  # the recorded responses of a [data] file and the regime each belongs to
+    "rigid": "rigid",
+    "curved": "deforming",
+    "exited": "deforming",
+    "turned_around": "deforming",
+    "broken": "deforming",
+    "eroded": "eroding",
+    "broken_eroding": "eroding",
+}
+
+
 def _unit_scale(unit: str, kind: str, field: str) -> float:
     from semianalytic.units import parse_quantity
 
@@ -149,8 +161,6 @@ def _check_row_labels(data, row: dict, i: int, shot_id: str, name: str) -> None:
     """A selected row's recorded response (one of the known labels, or blank: not recorded) and
     its hardness (a number where ``hardness_column`` is given: a blank would silently take the
     nominal ``[projectile] hardness``)."""
-    from semianalytic.penetration.regime_setup import RESPONSE_REGIME
-
     if data.response_column:
         label = row[data.response_column].strip()
         if label and label not in RESPONSE_REGIME:
