@@ -72,7 +72,9 @@ def test_text_output_flags_yielding(tmp_path, capsys):
     code, out, err = _run(capsys, _write(tmp_path, CASE), "--coefficients", "paper")
     assert code == 0, err
     assert "U_sC" in out and "YES (outside the model)" not in out  # issue 36 item 7: no verdict beside a contrary flag
-    assert "Part I's U_s >= U_sC (eqs. (33)/(36); not used by the meyer rule) at U_s = " in out
+    from semianalytic.penetration.regime_setup import DEFAULT_REGIME_RULE
+
+    assert f"Part I's U_s >= U_sC (eqs. (33)/(36); not used by the {DEFAULT_REGIME_RULE} rule) at U_s = " in out
 
 
 def test_appendix_inverse_problem_through_the_cli(tmp_path, capsys):
