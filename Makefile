@@ -8,7 +8,7 @@ export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 export PYVISTA_OFF_SCREEN ?= true
 
-.PHONY: demo test check bench reports clean
+.PHONY: demo test check lint bench reports clean
 
 # The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
 # executable_path (never `playwright install`: no browser download); installed here when missing.
@@ -30,9 +30,13 @@ test: $(VENV)/.installed $(CHROMIUM)
 
 # The inner loop (about a minute on two idle cores): the suite without the `long` tests
 # (tests/conftest.py lists them; `make test` runs them too).
-check: $(VENV)/.installed
+check: $(VENV)/.installed lint
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not long"
+
+# ruff and mypy as configured in pyproject.toml; the mutation check's targets still exist (tools/lint_fix.sh).
+lint: $(VENV)/.installed
+	$(VENV)/bin/ruff check --quiet . && $(VENV)/bin/mypy && $(PY) tools/mutation_check.py --targets
 
 $(CHROMIUM):
 	$(SUDO) apt-get update

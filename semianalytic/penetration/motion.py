@@ -482,7 +482,7 @@ class DepthProfile:
         done = g == 0
         it = 0
         rate = np.zeros_like(P)
-        for it in range(1, 51):
+        for it in range(1, 51):  # noqa: B007 (the count is returned)
             F, G, dG = self._eval(P, (self._F, self._G, self._dG))
             r = G - g
             lo = np.where(r < 0, P, lo)
