@@ -28,8 +28,8 @@ test: $(VENV)/.installed $(CHROMIUM)
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile
 
-# The inner loop (about a minute on two idle cores): the suite without the `long` tests
-# (tests/conftest.py lists them; `make test` runs them too).
+# The inner loop (at most a minute on two idle cores): lint, then the suite without the `long` tests
+# (measured: tests/durations.json, tests/conftest.py LONG_SECONDS; `make test` runs them too).
 check: $(VENV)/.installed lint
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not long"
@@ -37,6 +37,10 @@ check: $(VENV)/.installed lint
 # ruff and mypy as configured in pyproject.toml; the mutation check's targets still exist (tools/lint_fix.sh).
 lint: $(VENV)/.installed
 	$(VENV)/bin/ruff check --quiet . && $(VENV)/bin/mypy && $(PY) tools/mutation_check.py --targets
+
+# Re-measure what is `long`: every test's duration into tests/durations.json (one worker, the whole suite).
+durations: $(VENV)/.installed $(CHROMIUM)
+	$(PY) -m pytest -q -p no:cacheprovider --write-durations tests/durations.json
 
 $(CHROMIUM):
 	$(SUDO) apt-get update
