@@ -29,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from semianalytic.ballistic_limit import theory as rigid
+
 __all__ = [
     "ogive_nose_factor",
     "nose_factors",
@@ -168,10 +170,9 @@ def tate_penetration(length: float, rod_density: float, rod_strength: float, tar
     """Alekseevskii-Tate penetration of a rod of length L at striking velocity V (module docstring)."""
     rho_p, Y_p, rho_t, R_t = rod_density, rod_strength, target_density, target_resistance
     v_rigid = math.sqrt(2.0 * (Y_p - R_t) / rho_t) if Y_p > R_t else 0.0
-    if V <= v_rigid:  # never erodes: rigid rod, Part IV eq. (3)
-        P = rho_p * length / rho_t * math.log1p(rho_t * V**2 / (2.0 * R_t))
-        a = math.sqrt(2.0 * R_t / rho_t)
-        T = 2.0 * rho_p * length / (rho_t * a) * math.atan(V / a)
+    if V <= v_rigid:  # never erodes: rigid rod, Part IV eqs. (2)-(4)
+        P = float(rigid.stopping_thickness(V, R_t, rho_t, rho_p, length))
+        T = rigid.stop_time(V, R_t, rho_t, rho_p, length)
         return TateResult(P, length, T, False, math.nan)
     v_stall = math.sqrt(2.0 * (R_t - Y_p) / rho_p) if R_t > Y_p else 0.0
     if V <= v_stall:  # the target never yields (u = 0): the rod erodes on the surface, no penetration
@@ -199,9 +200,8 @@ def tate_penetration(length: float, rod_density: float, rod_strength: float, tar
     t = sol.t[-1]
     if len(sol.t_events[1]):  # rod consumed
         return TateResult(P, 0.0, t, True, 0.0)
-    if Y_p > R_t:  # rigid phase of the residual rod, Part IV eqs. (2)-(3)
-        a = math.sqrt(2.0 * R_t / rho_t)
-        P += rho_p * L / rho_t * math.log1p(rho_t * v**2 / (2.0 * R_t))
-        t += 2.0 * rho_p * L / (rho_t * a) * math.atan(v / a)
+    if Y_p > R_t:  # rigid phase of the residual rod, Part IV eqs. (2)-(4)
+        P += float(rigid.stopping_thickness(v, R_t, rho_t, rho_p, L))
+        t += rigid.stop_time(v, R_t, rho_t, rho_p, L)
         return TateResult(P, L, t, True, v)
     return TateResult(P, L, t, True, 0.0)  # u = 0: the rest of the rod erodes on the crater floor
