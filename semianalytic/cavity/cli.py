@@ -51,12 +51,15 @@ def run(args) -> int:
     from semianalytic.case import load_case
     from semianalytic.cavity import BrittleMaterial, solve_cavity
 
+    from semianalytic.cavity.case import MODEL_FIELDS
+    from semianalytic.errors import model_field
+
     case = load_case(args.case)
     section = case.require("material")
-    material = BrittleMaterial.from_section(section)
     method = args.method or section.solver
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), model_field(MODEL_FIELDS):
         warnings.simplefilter("ignore", ModelValidityWarning)  # printed below instead
+        material = BrittleMaterial.from_section(section)
         result = solve_cavity(material, method)
     for note in result.warnings:
         print(f"warning: {note}", file=sys.stderr)

@@ -35,7 +35,8 @@ from typing import Annotated, Any, Literal, Union
 
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator, model_validator
 
-from semianalytic.errors import InputError
+from semianalytic.cavity.case import MODEL_FIELDS as CAVITY_FIELDS
+from semianalytic.errors import InputError, ModelError, model_field
 from semianalytic.penetration.resistance import (
     MODELS,
     Brittle,
@@ -229,7 +230,7 @@ def _builds(spec):
     """Case-load check: the inputs must give a model (e.g. eq. (16)'s logarithm positive)."""
     try:
         spec.build()
-    except InputError as exc:
+    except (InputError, ModelError) as exc:  # the model's input name: its last part is the key
         raise ValueError(f"{exc.field.rsplit('.', 1)[-1]}: {exc.message}") from None
     return spec
 
@@ -270,6 +271,7 @@ def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
                 loc = ["model"]
             raise InputError(".".join([field, *loc]), _message(err)) from None
     try:
-        return spec.build()
+        with model_field(CAVITY_FIELDS):
+            return spec.build()
     except InputError as exc:
         raise InputError(exc.field.replace("target.resistance", field, 1), exc.message) from None

@@ -18,10 +18,11 @@ def _cavity_solve(case: Case):
     import warnings
 
     from semianalytic.cavity import BrittleMaterial, solve_cavity
-    from semianalytic.errors import ModelValidityWarning
+    from semianalytic.cavity.case import MODEL_FIELDS
+    from semianalytic.errors import ModelValidityWarning, model_field
 
     sec = case.require("material")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), model_field(MODEL_FIELDS):
         warnings.simplefilter("ignore", ModelValidityWarning)  # reported in the document
         return BrittleMaterial.from_section(sec), solve_cavity(BrittleMaterial.from_section(sec), sec.solver)
 
