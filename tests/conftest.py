@@ -83,6 +83,8 @@ def pytest_runtest_logreport(report):
     if seen is not None:
         key = _test_id(report.nodeid)
         seen[key] = seen.get(key, 0.0) + float(report.duration)
+        if report.when == "teardown" and _CONFIG.getoption("--write-durations"):
+            _write_durations(_CONFIG)  # after every test: an interrupted run keeps what it measured
 
 
 _CONFIG = None
@@ -95,15 +97,22 @@ def pytest_sessionstart(session):
 
 
 def pytest_sessionfinish(session, exitstatus):
-    path = session.config.getoption("--write-durations")
-    if not path or hasattr(session.config, "workerinput"):  # xdist: the controller writes
+    if session.config.getoption("--write-durations"):
+        _write_durations(session.config)
+
+
+def _write_durations(config):
+    """Merge this run's durations into the --write-durations file (xdist: the controller writes)."""
+    if hasattr(config, "workerinput"):
         return
-    path = Path(path)
-    old = json.loads(path.read_text()) if path.is_file() else {}
-    load = 0.5 * (session.config._durations_load0 + os.getloadavg()[0])
+    path = Path(config.getoption("--write-durations"))
+    if not hasattr(config, "_durations_base"):  # the file as it was before this run
+        config._durations_base = json.loads(path.read_text()) if path.is_file() else {}
+    old = config._durations_base
+    load = 0.5 * (config._durations_load0 + os.getloadavg()[0])
     cores = os.cpu_count() or 1
     factor = min(1.0, cores / load) if load > 0 else 1.0
-    seen = session.config._durations_seen
+    seen = config._durations_seen
     seconds = dict(old.get("seconds", {}))
     seconds.update({k: round(v * factor, 2) for k, v in seen.items()})
     runs = [*old.get("runs", []), {"tests": len(seen), "load_average": round(load, 1), "cores": cores,
@@ -113,6 +122,7 @@ def pytest_sessionfinish(session, exitstatus):
                     "tests/conftest.py marks those >= LONG_SECONDS as long; written by "
                     "`pytest --write-durations tests/durations.json` (make durations)",
            "runs": runs[-10:],
-           "long_until_measured": sorted(set(old.get("long_until_measured", [])) - set(seen) - set(seconds)),
+           "long_until_measured": sorted(e for e in old.get("long_until_measured", []) if e not in seconds
+                                         and not any(k.startswith(e + "::") for k in seen)),
            "seconds": dict(sorted(seconds.items()))}
     path.write_text(json.dumps(doc, indent=1) + "\n")
