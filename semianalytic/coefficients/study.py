@@ -120,7 +120,7 @@ def table_error_study(nose, table, depths) -> dict:
 
 
 def reach_depths(nose, n: int = 1000, seed: int = 1000) -> np.ndarray:
-    """Issue 24's check of tight tables: n seeded random depths, a third in 0.9-1.3 L_h, the rest
+    """The check of tight tables: n seeded random depths, a third in 0.9-1.3 L_h, the rest
     log-uniform from 1e-6 to 300 nose lengths (below the first knot and past the default range too)."""
     rng = np.random.default_rng(seed)
     L = nose.depth_unit
