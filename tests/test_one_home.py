@@ -79,7 +79,7 @@ def test_eq11_is_defined_once_and_called_by_every_path():
                "def separation_onset"):
         body = motion[motion.index(fn):].split("\n\n\n")[0]
         assert "eq11_acceleration(" in body, fn
-    for rel in ("semianalytic/coefficients/report.py", "semianalytic/penetration/elastic.py"):
+    for rel in ("semianalytic/coefficients/study.py", "semianalytic/penetration/elastic.py"):
         assert "eq11_acceleration(" in _text(rel), rel
 
 
@@ -231,6 +231,7 @@ def test_part4_home_against_eq1_integrated_and_part1_constant_coefficients():
     assert np.abs(T.velocity_at_time(t, us, R, rho_t, rho_p, L) - sol.y[0]).max() <= 1e-9 * us
     assert np.abs(T.depth_at_time(t, us, R, rho_t, rho_p, L) - sol.y[1]).max() <= 1e-9 * sol.y[1][-1]
     assert T.stopping_thickness(us, R, rho_t, rho_p, L) == pytest.approx(sol.y[1][-1], rel=1e-9)
+    assert T.quadratic_drag_depth_at_velocity(0.0, 800.0, np.inf, 1.0) == 0.0  # B <= 0 in Part I: a = inf
     from semianalytic.penetration.motion import ConstantCoefficientSolution
 
     s = ConstantCoefficientSolution(2e-7, 3e-6, 4e-5, 0.02, 2700.0, 1e9, 800.0)

@@ -121,10 +121,10 @@ def quadratic_drag_depth_at_time(t, u_s, a, k):
 
 
 def quadratic_drag_depth_at_velocity(u, u_s, a, k):
-    """P(u) = ln((a^2 + u_s^2) / (a^2 + u^2)) / (2 k) (Part IV, eq. (3), errata item 23)."""
-    a2 = a * a
+    """P(u) = ln((a^2 + u_s^2) / (a^2 + u^2)) / (2 k) (Part IV, eq. (3), errata item 23), written
+    as (ln(1 + (u_s/a)^2) - ln(1 + (u/a)^2)) / (2 k): no cancellation for a >> u_s, and 0 for a = inf."""
     u = np.asarray(u, dtype=float)
-    return (np.log((a2 + u_s**2) / (a2 + u**2)) / (2.0 * k))[()]
+    return ((np.log1p((u_s / a) ** 2) - np.log1p((u / a) ** 2)) / (2.0 * k))[()]
 
 
 def _k(rho_t, rho_p, L_p):
