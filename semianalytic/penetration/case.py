@@ -36,7 +36,7 @@ from typing import Annotated, Any, Literal, Union
 from pydantic import AfterValidator, BaseModel, ConfigDict, Field, TypeAdapter, ValidationError, field_validator, model_validator
 
 from semianalytic.cavity.case import MODEL_FIELDS as CAVITY_FIELDS
-from semianalytic.errors import InputError, ModelError, model_field
+from semianalytic.errors import InputError, ModelError, case_key
 from semianalytic.penetration.resistance import (
     MODELS,
     Brittle,
@@ -271,7 +271,8 @@ def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
                 loc = ["model"]
             raise InputError(".".join([field, *loc]), _message(err)) from None
     try:
-        with model_field(CAVITY_FIELDS):
-            return spec.build()
+        return spec.build()
+    except ModelError as exc:  # the cavity model's input names -> the keys of the case (InputError, as documented)
+        raise InputError(case_key(exc.field, CAVITY_FIELDS), exc.message) from None
     except InputError as exc:
         raise InputError(exc.field.replace("target.resistance", field, 1), exc.message) from None

@@ -417,8 +417,11 @@ class CavityKernel:
         from semianalytic.errors import model_field
 
         sec = case.require("material")
-        with model_field(MODEL_FIELDS):
-            r = solve_cavity(BrittleMaterial.from_section(sec), sec.solver, warn=False)
+        try:
+            with model_field(MODEL_FIELDS):
+                r = solve_cavity(BrittleMaterial.from_section(sec), sec.solver, warn=False)
+        except ModelError as exc:  # a sample the model cannot compute: an invalid row (the engine's InputError)
+            raise InputError(exc.field, exc.message) from None
         return {
             "cavity_pressure_Pa": np.array([r.cavity_pressure]),
             "sigma_star_Pa": np.array([r.sigma_star]),
