@@ -28,7 +28,7 @@ def _cavity_solve(case: Case):
 
 
 def _cavity_preflight(case: Case, run: RunSection) -> None:
-    _cavity_solve(case)  # hard conditions of errata item 20 raise InputError here
+    _cavity_solve(case)  # hard conditions of errata item 20 raise ModelError here (the [material] key)
 
 
 def _cavity_run(ctx: Context) -> None:
