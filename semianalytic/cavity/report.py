@@ -14,6 +14,7 @@ from pathlib import Path
 import numpy as np
 from matplotlib.figure import Figure
 
+import semianalytic
 from semianalytic.case import load_case
 from semianalytic.cavity import BrittleMaterial, fixed_point_iteration, solve_cavity
 from semianalytic.cavity import zones
@@ -24,7 +25,7 @@ from semianalytic.report.figures import png_bytes
 
 __all__ = ["build", "main"]
 
-CASES = Path(__file__).resolve().parents[2] / "cases"
+CASES = Path(semianalytic.__file__).resolve().parents[1] / "cases"  # the project's cases, wherever this module sits
 GPa = 1e9
 
 

@@ -233,7 +233,9 @@ def _table_studies(quick: bool):
     cases = ["cases/fig14_sphere_6061T651.toml"] if quick else [
         "cases/piekutowski1999_var4340.toml", "cases/fig14_sphere_6061T651.toml", "cases/fig15a_ogive_6061T651.toml",
         "cases/fig15b_ogive_7075T651.toml", "cases/fig16_limestone.toml"]
-    root = Path(__file__).resolve().parents[2]  # the cases of the project, wherever the command runs (issue 27)
+    import semianalytic
+
+    root = Path(semianalytic.__file__).resolve().parents[1]  # the cases of the project, wherever the command runs
     contact = st.contact_effect([root / c for c in cases])
     for row, name in zip(contact, cases):
         row["case"] = name  # shown as the project path, not the machine's
