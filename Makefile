@@ -8,7 +8,7 @@ export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 export PYVISTA_OFF_SCREEN ?= true
 
-.PHONY: demo test check lint bench reports clean
+.PHONY: demo test check lint durations bench reports clean
 
 # The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
 # executable_path (never `playwright install`: no browser download); installed here when missing.
