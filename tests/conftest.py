@@ -66,6 +66,7 @@ def pytest_addoption(parser):
 
 def pytest_configure(config):
     config._durations_seen = {}
+    config._durations_failed = set()  # a test that failed or errored is not measured (an error is quick)
 
 
 def pytest_collection_modifyitems(config, items):
@@ -83,6 +84,8 @@ def pytest_runtest_logreport(report):
     if seen is not None:
         key = _test_id(report.nodeid)
         seen[key] = seen.get(key, 0.0) + float(report.duration)
+        if report.failed:
+            _CONFIG._durations_failed.add(key)
         if report.when == "teardown" and _CONFIG.getoption("--write-durations"):
             _write_durations(_CONFIG)  # after every test: an interrupted run keeps what it measured
 
@@ -112,7 +115,7 @@ def _write_durations(config):
     load = 0.5 * (config._durations_load0 + os.getloadavg()[0])
     cores = os.cpu_count() or 1
     factor = min(1.0, cores / load) if load > 0 else 1.0
-    seen = config._durations_seen
+    seen = {k: v for k, v in config._durations_seen.items() if k not in config._durations_failed}
     seconds = dict(old.get("seconds", {}))
     seconds.update({k: round(v * factor, 2) for k, v in seen.items()})
     runs = [*old.get("runs", []), {"tests": len(seen), "load_average": round(load, 1), "cores": cores,
