@@ -51,11 +51,17 @@ def _test_id(nodeid: str) -> str:
 
 
 def measured_durations() -> dict[str, float]:
+    """Seconds per test function, and per file the longest setup of one of its functions: a slow
+    shared (module-scoped) fixture is paid by whichever test of the file runs first, so such a file
+    is long as a whole."""
     if not DURATIONS.is_file():
         return {}
     doc = json.loads(DURATIONS.read_text())
     out = {k: float(v) for k, v in doc["seconds"].items()}
     out.update({k: math.inf for k in doc.get("long_until_measured", []) if k not in out})
+    for k, v in doc.get("setup_seconds", {}).items():
+        f = k.split("::", 1)[0]
+        out[f] = max(out.get(f, 0.0), float(v))
     return out
 
 
@@ -66,7 +72,8 @@ def pytest_addoption(parser):
 
 def pytest_configure(config):
     config._durations_seen = {}
-    config._durations_failed = set()  # a test that failed or errored is not measured (an error is quick)
+    config._durations_failed = set()
+    config._durations_setup = {}  # a test that failed or errored is not measured (an error is quick)
 
 
 def pytest_collection_modifyitems(config, items):
@@ -84,6 +91,9 @@ def pytest_runtest_logreport(report):
     if seen is not None:
         key = _test_id(report.nodeid)
         seen[key] = seen.get(key, 0.0) + float(report.duration)
+        if report.when == "setup":
+            setups = _CONFIG._durations_setup
+            setups[key] = max(setups.get(key, 0.0), float(report.duration))
         if report.failed:
             _CONFIG._durations_failed.add(key)
         if report.when == "teardown" and _CONFIG.getoption("--write-durations"):
@@ -118,6 +128,10 @@ def _write_durations(config):
     seen = {k: v for k, v in config._durations_seen.items() if k not in config._durations_failed}
     seconds = dict(old.get("seconds", {}))
     seconds.update({k: round(v * factor, 2) for k, v in seen.items()})
+    setup = dict(old.get("setup_seconds", {}))
+    setup.update({k: round(v * factor, 2) for k, v in config._durations_setup.items()
+                  if k in seen and v * factor >= 0.5})
+    setup = {k: v for k, v in setup.items() if v >= 0.5}
     runs = [*old.get("runs", []), {"tests": len(seen), "load_average": round(load, 1), "cores": cores,
                                    "factor": round(factor, 3)}]
     doc = {"about": "quiet-core seconds per test function (setup + call + teardown, all parameters, one "
@@ -127,5 +141,6 @@ def _write_durations(config):
            "runs": runs[-10:],
            "long_until_measured": sorted(e for e in old.get("long_until_measured", []) if e not in seconds
                                          and not any(k.startswith(e + "::") for k in seen)),
+           "setup_seconds": dict(sorted(setup.items())),
            "seconds": dict(sorted(seconds.items()))}
     path.write_text(json.dumps(doc, indent=1) + "\n")
