@@ -13,7 +13,7 @@ export MKL_NUM_THREADS ?= 1
 export MPLBACKEND ?= Agg
 export PYVISTA_OFF_SCREEN ?= true
 
-.PHONY: demo test test-311 test-313 check bench reports clean
+.PHONY: demo test test-311 test-313 check lint durations bench reports clean
 
 # The browser test (tests/test_browser_report.py) drives Debian's Chromium through playwright's
 # executable_path (never `playwright install`: no browser download); installed here when missing.
@@ -62,11 +62,19 @@ test-311: $(VENV)/.installed $(CHROMIUM)
 test-313: $(VENV313)/.installed $(CHROMIUM)
 	SEMIANALYTIC_KERNEL=numpy $(VENV313)/bin/python -m pytest -q -n 2 --dist loadfile
 
-# The inner loop (about a minute on two idle cores): the suite without the `long` tests
-# (tests/conftest.py lists them; `make test` runs them too), on 3.11.
-check: $(VENV)/.installed
+# The inner loop (at most a minute on two idle cores), on 3.11: lint, then the suite without the `long`
+# tests (measured: tests/durations.json, tests/conftest.py LONG_SECONDS; `make test` runs them too).
+check: $(VENV)/.installed lint
 	$(VENV)/bin/lint-imports --no-cache
 	$(PY) -m pytest -q -n 2 --dist loadfile -m "not slow and not long"
+
+# ruff and mypy as configured in pyproject.toml; the mutation check's targets still exist (tools/lint_fix.sh).
+lint: $(VENV)/.installed
+	$(VENV)/bin/ruff check --quiet . && $(VENV)/bin/mypy && $(PY) tools/mutation_check.py --targets
+
+# Re-measure what is `long`: every test's duration into tests/durations.json (one worker, the whole suite).
+durations: $(VENV)/.installed $(CHROMIUM)
+	$(PY) -m pytest -q -p no:cacheprovider --write-durations tests/durations.json
 
 $(CHROMIUM):
 	$(SUDO) apt-get update

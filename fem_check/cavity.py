@@ -383,12 +383,16 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from fem_check.report import Report, emit_json
+    from semianalytic.cavity.case import MODEL_FIELDS
+    from semianalytic.errors import model_field
 
-    material, title = material_from_args(args.case)
+    with model_field(MODEL_FIELDS):  # the cavity model's input names -> the [material] keys of the case
+        material, title = material_from_args(args.case)
     report = None if args.no_report else Report(Path(args.out), args.name, args.force)
     if report:
         report.check()
-    study = cavity_study(material, quick=args.quick)
+    with model_field(MODEL_FIELDS):
+        study = cavity_study(material, quick=args.quick)
     payload = _public(study)
     payload["material"] = title
     if report:

@@ -234,19 +234,10 @@ def driven_study(case, rod: Rod, n_elements: int = 400, courant: float = 2**-0.5
 
 
 def _coefficients_for(nose):
-    """Drag coefficients for the nose: the BEM table if it exists, else the paper's constants."""
-    try:
-        import semianalytic.coefficients.table  # noqa: F401 (the BEM table is available)
-        from semianalytic.cache import cached_coefficient_table
+    """Drag coefficients for the nose: its BEM coefficient table (body reading, cached per user)."""
+    from semianalytic.cache import cached_coefficient_table
 
-        return cached_coefficient_table(nose), "BEM table (body reading)"
-    except ImportError:
-        from semianalytic.coefficients import ConstantCoefficients
-
-        paper = {"sphere": (1.5e-3, 0.58, 1.0), "ogive": (1.0e-3, 0.11, 1.0)}
-        Ab, Bb, Cb = paper.get(nose.kind, paper["ogive"])
-        return ConstantCoefficients.from_normalised(Ab, Bb, Cb, nose.diameter), \
-            f"paper's constants (Abar = {Ab * 1e3} mm, Bbar = {Bb}, Cbar = {Cb}; BEM table not available)"
+    return cached_coefficient_table(nose), "BEM table (body reading)"
 
 
 def rod_from_case(case) -> tuple[Rod, float | None]:
@@ -299,10 +290,7 @@ def run(args) -> int:
     step = step_load_study(rod, sigma0, args.round_trips, args.elements)
     driven = None
     if case is not None and case.section("impact") is not None and case.require("target").resistance is not None:
-        try:
-            driven = driven_study(case, rod, args.elements)
-        except ImportError as exc:
-            driven = {"skipped": f"Part I dynamics not available ({exc})"}
+        driven = driven_study(case, rod, args.elements)
     payload = {k: v for k, v in step.items() if not k.startswith("_")}
     if driven is not None:
         payload["driven"] = {k: v for k, v in driven.items() if not k.startswith("_")}

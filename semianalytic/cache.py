@@ -173,8 +173,8 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
     ``source="bem"``: the BEM table of the case's nose (cached on disk), in the B reading of
     ``[coefficients] reading`` (errata item 2a); ``"paper"``: the paper's quoted constants
     (:func:`semianalytic.penetration.curve.paper_coefficients`).  ``tolerance`` overrides
-    ``[coefficients] tolerance`` (the table's relative interpolation error).  ``fallback`` is True when "bem" was asked for but the table
-    module is not available (then the paper's constants are used).
+    ``[coefficients] tolerance`` (the table's relative interpolation error).  ``fallback`` is always False (kept in the
+    tuple for the callers that print a fallback warning).
     """
     from semianalytic.errors import InputError
 
@@ -185,16 +185,6 @@ def coefficients_for_case(case, source: str = "bem", cache_dir=None, progress: b
         return paper_coefficients(psec), "the paper's quoted deep-penetration Abar, Bbar, Cbar (constant in P)", False
     if source != "bem":
         raise InputError("coefficients", f"must be 'bem' or 'paper'; got {source!r}")
-    try:
-        import semianalytic.coefficients.table  # noqa: F401
-    except ImportError:
-        from semianalytic.penetration.curve import paper_coefficients
-
-        return (
-            paper_coefficients(psec),
-            "the paper's quoted Abar, Bbar, Cbar (FALLBACK: the BEM coefficient table is not available)",
-            True,
-        )
     cs = case.coefficients
     tolerance = cs.tolerance if tolerance is None else tolerance
     nose, kwargs = case_table_request(case, tolerance)

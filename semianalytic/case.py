@@ -384,10 +384,8 @@ def _section_model(name: str) -> type[BaseModel]:
     if name in _CORE:
         return _CORE[name]
     module, _, attr = SECTIONS[name].partition(":")
-    try:
-        return getattr(importlib.import_module(module), attr)
-    except (ImportError, AttributeError):
-        raise InputError(name, f"section [{name}] is not supported by this version") from None
+    model: type[BaseModel] = getattr(importlib.import_module(module), attr)  # a broken import is a bug: exit 1
+    return model
 
 
 def parse_case(data: Mapping[str, Any], path: Path | None = None) -> Case:

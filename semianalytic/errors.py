@@ -6,7 +6,16 @@
 they can compute; the CLI dispatcher turns it into exit status 2 with one line, as bad input.
 ``ConvergenceError`` is the ModelError of an iterative solve that did not converge (never a
 silent result).  Anything else escaping a command is an internal failure (exit status 1).
+
+A model names its inputs in model words (``ModelError(message, field="cavity.tensile_strength")``);
+the case layer that built the model's inputs from a case file maps the name to the key the user
+wrote, with :func:`model_field` (``with model_field({"cavity.": "material."}): solve_cavity(...)``),
+so that the line the user sees is the one a case-layer check would have written.
 """
+
+import copy
+from collections.abc import Iterator, Mapping
+from contextlib import contextmanager
 
 
 def one_line(text: str) -> str:
@@ -35,6 +44,34 @@ class ModelError(ValueError):
         self.field = one_line(str(field))
         self.message = one_line(str(message))
         super().__init__(f"{self.field}: {self.message}")
+
+
+def case_key(field: str, names: Mapping[str, str]) -> str:
+    """The case key of a model-level name: ``names[field]`` when present, else the longest prefix of
+    ``names`` ending in "." replaced (``{"cavity.": "material."}``), else ``field`` itself."""
+    if field in names:
+        return names[field]
+    prefixes = [p for p in names if p.endswith(".") and field.startswith(p)]
+    if prefixes:
+        p = max(prefixes, key=len)
+        return names[p] + field[len(p):]
+    return field
+
+
+@contextmanager
+def model_field(names: Mapping[str, str]) -> Iterator[None]:
+    """Within the block, a :class:`ModelError` is raised again (same class and message) with its
+    field mapped by :func:`case_key` to the case key the user wrote."""
+    try:
+        yield
+    except ModelError as exc:
+        key = case_key(exc.field, names)
+        if key == exc.field:
+            raise
+        mapped = copy.copy(exc)  # the same class (and attributes), the case key as its field
+        mapped.field = key
+        mapped.args = (f"{key}: {exc.message}",)
+        raise mapped from None
 
 
 class ConvergenceError(ModelError):

@@ -551,7 +551,7 @@ def spline_stations(control_radii, nose_length: float, diameter: float) -> np.nd
 
 
 def spline_nose(diameter: float, control_radii, nose_length: float, field_name: str = "projectile.control_radii") -> Nose:
-    """Free-form nose from a few control points (issue 24; this project's own shape family):
+    """Free-form nose from a few control points (this project's own shape family):
     the control radii c_1..c_m (fractions of d/2, each in (0, 1]) at the m equally spaced
     stations xi_k = k L_h / (m + 1) back from the tip, with the tip (0, 0) and the shoulder
     (L_h, d/2) as end points, define the Bezier curve (one-interval clamped B-spline) of degree

@@ -65,7 +65,7 @@ def contained_path(root: str | os.PathLike, relative: str, field: str) -> Path:
 
 def interrupt_on_termination():
     """SIGTERM and SIGHUP raise KeyboardInterrupt (as Ctrl-C does) until the returned undo is
-    called, so that staging folders and temporary files are removed on the way out (issue 27).
+    called, so that staging folders and temporary files are removed on the way out.
     Only in the main thread, and only where the signal has its default handler."""
     import signal
     import threading
@@ -130,7 +130,7 @@ def check_file_target(path: str | os.PathLike, field: str, inputs=()) -> Path:
 
 def check_report_target(path: str | os.PathLike, force: bool, inputs=()) -> Path:
     """A report path that may be written: refuse to overwrite an existing one without force, and
-    (issue 27) a report into ``/``, the home folder (or above it) or a folder above the working
+    a report into ``/``, the home folder (or above it) or a folder above the working
     folder (``--report OUT/../../..``)."""
     path = Path(path)
     try:
@@ -261,7 +261,7 @@ def _cache_entry_fault(data: bytes, key: str) -> str | None:
 
 def case_input_path(case_path: str | os.PathLike | None, name: str, field: str) -> Path:
     """The file ``name`` that a case file names (a data table, a shot table, another case), read
-    from the case file's folder or below it only (issue 27): an absolute path, a ``..`` or a
+    from the case file's folder or below it only: an absolute path, a ``..`` or a
     symbolic link leading out of that folder is refused naming ``field``, so that a case cannot
     make a command read any file of the system.  Without a case path: the working folder."""
     base = Path(case_path).parent if case_path is not None else Path(".")

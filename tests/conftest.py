@@ -8,7 +8,10 @@ failure (``@reproduce_failure``), and the seed is printed by hypothesis's own re
 
 from __future__ import annotations
 
+import json
+import math
 import os
+from pathlib import Path
 
 try:
     from hypothesis import settings
@@ -22,78 +25,113 @@ if settings is not None:
 
 
 # --------------------------------------------------------------------------------------------
-# The inner loop.  `make check` runs the suite without the tests below (each takes more than a
-# few seconds of CPU: benchmarks on small problems, certified tables of cornered noses, sampler
-# runs, FEM studies, subprocess sweeps); `make test` (and so CI) runs everything that is not
-# `slow`.  A node id here is a file, or a test function of a file (all its parameters).
-LONG = {
-    "tests/test_regimes_transfer.py::test_calibrate_regimes_transfer_through_the_cli",
-    "tests/test_regimes_transfer.py::test_transfer_between_materials_against_the_data_file",
-    "tests/test_regimes_transfer.py::test_issue22_targets",
-    "tests/test_benchmarks_small.py",
-    "tests/test_bad_input.py::test_bad_case_exit_status_in_a_subprocess",
-    "tests/test_browser_report.py",
-    "tests/test_cache.py::test_commands_write_no_cache_into_the_working_directory",
-    "tests/test_calibration.py::test_calibrate_cli_files_keys_and_penetrate_posterior_other_noses",
-    "tests/test_calibration.py::test_sampler_against_quadrature_of_the_same_posterior",
-    "tests/test_calibration_crossval.py",
-    "tests/test_calibration_eroding.py",
-    "tests/test_cli_noses.py",
-    "tests/test_corpus.py",
-    "tests/test_fem_cli.py::test_cavity_json",
-    "tests/test_fem_corners.py::test_fem_flat_nose_converges_at_the_graded_rate",
-    "tests/test_fem_error_bar.py",
-    "tests/test_plate_report.py",
-    "tests/test_plate_coefficients.py::test_fem_agreement",
-    "tests/test_plate_coefficients.py::test_fem_agreement_drag",
-    "tests/test_plate_coefficients.py::test_table_interface_and_zero_beyond_exit",
-    "tests/test_docs.py",
-    "tests/test_perforation.py::test_part4_table3_shots_beside_the_ballistic_limit_command",
-    "tests/test_perforation.py::test_run_gains_a_perforation_section",
-    "tests/test_perforation.py::test_flat_nose_plug_against_recht_ipson_closed_form",
-    "tests/test_user_outputs.py::test_run_csv_one_row_per_velocity_and_model",
-    "tests/test_user_outputs.py::test_progress_on_a_terminal_only_and_not_with_quiet",
-    "tests/test_user_outputs.py::test_penetrate_csv_and_per_shot_table",
-    "tests/test_tables_speed_and_reach.py::test_near_hemisphere_costs_what_the_hemisphere_costs",
-    "tests/test_calibration.py::test_penetrate_posterior_refuses_other_target_and_bad_files",
-    "tests/test_plate_coefficients.py::test_energy_identity_through_the_back_face",
-    "tests/test_bem_corners.py::test_more_grading_does_not_diverge",
-    "tests/test_optimize_shapes.py::test_sweep_over_the_exponent_builds_a_table_per_design",
-    "tests/test_guards_and_outputs.py::test_run_and_penetrate_write_no_cache_into_the_cwd",
-    "tests/test_hardening_properties.py",
-    "tests/test_optimize.py",
-    "tests/test_penetration_cli.py::test_report_is_not_overwritten_without_force",
-    "tests/test_readme_commands.py",
-    "tests/test_run_report.py",
-    "tests/test_separation_onset.py::test_onset_is_the_first_knot_where_eq9_turns_negative",
-    "tests/test_startup_imports.py",
-    "tests/test_sweep_engine.py::test_killed_sweep_process_resumes",
-    "tests/test_sweep_penetration.py::test_velocity_by_material_on_an_existing_dask_cluster",
-    "tests/test_sweep_vectorised.py",
-    "tests/test_table_corners.py::test_certified_table_within_tolerance_off_knots_and_beside_breakpoints",
-    "tests/test_tables.py::test_depth_error_estimate_bounds_a_tighter_table",
-    "tests/test_tables.py::test_short_blunt_nose_reaches_its_deep_limit_with_the_defaults",
-    "tests/test_tables.py::test_table_against_direct_solves_at_random_depths",
-    "tests/test_tables_speed_and_reach.py::test_block_sums_of_the_rules_match_adaptive_quadrature",
-    "tests/test_force_reports.py::test_force_refuses_a_users_file_and_replaces_its_own",
-    # moved out of the inner loop on 2026-11-29, when make check had reached 72 s on a slower day of
-    # this shared machine (2-6 s each: report regenerations, subprocess schedulers, compiles, optimisers)
-    "tests/test_report_freshness.py::test_part3_nanostrength_report_regenerates_identically",
-    "tests/test_report_freshness.py::test_part2_cavity_report_regenerates_identically",
-    "tests/test_nanostrength_cli.py::test_report_written_and_not_overwritten",
-    "tests/test_sweep_external.py::test_sweep_on_an_external_scheduler",
-    "tests/test_optimize_plates.py::test_optimize_a_plate_objective",
-    "tests/test_ring_kernel_c.py::test_nothing_planted_in_the_cache_is_loaded",
-    "tests/test_tables_speed_and_reach.py::test_truncated_ogive_shallow_direct_solve_through_the_cli",
-    "tests/test_optimize_spline.py::test_spline_case_fem_against_bem",
-    "tests/test_optimize_spline.py::test_spline_optimize_vary_key_checks",
-}
+# The inner loop.  `make check` runs the suite without the `long` tests; `make test` (and so CI)
+# runs everything that is not `slow`.  A test function is `long` when its measured duration (setup,
+# call and teardown, summed over its parameters, one worker) in tests/durations.json is at least
+# LONG_SECONDS.  The file is measured, not edited: `make durations` (pytest --write-durations
+# tests/durations.json) rewrites the entries of the tests it ran, in quiet-core seconds (the
+# measured seconds times cores / load average over the run, when the load exceeds the cores); a
+# test not in the file is short until it is measured, except those of "long_until_measured" (the
+# hand list this replaced, for the tests not yet measured: a run removes the ones it measures).
+DURATIONS = Path(__file__).with_name("durations.json")
+LONG_SECONDS = 1.5  # quiet-core seconds: the check set then sums to about 73 s of one core (37 s on two)
+
+
+def _test_id(nodeid: str) -> str:
+    return nodeid.split("[", 1)[0]
+
+
+def measured_durations() -> dict[str, float]:
+    """Seconds per test function, and per file the longest setup of one of its functions: a slow
+    shared (module-scoped) fixture is paid by whichever test of the file runs first, so such a file
+    is long as a whole."""
+    if not DURATIONS.is_file():
+        return {}
+    doc = json.loads(DURATIONS.read_text())
+    out = {k: float(v) for k, v in doc["seconds"].items()}
+    out.update({k: math.inf for k in doc.get("long_until_measured", []) if k not in out})
+    for k, v in doc.get("setup_seconds", {}).items():
+        f = k.split("::", 1)[0]
+        out[f] = max(out.get(f, 0.0), float(v))
+    return out
+
+
+def pytest_addoption(parser):
+    parser.addoption("--write-durations", metavar="PATH", default=None,
+                     help="write the measured duration of every test function run into PATH (JSON; merged)")
+
+
+def pytest_configure(config):
+    config._durations_seen = {}
+    config._durations_failed = set()
+    config._durations_setup = {}  # a test that failed or errored is not measured (an error is quick)
 
 
 def pytest_collection_modifyitems(config, items):
     import pytest
 
+    seconds = measured_durations()
     for item in items:
-        test = item.nodeid.split("[", 1)[0]
-        if test in LONG or test.split("::", 1)[0] in LONG:
+        test = _test_id(item.nodeid)
+        if max(seconds.get(test, 0.0), seconds.get(test.split("::", 1)[0], 0.0)) >= LONG_SECONDS:
             item.add_marker(pytest.mark.long)
+
+
+def pytest_runtest_logreport(report):
+    seen = getattr(_CONFIG, "_durations_seen", None)
+    if seen is not None:
+        key = _test_id(report.nodeid)
+        seen[key] = seen.get(key, 0.0) + float(report.duration)
+        if report.when == "setup":
+            setups = _CONFIG._durations_setup
+            setups[key] = max(setups.get(key, 0.0), float(report.duration))
+        if report.failed:
+            _CONFIG._durations_failed.add(key)
+        if report.when == "teardown" and _CONFIG.getoption("--write-durations"):
+            _write_durations(_CONFIG)  # after every test: an interrupted run keeps what it measured
+
+
+_CONFIG = None
+
+
+def pytest_sessionstart(session):
+    global _CONFIG
+    _CONFIG = session.config
+    session.config._durations_load0 = os.getloadavg()[0]
+
+
+def pytest_sessionfinish(session, exitstatus):
+    if session.config.getoption("--write-durations"):
+        _write_durations(session.config)
+
+
+def _write_durations(config):
+    """Merge this run's durations into the --write-durations file (xdist: the controller writes)."""
+    if hasattr(config, "workerinput"):
+        return
+    path = Path(config.getoption("--write-durations"))
+    if not hasattr(config, "_durations_base"):  # the file as it was before this run
+        config._durations_base = json.loads(path.read_text()) if path.is_file() else {}
+    old = config._durations_base
+    load = 0.5 * (config._durations_load0 + os.getloadavg()[0])
+    cores = os.cpu_count() or 1
+    factor = min(1.0, cores / load) if load > 0 else 1.0
+    seen = {k: v for k, v in config._durations_seen.items() if k not in config._durations_failed}
+    seconds = dict(old.get("seconds", {}))
+    seconds.update({k: round(v * factor, 2) for k, v in seen.items()})
+    setup = dict(old.get("setup_seconds", {}))
+    setup.update({k: round(v * factor, 2) for k, v in config._durations_setup.items()
+                  if k in seen and v * factor >= 0.5})
+    setup = {k: v for k, v in setup.items() if v >= 0.5}
+    runs = [*old.get("runs", []), {"tests": len(seen), "load_average": round(load, 1), "cores": cores,
+                                   "factor": round(factor, 3)}]
+    doc = {"about": "quiet-core seconds per test function (setup + call + teardown, all parameters, one "
+                    "worker; measured seconds times cores / load average when the load exceeds the cores); "
+                    "tests/conftest.py marks those >= LONG_SECONDS as long; written by "
+                    "`pytest --write-durations tests/durations.json` (make durations)",
+           "runs": runs[-10:],
+           "long_until_measured": sorted(e for e in old.get("long_until_measured", []) if e not in seconds
+                                         and not any(k.startswith(e + "::") for k in seen)),
+           "setup_seconds": dict(sorted(setup.items())),
+           "seconds": dict(sorted(seconds.items()))}
+    path.write_text(json.dumps(doc, indent=1) + "\n")

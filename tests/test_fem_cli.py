@@ -17,7 +17,6 @@ def _json(capsys, argv):
 
 
 def test_verify_projectile_json(capsys):
-    pytest.importorskip("semianalytic.coefficients.table")
     d = _json(capsys, ["verify", str(ROOT / "cases/fig5_ogive.toml"), "--quick", "--depths", "2", "--h", "0.1",
                        "--json", "--no-report"])
     row = d["depths"][0]

@@ -69,7 +69,6 @@ def test_far_field_monopole_robin_beats_dipole_and_neumann_in_the_halfspace():
 def test_bem_and_fem_agree_at_three_depths(kind):
     # brief: A and C within 1e-3, B within 5e-3 at the test resolution (here P2, h = 0.08 d,
     # where the measured differences are below 1e-4 for A, B_body and C, for both noses).
-    pytest.importorskip("semianalytic.coefficients.table")
     from semianalytic.coefficients.table import coefficients_at
 
     nose = sphere_nose(D) if kind == "sphere" else ogive_nose(D, 3.0)

@@ -79,7 +79,7 @@ def test_eq11_is_defined_once_and_called_by_every_path():
                "def separation_onset"):
         body = motion[motion.index(fn):].split("\n\n\n")[0]
         assert "eq11_acceleration(" in body, fn
-    for rel in ("semianalytic/coefficients/report.py", "semianalytic/penetration/elastic.py"):
+    for rel in ("semianalytic/coefficients/study.py", "semianalytic/penetration/elastic.py"):
         assert "eq11_acceleration(" in _text(rel), rel
 
 
@@ -213,3 +213,73 @@ def test_meyer_conversion_has_one_home():
     # HV 372 (38 HRC): H_M = 372 / sin 68 deg kgf/mm^2 by hand, in both units
     assert meyer_hardness(372.0) == pytest.approx(372.0 / 0.9271838545667874, rel=1e-14)
     assert meyer_hardness_from_vickers(372.0) == pytest.approx(372.0 / 0.9271838545667874 * 9.80665e6, rel=1e-14)
+
+
+# Part IV's rigid-rod closed forms (eqs. (2)-(4) of du/dt = -k (u^2 + a^2)) and the right-hand side
+# of Part IV, eq. (1): one home each, semianalytic/ballistic_limit/theory.py (quadratic_drag_* and
+# eq1_deceleration); Part I's constant-coefficient solution, Tate's rigid phase and the Part IV report's
+# ODE check call them.
+PART4_HOME = "semianalytic/ballistic_limit/theory.py"
+PART4_PATTERNS = {
+    "stop time arctan(u/a)": r"\batan\(\s*[\w.]+\s*/\s*(self\.)?a\s*\)",
+    "velocity (u - a tan)/(a + u tan)": r"\(\s*(self\.)?a\s*\+\s*[\w.]+\s*\*\s*tg\s*\)",
+    "depth ln(cos g + u/a sin g)": r"log\(\s*np\.cos\(",
+    "depth ln((a^2 + u_s^2)/(a^2 + u^2))": r"log1?p?\(\s*\(\s*a2\s*\+|log1p\(\s*\(\s*[\w.]+\s*/\s*(self\.)?a\s*\)\s*\*\*\s*2"
+                                            r"|log1p\(\s*rho_t\s*\*\s*\w+\s*\*\*\s*2\s*/\s*\(\s*2\.0\s*\*\s*R",
+    "eq. (1) right-hand side": r"0\.5\s*\*\s*rho_t\s*\*\s*[\w.\[\]]+\s*\*\*\s*2\s*[-+]\s*R\b",
+}
+
+
+@pytest.mark.parametrize("name", sorted(PART4_PATTERNS))
+def test_part4_closed_forms_are_written_once(name):
+    hits = [h for h in _hits(PART4_PATTERNS[name]) if not h.startswith(PART4_HOME)]
+    assert hits == [], hits
+    assert [h for h in _hits(PART4_PATTERNS[name]) if h.startswith(PART4_HOME)], "the home itself must match"
+
+
+@pytest.mark.parametrize("name, copy", [
+    ("stop time arctan(u/a)", "return math.atan(self.U0 / self.a) / (self.a * self.k)"),  # the old motion.py
+    ("stop time arctan(u/a)", "T = 2.0 * rho_p * length / (rho_t * a) * math.atan(V / a)"),  # the old peers.py
+    ("velocity (u - a tan)/(a + u tan)", "return a * (U - a * tg) / (a + U * tg)"),  # the old motion.py
+    ("depth ln(cos g + u/a sin g)", "return np.log(np.cos(g) + self.U0 / self.a * np.sin(g)) / self.k"),
+    ("depth ln((a^2 + u_s^2)/(a^2 + u^2))", "return math.log1p((self.U0 / self.a) ** 2) / (2.0 * self.k)"),
+    ("depth ln((a^2 + u_s^2)/(a^2 + u^2))", "return np.log((a2 + self.U0**2) / (a2 + u * u)) / (2.0 * self.k)"),
+    ("depth ln((a^2 + u_s^2)/(a^2 + u^2))", "P += rho_p * L / rho_t * math.log1p(rho_t * v**2 / (2.0 * R_t))"),
+    ("eq. (1) right-hand side", "sol = solve_ivp(lambda _, y: [(-0.5 * rho_t * y[0] ** 2 - R) / (rho_p * L), y[0]],"),
+])
+def test_the_part4_patterns_catch_the_old_copies(name, copy):
+    assert re.search(PART4_PATTERNS[name], copy), (name, copy)
+
+
+def test_part4_closed_forms_are_called_by_every_path():
+    motion = _text("semianalytic/penetration/motion.py")
+    body = motion[motion.index("class ConstantCoefficientSolution"):].split("\n\n\n")[0]
+    for fn in ("quadratic_drag_stop_time(", "quadratic_drag_velocity(", "quadratic_drag_depth_at_time(",
+               "quadratic_drag_depth_at_velocity("):
+        assert fn in body, fn
+    assert "eq1_deceleration(" in _text("semianalytic/ballistic_limit/study.py")
+
+
+def test_part4_home_against_eq1_integrated_and_part1_constant_coefficients():
+    """The one home against an independent method: eq. (1) integrated (DOP853) to 1e-9, and Part I's
+    constant-coefficient solution (which now calls it) against the same integration of eq. (11)."""
+    from scipy.integrate import solve_ivp
+
+    from semianalytic.ballistic_limit import theory as T
+
+    R, rho_t, rho_p, L, us = 2.0e9, 7800.0, 7850.0, 0.05, 800.0
+    t_end = T.stop_time(us, R, rho_t, rho_p, L)
+    t = np.linspace(0.0, t_end, 50)
+    # the right-hand side written here, not taken from the home: the check must not share it
+    sol = solve_ivp(lambda _, y: [-(rho_t * y[0] ** 2 / 2 + R) / (rho_p * L), y[0]], (0, t_end), [us, 0.0],
+                    t_eval=t, rtol=1e-12, atol=1e-12, method="DOP853")
+    assert np.abs(T.velocity_at_time(t, us, R, rho_t, rho_p, L) - sol.y[0]).max() <= 1e-9 * us
+    assert np.abs(T.depth_at_time(t, us, R, rho_t, rho_p, L) - sol.y[1]).max() <= 1e-9 * sol.y[1][-1]
+    assert T.stopping_thickness(us, R, rho_t, rho_p, L) == pytest.approx(sol.y[1][-1], rel=1e-9)
+    assert T.quadratic_drag_depth_at_velocity(0.0, 800.0, np.inf, 1.0) == 0.0  # B <= 0 in Part I: a = inf
+    from semianalytic.penetration.motion import ConstantCoefficientSolution
+
+    s = ConstantCoefficientSolution(2e-7, 3e-6, 4e-5, 0.02, 2700.0, 1e9, 800.0)
+    ode = solve_ivp(lambda _, y: [-s.k * (y[0] ** 2 + s.a**2), y[0]], (0, s.penetration_time), [800.0, 0.0],
+                    rtol=1e-12, atol=1e-12, method="DOP853")
+    assert s.final_depth == pytest.approx(ode.y[1][-1], rel=1e-9)

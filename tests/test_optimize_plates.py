@@ -17,8 +17,6 @@ from pathlib import Path
 import pandas as pd
 import pytest
 
-pytest.importorskip("semianalytic.perforation.model")
-
 ROOT = Path(__file__).resolve().parent.parent
 DEMO = ROOT / "cases" / "perforation_ogive_6061T651.toml"
 COARSE = """

@@ -143,7 +143,7 @@ def test_part2_cavity_report_regenerates_identically(tmp_path):
 def test_part3_nanostrength_report_regenerates_identically():
     """`python -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force`
     (a few seconds in-process): the same analysis and text, but for the elapsed time."""
-    from semianalytic.nanostrength.analysis import analyse_section
+    from semianalytic.nanostrength.case import analyse_section
     from semianalytic.nanostrength.report import build_report
 
     committed = (ROOT / "reports" / "part3_nanostrength.md").read_text()

@@ -1,6 +1,7 @@
 """The common unit strings are parsed without pint (start-up, issue 14); pint stays the authority.
 
-The reference is pint itself: every entry of ``units._COMMON_UNITS`` and every quantity string of
+The reference is pint itself: every entry of ``units._COMMON_UNITS`` (each once), any number in
+any spelling with any of them (a hypothesis property, 300 examples) and every quantity string of
 the bundled cases parse to the same float, bit for bit (sign of zero included), or to the same
 error, with the fast path as without it.  Exact equality, no tolerance: the fast path multiplies
 by pint's own conversion factor, as pint does.
@@ -16,6 +17,8 @@ import tomllib
 from pathlib import Path
 
 import pytest
+from hypothesis import HealthCheck, given, settings
+from hypothesis import strategies as st
 
 from semianalytic import units
 from semianalytic.errors import InputError
@@ -43,16 +46,32 @@ def _outcome(value: str, kind: str, fast: bool, monkeypatch) -> tuple:
 
 
 @pytest.mark.parametrize("unit", sorted(units._COMMON_UNITS))
-def test_common_units_parse_as_pint_does(unit, monkeypatch):
+def test_every_common_unit_parses_as_pint_does(unit, monkeypatch):
+    """Each unit of the fast path once, in each spelling, against pint (the table itself, all of it)."""
     kind = units._COMMON_UNITS[unit][0]
-    fast_hits = 0
-    for number in NUMBERS:
-        for spelling in SPELLINGS:
-            value = spelling.format(n=number, u=unit)
-            fast = _outcome(value, kind, True, monkeypatch)
-            assert fast == _outcome(value, kind, False, monkeypatch), value
-            fast_hits += units._common_unit_si(value, kind) is not None
-    assert fast_hits > len(NUMBERS)  # the fast path did take the common spellings
+    assert units._common_unit_si(f"7.11 {unit}", kind) is not None  # the fast path takes it
+    for spelling in SPELLINGS:
+        value = spelling.format(n="7.11", u=unit)
+        assert _outcome(value, kind, True, monkeypatch) == _outcome(value, kind, False, monkeypatch), value
+
+
+# numbers as a user types them: the hand-picked edge cases, or any float / integer in any notation
+_NUMBER = st.one_of(
+    st.sampled_from(NUMBERS),
+    st.floats(allow_nan=False, allow_infinity=False).map(repr),
+    st.integers(-10**20, 10**20).map(str),
+    st.builds(lambda m, e: f"{m}e{e}", st.integers(-999, 999), st.integers(-330, 330)),
+)
+
+
+@settings(max_examples=300, suppress_health_check=[HealthCheck.function_scoped_fixture])
+@given(unit=st.sampled_from(sorted(units._COMMON_UNITS)), number=_NUMBER, spelling=st.sampled_from(SPELLINGS))
+def test_common_units_parse_as_pint_does(unit, number, spelling, monkeypatch):
+    """Property: for any number, unit and spelling, the fast path gives pint's float, bit for bit
+    (sign of zero included), or pint's error."""
+    kind = units._COMMON_UNITS[unit][0]
+    value = spelling.format(n=number, u=unit)
+    assert _outcome(value, kind, True, monkeypatch) == _outcome(value, kind, False, monkeypatch), value
 
 
 @pytest.mark.parametrize("unit", sorted(units._COMMON_UNITS))

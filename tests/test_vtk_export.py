@@ -116,7 +116,6 @@ def test_bem_field_in_the_file(tmp_path):
 def test_fem_field_file(tmp_path):
     """fem_check's FEM potential written as .vtu: read back, it holds the FEM nodal values, and
     near the nose it agrees with the BEM (an independent method) to the FEM's accuracy."""
-    pytest.importorskip("fem_check.potential")
     from fem_check.api import potential_field
     from fem_check.meshing import MeshOptions, build_mesh, halfspace_domain
     from fem_check.potential import solve_potential

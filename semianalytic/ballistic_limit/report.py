@@ -11,8 +11,6 @@ import math
 
 import numpy as np
 from matplotlib.figure import Figure
-from scipy.integrate import solve_ivp
-from scipy.optimize import brentq
 
 from semianalytic.ballistic_limit.empirical import composite_vcr, fit_constants, vcr_eq9
 from semianalytic.ballistic_limit.energy import kinetic_energy, plastic_work_density
@@ -29,12 +27,8 @@ from semianalytic.ballistic_limit.paper import (
     table4_paper,
 )
 from semianalytic.ballistic_limit.shots import empirical_limits
+from semianalytic.ballistic_limit.study import closed_forms_against_ode, implied_moduli
 from semianalytic.ballistic_limit.tables import load_table1, load_table2, load_table3, load_table4, load_table5
-from semianalytic.ballistic_limit.theory import (
-    depth_at_time,
-    stop_time,
-    velocity_at_time,
-)
 from semianalytic.report.output import report_command
 from semianalytic.report.document import Document, to_markdown
 from semianalytic.report.figures import png_bytes
@@ -56,19 +50,6 @@ def _v(x) -> str:
     return "-" if x is None else f"{x:.1f}"
 
 
-def _ode_check() -> tuple[float, float]:
-    """Largest relative error of eq. (2) (errata 22) and P(t) (errata 24) against eq. (1) integrated."""
-    rho_t = rho_p = 7800.0
-    L, R, us = 0.0516, 2.388 * GPa, 900.0
-    t_end = stop_time(us, R, rho_t, rho_p, L)
-    t = np.linspace(0, t_end, 200)
-    sol = solve_ivp(lambda _, y: [(-0.5 * rho_t * y[0] ** 2 - R) / (rho_p * L), y[0]], (0, t_end), [us, 0.0],
-                    t_eval=t, rtol=1e-12, atol=1e-12, method="DOP853")
-    eu = np.max(np.abs(velocity_at_time(t, us, R, rho_t, rho_p, L) - sol.y[0])) / us
-    eP = np.max(np.abs(depth_at_time(t, us, R, rho_t, rho_p, L) - sol.y[1])) / sol.y[1][-1]
-    return float(eu), float(eP)
-
-
 def build() -> tuple[str, dict[str, bytes]]:
     figs: dict[str, bytes] = {}
     deviations: list[str] = []
@@ -84,7 +65,7 @@ def build() -> tuple[str, dict[str, bytes]]:
     )
 
     # ------------------------------------------------------------------ theory
-    eu, eP = _ode_check()
+    eu, eP = closed_forms_against_ode()
     doc.heading("Closed forms of section 2 against the equation of motion")
     doc.para(
         f"Eq. (1) integrated numerically (DOP853, rtol 1e-12) for a Steel-40-like shot: the corrected eq. (2) "
@@ -297,11 +278,7 @@ def build() -> tuple[str, dict[str, bytes]]:
     doc.table(["material", "HV [GPa]", "E [GPa] / nu assumed", "delta_H printed", "delta_H eqs. (10)-(14)", "difference"],
               rows, caption="Vickers diamond indenter (gamma_1 = 68 deg, E_2 = 1140 GPa, nu_2 = 0.07), HM = HV/sin 68 deg. "
                             "E and nu are handbook values (the paper prints none).")
-    need = {}
-    for r in load_table1():
-        if r.marking in ("Steel 600", "Ti-alloy", "SiC"):
-            need[r.marking] = brentq(lambda E: float(plasticity_from_vickers(r.hardness, E, r.nu_assumed)) - r.delta_H,
-                                     150 * GPa, 5000 * GPa) / GPa  # delta_H rises with E here
+    need = implied_moduli(("Steel 600", "Ti-alloy", "SiC"))
     doc.para(
         "Eleven of fourteen agree within 0.015 (the effect of a 10 % error in the assumed E). Steel 600, the Ti alloy "
         "and SiC do not: with the same nu, their printed delta_H need E = "

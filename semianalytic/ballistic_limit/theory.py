@@ -26,6 +26,11 @@ __all__ = [
     "resistance_R2",
     "resistance_R3",
     "alpha",
+    "eq1_deceleration",
+    "quadratic_drag_stop_time",
+    "quadratic_drag_velocity",
+    "quadratic_drag_depth_at_time",
+    "quadratic_drag_depth_at_velocity",
     "speed_scale",
     "stop_time",
     "velocity_at_time",
@@ -81,6 +86,53 @@ def alpha(rho_t, h_t, rho_p, L_p):
     return rho_t * h_t / (rho_p * L_p)
 
 
+def eq1_deceleration(u, R, rho_t, rho_p, L_p):
+    """-du/dt of Part IV, eq. (1): (rho_t u^2 / 2 + R) / (rho_p L_p) [m/s^2] (the right-hand side
+    that the closed forms below integrate)."""
+    u = np.asarray(u, dtype=float)
+    return ((0.5 * rho_t * u**2 + R) / (rho_p * L_p))[()]
+
+
+# The closed forms of du/dt = -k (u^2 + a^2), u(0) = u_s: Part IV, eqs. (2)-(4) (k = rho_t / (2 rho_p
+# L_p), a^2 = 2 R / rho_t) and Part I, eq. (11) with constant coefficients (k = rho B / (2 (m + rho A)),
+# a^2 = 2 C R_t / (rho B)).  Their one home: every path calls these.
+
+def quadratic_drag_stop_time(u_s, a, k):
+    """t* = arctan(u_s / a) / (a k): the time at which u = 0 (Part IV, from eq. (2))."""
+    return math.atan(u_s / a) / (a * k)
+
+
+def quadratic_drag_velocity(t, u_s, a, k):
+    """u(t) = a (u_s - a tan(gamma)) / (a + u_s tan(gamma)), gamma = a k t (Part IV, eq. (2) with the
+    corrected denominator, errata item 22); 0 once the rod has stopped."""
+    t = np.asarray(t, dtype=float)
+    gamma_stop = math.atan(u_s / a)
+    gamma = np.minimum(a * k * t, gamma_stop)
+    tg = np.tan(gamma)
+    u = np.maximum(a * (u_s - a * tg) / (a + u_s * tg), 0.0)
+    return np.where(gamma >= gamma_stop, 0.0, u)[()]
+
+
+def quadratic_drag_depth_at_time(t, u_s, a, k):
+    """P(t) = ln(cos(gamma) + (u_s / a) sin(gamma)) / k, gamma = a k t, up to the stop (Part IV,
+    after eq. (3), errata item 24); constant afterwards."""
+    t = np.asarray(t, dtype=float)
+    gamma = np.minimum(a * k * t, math.atan(u_s / a))
+    return (np.log(np.cos(gamma) + (u_s / a) * np.sin(gamma)) / k)[()]
+
+
+def quadratic_drag_depth_at_velocity(u, u_s, a, k):
+    """P(u) = ln((a^2 + u_s^2) / (a^2 + u^2)) / (2 k) (Part IV, eq. (3), errata item 23), written
+    as (ln(1 + (u_s/a)^2) - ln(1 + (u/a)^2)) / (2 k): no cancellation for a >> u_s, and 0 for a = inf."""
+    u = np.asarray(u, dtype=float)
+    return ((np.log1p((u_s / a) ** 2) - np.log1p((u / a) ** 2)) / (2.0 * k))[()]
+
+
+def _k(rho_t, rho_p, L_p):
+    """k = rho_t / (2 rho_p L_p) of Part IV, eq. (1) written as du/dt = -k (u^2 + a^2)."""
+    return rho_t / (2.0 * rho_p * L_p)
+
+
 def speed_scale(R, rho_t):
     """a = sqrt(2 R / rho_t) of Part IV, eq. (2) [m/s]."""
     return math.sqrt(2.0 * R / rho_t)
@@ -88,8 +140,7 @@ def speed_scale(R, rho_t):
 
 def stop_time(u_s, R, rho_t, rho_p, L_p):
     """Time at which u = 0: t* = (2 rho_p L_p / (a rho_t)) arctan(u_s / a), from eq. (2)."""
-    a = speed_scale(R, rho_t)
-    return 2.0 * rho_p * L_p / (a * rho_t) * math.atan(u_s / a)
+    return quadratic_drag_stop_time(u_s, speed_scale(R, rho_t), _k(rho_t, rho_p, L_p))
 
 
 def velocity_at_time(t, u_s, R, rho_t, rho_p, L_p):
@@ -99,30 +150,19 @@ def velocity_at_time(t, u_s, R, rho_t, rho_p, L_p):
 
     valid until the rod stops (gamma = arctan(u_s/a)); 0 afterwards.
     """
-    a = speed_scale(R, rho_t)
-    t = np.asarray(t, dtype=float)
-    gamma_stop = math.atan(u_s / a)
-    gamma = np.minimum(a * rho_t * t / (2.0 * L_p * rho_p), gamma_stop)
-    tg = np.tan(gamma)
-    u = np.maximum(a * (u_s - a * tg) / (a + u_s * tg), 0.0)
-    return np.where(gamma >= gamma_stop, 0.0, u)[()]
+    return quadratic_drag_velocity(t, u_s, speed_scale(R, rho_t), _k(rho_t, rho_p, L_p))
 
 
 def depth_at_velocity(u, u_s, R, rho_t, rho_p, L_p):
     """P(u) = (rho_p L_p / rho_t) ln((a^2 + u_s^2)/(a^2 + u^2)): Part IV, eq. (3) (the integrand
     is 2 rho_p L_p u du / (rho_t (a^2 + u^2)), errata item 23; the printed result is right)."""
-    a2 = 2.0 * R / rho_t
-    u = np.asarray(u, dtype=float)
-    return (rho_p * L_p / rho_t * np.log((a2 + u_s**2) / (a2 + u**2)))[()]
+    return quadratic_drag_depth_at_velocity(u, u_s, math.sqrt(2.0 * R / rho_t), _k(rho_t, rho_p, L_p))
 
 
 def depth_at_time(t, u_s, R, rho_t, rho_p, L_p):
     """P(t) = (2 rho_p L_p / rho_t) ln(cos(gamma) + (u_s/a) sin(gamma)) for gamma <= arctan(u_s/a)
     (Part IV, after eq. (3), in the corrected form of errata item 24); constant afterwards."""
-    a = speed_scale(R, rho_t)
-    t = np.asarray(t, dtype=float)
-    gamma = np.minimum(a * rho_t * t / (2.0 * L_p * rho_p), math.atan(u_s / a))
-    return (2.0 * rho_p * L_p / rho_t * np.log(np.cos(gamma) + (u_s / a) * np.sin(gamma)))[()]
+    return quadratic_drag_depth_at_time(t, u_s, speed_scale(R, rho_t), _k(rho_t, rho_p, L_p))
 
 
 def ballistic_limit(h_t, R, rho_t, rho_p, L_p):

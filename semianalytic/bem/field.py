@@ -11,10 +11,15 @@ is :mod:`semianalytic.report.vtk`'s job.
 
 from __future__ import annotations
 
+from collections.abc import Callable, Iterator
 from dataclasses import dataclass
-from typing import Callable
+from typing import TYPE_CHECKING
 
 import numpy as np
+
+if TYPE_CHECKING:
+    from semianalytic.bem.solve import SurfaceSolution
+    from semianalytic.geometry import Nose
 
 __all__ = [
     "MeridianGrid",
@@ -55,7 +60,10 @@ class FieldOnGrid:
     depth: float | None = None  # P [m]
 
 
-def meridian_grid(x0: float, x1: float, r1: float, nx: int, nr: int, inside: Callable | None = None) -> MeridianGrid:
+Inside = Callable[[np.ndarray, np.ndarray], np.ndarray]  # inside(x, r) -> bool array
+
+
+def meridian_grid(x0: float, x1: float, r1: float, nx: int, nr: int, inside: Inside | None = None) -> MeridianGrid:
     """Grid on [x0, x1] x [0, r1]; ``inside(x, r) -> bool array`` marks non-fluid nodes."""
     if not (x1 > x0 and r1 > 0 and nx >= 2 and nr >= 2):
         raise ValueError("empty grid")
@@ -86,7 +94,7 @@ def evaluate_field(
         g = np.asarray(gradient(pts[sel]), dtype=float)
         vx[sel] = -u * g[:, 0]
         vr[sel] = -u * g[:, 1]
-        if potential is not None:
+        if potential is not None and ph is not None:
             ph[sel] = np.asarray(potential(pts[sel]), dtype=float)
     shape = grid.fluid.shape
     return FieldOnGrid(grid, vx.reshape(shape), vr.reshape(shape), None if ph is None else ph.reshape(shape), u, depth)
@@ -96,7 +104,7 @@ def evaluate_field(
 # the projectile in the target
 
 
-def projectile_inside(nose, length: float, depth: float, tol: float = 1e-9):
+def projectile_inside(nose: Nose, length: float, depth: float, tol: float = 1e-9) -> Inside:
     """``inside(x, r)`` for the projectile of total ``length`` (nose + shank) with its tip at
     x = depth, and the entry hole behind it (x < depth - length, r < d/2): the non-fluid part."""
     prof = np.vstack([seg_pts for seg_pts in _nose_profile(nose)])
@@ -106,25 +114,26 @@ def projectile_inside(nose, length: float, depth: float, tol: float = 1e-9):
     R = 0.5 * nose.diameter
     L_h = nose.length
 
-    def inside(x, r):
+    def inside(x: np.ndarray, r: np.ndarray) -> np.ndarray:
         x, r = np.asarray(x, float), np.asarray(r, float)
         s = depth - x
         rp = np.where(s <= L_h, np.interp(s, s_back, r_prof), R)
         body = (s >= -tol * R) & (s <= length) & (r <= rp * (1 + tol) + tol * R)
         hole = (x >= 0) & (s > length) & (r <= R * (1 + tol))
-        return body | hole
+        out: np.ndarray = body | hole
+        return out
 
     return inside
 
 
-def _nose_profile(nose, n: int = 400):
+def _nose_profile(nose: Nose, n: int = 400) -> Iterator[np.ndarray]:
     for seg in nose.segments:
         t = np.linspace(seg.t0, seg.t1, n)
-        x, r = seg.point(t)
+        x, r = seg.point(t)  # type: ignore[no-untyped-call]  # geometry.py is not annotated yet
         yield np.column_stack([np.asarray(x, float) * np.ones_like(t), np.asarray(r, float) * np.ones_like(t)])
 
 
-def projectile_outline(nose, length: float, depth: float) -> np.ndarray:
+def projectile_outline(nose: Nose, length: float, depth: float) -> np.ndarray:
     """Closed meridian outline (x, r) of the projectile in the target frame (tip at x = depth)."""
     prof = np.vstack(list(_nose_profile(nose, 120)))
     R = 0.5 * nose.diameter
@@ -134,7 +143,7 @@ def projectile_outline(nose, length: float, depth: float) -> np.ndarray:
     return out
 
 
-def field_window(nose, length: float, depth: float, extent: float) -> tuple[float, float, float]:
+def field_window(nose: Nose, length: float, depth: float, extent: float) -> tuple[float, float, float]:
     """(x0, x1, r1): ``extent`` diameters around the nose, clipped to the target x >= 0."""
     d = nose.diameter
     x0 = max(0.0, depth - nose.length - extent * d)
@@ -144,7 +153,7 @@ def field_window(nose, length: float, depth: float, extent: float) -> tuple[floa
 
 
 def projectile_field(
-    nose,
+    nose: Nose,
     length: float,
     depth: float,
     u: float,
@@ -153,8 +162,8 @@ def projectile_field(
     grid: tuple[int, int] = (49, 25),
     order: int = 8,
     refinement: float | None = None,
-    solution=None,
-):
+    solution: SurfaceSolution | None = None,
+) -> tuple[FieldOnGrid, SurfaceSolution]:
     """BEM velocity field around the projectile at depth P: Part I, eq. (23).
 
     Returns ``(field, solution)``; ``solution`` is the :func:`semianalytic.bem.solve_halfspace`

@@ -37,7 +37,8 @@ def gauss_legendre(n: int) -> tuple[np.ndarray, np.ndarray]:
 def barycentric_weights(nodes: np.ndarray) -> np.ndarray:
     diff = nodes[:, None] - nodes[None, :]
     np.fill_diagonal(diff, 1.0)
-    return 1.0 / np.prod(diff, axis=1)
+    out: np.ndarray = 1.0 / np.prod(diff, axis=1)
+    return out
 
 
 def lagrange_matrix(nodes: np.ndarray, points: np.ndarray) -> np.ndarray:
@@ -52,7 +53,8 @@ def lagrange_matrix(nodes: np.ndarray, points: np.ndarray) -> np.ndarray:
     hit = exact.any(axis=-1)
     if np.any(hit):
         L[hit] = exact[hit].astype(float)
-    return L
+    out: np.ndarray = L
+    return out
 
 
 @functools.cache
@@ -66,7 +68,8 @@ def differentiation_matrix(p: int) -> np.ndarray:
     np.fill_diagonal(D, 0.0)
     np.fill_diagonal(D, -D.sum(axis=1))
     D.setflags(write=False)
-    return D
+    out: np.ndarray = D
+    return out
 
 
 @functools.cache

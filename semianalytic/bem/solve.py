@@ -500,8 +500,9 @@ class PairQuadrature:
         points and past-the-last point, rows repeating every q points (0: one row per point),
         the rows' addresses, p, the row arrays)."""
         starts, q, keep = [], [], []
-        for pairs, points, Q, lag, rows, n in self._block_slices:
-            if points.start != (starts and stop or 0):  # the blocks' points follow each other
+        stop = 0
+        for _pairs, points, Q, lag, rows, _n in self._block_slices:
+            if points.start != stop:  # the blocks' points follow each other
                 raise ValueError("PairQuadrature: blocks with gaps between their points")
             starts.append(points.start)
             stop = points.stop

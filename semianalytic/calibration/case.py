@@ -32,6 +32,7 @@ import json
 import math
 import re
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 from pydantic import Field
@@ -40,6 +41,9 @@ from semianalytic.calibration.names import CALIBRATION_MODELS, ERODING, ERODING_
 from semianalytic.calibration.priors import HalfNormal, LogNormal, Normal, Uniform
 from semianalytic.errors import InputError
 from semianalytic.schema import Section
+
+if TYPE_CHECKING:
+    from semianalytic.calibration.models import ShotSet
 
 __all__ = ["CalibrationSection", "parse_prior", "parameter_kind", "default_parameter", "load_shot_set", "shots_in_regime",
            "read_posterior", "POSTERIOR_FORMAT"]

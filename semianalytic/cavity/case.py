@@ -21,7 +21,10 @@ from pydantic import Field, field_validator, model_validator
 from semianalytic.schema import Section, check_brittle_constants
 from semianalytic.units import Pressure
 
-__all__ = ["MaterialSection"]
+__all__ = ["MaterialSection", "MODEL_FIELDS"]
+
+# the cavity model's input names -> the keys of a case file (errors.model_field)
+MODEL_FIELDS = {"cavity.method": "method", "cavity.": "material."}
 
 
 class MaterialSection(Section):

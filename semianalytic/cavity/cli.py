@@ -55,12 +55,15 @@ def run(args) -> int:
     from semianalytic.report.formats import Output, chosen_format, emit
 
     fmt = chosen_format(args)
+    from semianalytic.cavity.case import MODEL_FIELDS
+    from semianalytic.errors import model_field
+
     case = load_case(args.case)
     section = case.require("material")
-    material = BrittleMaterial.from_section(section)
     method = args.method or section.solver
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), model_field(MODEL_FIELDS):
         warnings.simplefilter("ignore", ModelValidityWarning)  # printed below instead
+        material = BrittleMaterial.from_section(section)
         result = solve_cavity(material, method)
     for note in result.warnings:
         print(f"warning: {note}", file=sys.stderr)

@@ -11,7 +11,7 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 
-from semianalytic.errors import InputError
+from semianalytic.errors import ModelError
 
 __all__ = ["BrittleMaterial"]
 
@@ -28,8 +28,8 @@ class BrittleMaterial:
                         E / (3 (1 - 2 nu))
     initial_porosity    theta_0 [-] (0 <= theta_0 < 1), eq. (16)
 
-    Invalid values raise :class:`~semianalytic.errors.InputError` naming
-    ``material.<field>`` (exit status 2 at the command line).
+    Invalid values raise :class:`~semianalytic.errors.ModelError` naming ``cavity.<field>``
+    (the case layer maps it to the key the user wrote, e.g. ``material.<field>``; exit status 2).
     """
 
     youngs_modulus: float
@@ -42,23 +42,23 @@ class BrittleMaterial:
     def __post_init__(self):
         def finite(name, value):
             if isinstance(value, bool) or not isinstance(value, (int, float)) or not math.isfinite(value):
-                raise InputError(f"material.{name}", f"must be a finite number; got {value!r}")
+                raise ModelError(f"must be a finite number; got {value!r}", f"cavity.{name}")
 
         for name in ("youngs_modulus", "tensile_strength", "compressive_strength"):
             value = getattr(self, name)
             finite(name, value)
             if not value > 0:
-                raise InputError(f"material.{name}", f"must be positive (Pa); got {value!r}")
+                raise ModelError(f"must be positive (Pa); got {value!r}", f"cavity.{name}")
         finite("poisson_ratio", self.poisson_ratio)
         if not -1.0 < self.poisson_ratio < 0.5:
-            raise InputError("material.poisson_ratio", f"must lie in (-1, 0.5); got {self.poisson_ratio!r}")
+            raise ModelError(f"must lie in (-1, 0.5); got {self.poisson_ratio!r}", "cavity.poisson_ratio")
         if self.bulk_modulus is not None:
             finite("bulk_modulus", self.bulk_modulus)
             if not self.bulk_modulus > 0:
-                raise InputError("material.bulk_modulus", f"must be positive (Pa); got {self.bulk_modulus!r}")
+                raise ModelError(f"must be positive (Pa); got {self.bulk_modulus!r}", "cavity.bulk_modulus")
         finite("initial_porosity", self.initial_porosity)
         if not 0.0 <= self.initial_porosity < 1.0:
-            raise InputError("material.initial_porosity", f"must lie in [0, 1); got {self.initial_porosity!r}")
+            raise ModelError(f"must lie in [0, 1); got {self.initial_porosity!r}", "cavity.initial_porosity")
 
     @property
     def K_s(self) -> float:

@@ -30,7 +30,7 @@ import numpy as np
 
 from semianalytic.cavity.material import BrittleMaterial
 from semianalytic.cavity.zones import crack_front_ratio, front_strains
-from semianalytic.errors import InputError, ModelValidityWarning
+from semianalytic.errors import ModelError, ModelValidityWarning
 
 __all__ = [
     "CavityResult",
@@ -66,11 +66,11 @@ STRAIN_LIMIT = 0.025
 FIXED_POINT_SOFT_LIMIT = 0.65
 
 
-class FixedPointDivergence(InputError):
+class FixedPointDivergence(ModelError):
     """The paper's iteration (22) did not converge for this material (use ``method='bracket'``)."""
 
-    def __init__(self, message: str):
-        super().__init__("method", message)
+    def __init__(self, message: str, field: str = "cavity.method"):
+        super().__init__(message, field)
 
 
 # ---------------------------------------------------------------------------------------------
@@ -148,8 +148,8 @@ def _lower_limit(m: BrittleMaterial) -> float:
 def solve_front_stress_bracket(material: BrittleMaterial, xtol_rel: float = 1e-14):
     """sigma* from eq. (21) by Brent's method on a bracket (errata item 13).
 
-    Returns ``(sigma_star, iterations)``.  Raises ``InputError`` (naming
-    ``material.tensile_strength``) if the root does not lie above 2 sigma_f, i.e. the
+    Returns ``(sigma_star, iterations)``.  Raises ``ModelError`` (naming
+    ``cavity.tensile_strength``) if the root does not lie above 2 sigma_f, i.e. the
     material has no cracked zone (errata item 20).
     """
     m = material
@@ -160,11 +160,11 @@ def solve_front_stress_bracket(material: BrittleMaterial, xtol_rel: float = 1e-1
         f_lo = front_equation(lo, m)
     if not f_lo < 0.0:
         x_min = _lower_limit(m)
-        raise InputError(
-            "material.tensile_strength",
+        raise ModelError(
             f"no cracked zone: eq. (21) has no root with -sigma* > 2 sigma_f = {x_min / 1e9:.4g} GPa "
             f"(C(theta*) Y_s <= 2 sigma_f there); the three-zone model needs -sigma* > 2 sigma_f "
             f"(Part II eq. (13), errata 14, 20): lower the tensile strength or raise Y_s",
+            "cavity.tensile_strength",
         )
     hi = max(2.0 * lo, m.compressive_strength)
     for _ in range(200):
@@ -338,14 +338,14 @@ def solve_cavity(material: BrittleMaterial, method: str = "bracket", *, warn: bo
     ``method``: ``"bracket"`` (default, robust) or ``"fixed-point"`` (the paper's eq. (22);
     raises :class:`FixedPointDivergence` if it does not converge).
 
-    Hard conditions (errata item 20) raise ``InputError`` naming the field and the failed
+    Hard conditions (errata item 20) raise ``ModelError`` naming the input (``cavity.<field>``) and the failed
     condition: no cracked zone (-sigma* <= 2 sigma_f), theta_k < 0, a/b >= 1.  Soft ones are
     returned in ``warnings`` and, with ``warn=True``, issued as ``ModelValidityWarning``:
     theta_k > theta*, Y_s/E > 0.025, and for the fixed-point method a convergence factor near 1.
     """
     m = material
     if method not in METHODS:
-        raise InputError("method", f"must be one of {', '.join(METHODS)}; got {method!r}")
+        raise ModelError(f"must be one of {', '.join(METHODS)}; got {method!r}", "cavity.method")
     sigma_b, it_b = solve_front_stress_bracket(m)  # also checks the cracked-zone condition
     if method == "bracket":
         sigma_star, iterations = sigma_b, it_b
@@ -369,20 +369,20 @@ def solve_cavity(material: BrittleMaterial, method: str = "bracket", *, warn: bo
     c_over_b = float(crack_front_ratio(sigma_star, m.tensile_strength))
     v_star = front_velocity(sigma_star, m)
     if not v_star < 1.0:
-        raise InputError(
-            "material.compressive_strength",
+        raise ModelError(
             f"strains are not small: v* = (a/b)^3 = {v_star:.3g} >= 1 (Part II eqs. (26)-(29)); "
             f"Y_s/E = {m.compressive_strength / m.youngs_modulus:.3g} is far above {STRAIN_LIMIT}",
+            "cavity.compressive_strength",
         )
     a_over_b = comminuted_ratio(v_star)
     e_k = comminuted_volume_strain(v_star, e_phi)
     e_ks = solid_volume_strain(sigma_star, m.K_s)
     theta_k = comminuted_porosity(theta_star, e_c, e_k, e_ks)
     if theta_k < 0.0:
-        raise InputError(
-            "material.poisson_ratio",
+        raise ModelError(
             f"theta_k = {theta_k:.4g} < 0: the comminuted zone would have negative porosity "
             f"(Part II eq. (33), errata 20; happens for nu above about 0.31-0.34, here nu = {m.poisson_ratio:g})",
+            "cavity.poisson_ratio",
         )
     alpha = 1.5 * theta_k
     R_r = cavity_pressure(sigma_star, a_over_b, theta_k)

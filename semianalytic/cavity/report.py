@@ -18,7 +18,7 @@ from semianalytic.bundled import cases_dir
 from semianalytic.case import load_case
 from semianalytic.cavity import BrittleMaterial, fixed_point_iteration, solve_cavity
 from semianalytic.cavity import zones
-from semianalytic.errors import InputError, ModelValidityWarning
+from semianalytic.errors import ModelError, ModelValidityWarning
 from semianalytic.report.output import report_command
 from semianalytic.report.document import Document, fmt, to_markdown
 from semianalytic.report.figures import png_bytes
@@ -48,7 +48,7 @@ def _classify(m: BrittleMaterial) -> int:
     """0 ok, 1 warn theta_k > theta*, 2 reject theta_k < 0, 3 reject no cracked zone."""
     try:
         r = _quiet(solve_cavity, m)
-    except InputError as exc:
+    except ModelError as exc:
         return 3 if "cracked zone" in exc.message else 2
     return 1 if r.theta_k > r.theta_star else 0
 
@@ -59,7 +59,7 @@ def _nu_threshold(base: BrittleMaterial, what: str) -> float:
         m = BrittleMaterial(base.youngs_modulus, nu, base.tensile_strength, base.compressive_strength)
         try:
             r = _quiet(solve_cavity, m)
-        except InputError:
+        except ModelError:
             return -1.0 if what == "zero" else -1.0
         return r.theta_k if what == "zero" else r.theta_star - r.theta_k
 

@@ -1,4 +1,4 @@
-"""Convergence of the BEM on noses and bodies with corners (issue 10), written by
+"""Convergence of the BEM on noses and bodies with corners, written by
 ``python -m semianalytic bench-bem --corners``: ``reports/bem_corners.md`` and
 ``reports/bem_corners.png``.
 
@@ -9,7 +9,7 @@ identity error |B_bernoulli - dA/dP| / |B_literal|, the change against the fines
 the observed order; the added mass of a flat-ended cylinder and a double cone by refinement;
 the wall time of a full table against the Fig. 5 ogive's, measured in the same run; and the
 certified table's cost per nose (knots, CPU time, ratio to the ogive) with its interpolation
-error against direct solves off the knots and beside every breakpoint (issue 10's last target).
+error against direct solves off the knots and beside every breakpoint.
 """
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ ISSUE_TABLE = [(0.0, 0.0), (2e-3, 1.8e-3), (4e-3, 2.7e-3), (6e-3, 3.2e-3), (8e-3
 
 
 def cornered_noses():
-    """(name, Nose) of issue 10's targets, d = 7.11 mm."""
+    """(name, Nose) of the cornered noses studied, d = 7.11 mm."""
     from semianalytic.geometry import cone_nose, flat_nose, ogive_nose, table_nose
 
     return [
@@ -110,7 +110,7 @@ def table_costs(noses, n_depths: int = 60, repeats: int = 2):
 def certified_noses():
     """(name, Nose) of the certified-table cost study: the Fig. 5 ogive first (the reference),
     the sphere, both cones (cases/cone30.toml's 15 deg half-angle and a 30 deg half-angle),
-    then the other cornered noses of issue 10."""
+    then the other cornered noses."""
     from semianalytic.geometry import cone_nose, ogive_nose, sphere_nose
 
     named = dict(cornered_noses())

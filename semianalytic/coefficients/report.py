@@ -17,39 +17,11 @@ from semianalytic.coefficients import READINGS
 PAPER = {"sphere": {"A_bar": 1.5e-3, "B_bar": 0.58, "C_bar": 1.00}, "ogive": {"A_bar": 1.0e-3, "B_bar": 0.11, "C_bar": 1.00}}
 # Part I, section 3 (Figs. 14-15): 6061-T651 target
 TARGET = {"density": 2710.0, "Y": 400e6, "E": 68.9e9, "nu": 0.33}
-VELOCITIES = np.linspace(100.0, 2500.0, 49)
-
-
-def _noses():
-    from semianalytic.geometry import Projectile, ogive_nose, sphere_nose
-
-    # Fig. 5: d = 7.11 mm, L_c = 59.3 mm; densities of the Fig. 14/15 projectiles
-    return [
-        ("ogive", Projectile(ogive_nose(7.11e-3, 3.0), 59.3e-3, 8020.0)),
-        ("sphere", Projectile(sphere_nose(7.11e-3), 59.3e-3, 8000.0)),
-    ]
-
-
-def separation_velocity(table, mass: float, rho: float, R_t: float, reading: str, depths):
-    """Lowest velocity (of VELOCITIES) at which p_c <= 0 somewhere on the nose (eq. (15)),
-    with du/dt from eq. (11) at that depth and velocity; None if the contact stays full.
-    Returns (velocity, depth, separated interval in target-frame x)."""
-    from semianalytic.penetration.motion import eq11_acceleration
-
-    for u in VELOCITIES:
-        for P in depths:
-            du_dt = eq11_acceleration(table.A(P), table.B(P, reading), table.C(P), mass, rho, R_t, u * u)
-            sep = table.contact_intervals(P, rho, u, du_dt, R_t, reading)
-            if sep:
-                return float(u), float(P), sep[0]
-    return None
-
-
 def write_coefficients_report(out_dir: Path, n_depths: int | None = None, table_study=None, contact=None) -> list[Path]:
     """bem_coefficients.md (+ CSV, PNG).  ``n_depths`` None: the certified tables; ``table_study``
     (nose -> {"knots", "noise_limited", "study"}) and ``contact`` (rows of
     :func:`semianalytic.coefficients.study.contact_effect`) add their sections."""
-    from semianalytic.coefficients.table import coefficient_table
+    from semianalytic.coefficients.study import VELOCITIES, fig5_tables, separation_onsets
     from semianalytic.io import atomic_write_bytes, atomic_write_text
     from semianalytic.penetration.resistance import elastic_plastic_resistance
     from semianalytic.report.document import Document, fmt, to_markdown
@@ -67,9 +39,8 @@ def write_coefficients_report(out_dir: Path, n_depths: int | None = None, table_
     )
     R_t = elastic_plastic_resistance(TARGET["Y"], TARGET["E"], TARGET["nu"])
     deep_rows, identity_rows, contact_rows = [], [], []
-    for name, proj in _noses():
+    for name, proj, tab in fig5_tables(n_depths):
         nose = proj.nose
-        tab = coefficient_table(nose, n_depths=n_depths) if n_depths else coefficient_table(nose)
         area = tab.area
         v = tab.values
         P = tab.depth
@@ -128,14 +99,8 @@ def write_coefficients_report(out_dir: Path, n_depths: int | None = None, table_
                           fmt(np.interp(10 * nose.length, P, v["B_bernoulli"]) / area, 3)))
         gap = np.abs(v["B_bernoulli"] - v["dA_dP"]) / np.abs(v["B_literal"])
         identity_rows.append((name, len(P), f"{gap.max():.1e}", fmt(P[np.argmax(gap)] / nose.length, 3)))
-        for reading in READINGS:
-            Lh = nose.length
-            for phase, depths in (
-                ("entry, P < L_h", P[P < Lh]),
-                ("shoulder at the surface, L_h < P < 1.1 L_h", P[(P > Lh) & (P < 1.1 * Lh)]),
-                ("nose in, P >= 1.1 L_h", P[P >= 1.1 * Lh]),
-            ):
-                sep = separation_velocity(tab, proj.mass, TARGET["density"], R_t, reading, depths)
+        for reading, onsets in separation_onsets(tab, proj.mass, TARGET["density"], R_t).items():
+            for phase, sep in onsets.items():
                 if sep is None:
                     contact_rows.append((name, reading, phase, f"none up to {VELOCITIES[-1] / 1e3:.1f} km/s", "-", "-"))
                 else:

@@ -11,8 +11,56 @@ import time
 
 import numpy as np
 
-__all__ = ["STUDY_NOSES", "study_nose", "random_depths", "table_error_study", "certified_timing", "contact_effect",
+__all__ = ["VELOCITIES", "fig5_projectiles", "fig5_tables", "separation_velocity", "separation_onsets", "STUDY_NOSES", "study_nose", "random_depths", "table_error_study", "certified_timing", "contact_effect",
            "reach_depths", "reach_study"]
+
+
+VELOCITIES = np.linspace(100.0, 2500.0, 49)  # the striking velocities of the contact study [m/s]
+
+
+def fig5_projectiles():
+    """The two Fig. 5 projectiles (d = 7.11 mm, L_c = 59.3 mm; densities of the Fig. 14/15 shots)."""
+    from semianalytic.geometry import Projectile, ogive_nose, sphere_nose
+
+    return [
+        ("ogive", Projectile(ogive_nose(7.11e-3, 3.0), 59.3e-3, 8020.0)),
+        ("sphere", Projectile(sphere_nose(7.11e-3), 59.3e-3, 8000.0)),
+    ]
+
+
+def fig5_tables(n_depths: int | None = None):
+    """(name, projectile, coefficient table) of the Fig. 5 projectiles: the certified tables, or
+    ``n_depths`` fixed depths."""
+    from semianalytic.coefficients.table import coefficient_table
+
+    return [(name, proj, coefficient_table(proj.nose, n_depths=n_depths) if n_depths else coefficient_table(proj.nose))
+            for name, proj in fig5_projectiles()]
+
+
+def separation_velocity(table, mass: float, rho: float, R_t: float, reading: str, depths):
+    """Lowest velocity (of VELOCITIES) at which p_c <= 0 somewhere on the nose (eq. (15)),
+    with du/dt from eq. (11) at that depth and velocity; None if the contact stays full.
+    Returns (velocity, depth, separated interval in target-frame x)."""
+    from semianalytic.penetration.motion import eq11_acceleration
+
+    for u in VELOCITIES:
+        for P in depths:
+            du_dt = eq11_acceleration(table.A(P), table.B(P, reading), table.C(P), mass, rho, R_t, u * u)
+            sep = table.contact_intervals(P, rho, u, du_dt, R_t, reading)
+            if sep:
+                return float(u), float(P), sep[0]
+    return None
+
+
+def separation_onsets(table, mass: float, rho: float, R_t: float) -> dict:
+    """reading -> phase of entry -> :func:`separation_velocity` over the table's knots of that phase
+    (entry P < L_h, shoulder at the surface L_h < P < 1.1 L_h, nose in P >= 1.1 L_h)."""
+    from semianalytic.coefficients import READINGS
+
+    P, Lh = table.depth, table.nose_length
+    phases = (("entry, P < L_h", P[P < Lh]), ("shoulder at the surface, L_h < P < 1.1 L_h", P[(P > Lh) & (P < 1.1 * Lh)]),
+              ("nose in, P >= 1.1 L_h", P[P >= 1.1 * Lh]))
+    return {r: {name: separation_velocity(table, mass, rho, R_t, r, d) for name, d in phases} for r in READINGS}
 
 
 def study_nose(kind: str, diameter: float = 7.11e-3):
@@ -72,7 +120,7 @@ def table_error_study(nose, table, depths) -> dict:
 
 
 def reach_depths(nose, n: int = 1000, seed: int = 1000) -> np.ndarray:
-    """Issue 24's check of tight tables: n seeded random depths, a third in 0.9-1.3 L_h, the rest
+    """The check of tight tables: n seeded random depths, a third in 0.9-1.3 L_h, the rest
     log-uniform from 1e-6 to 300 nose lengths (below the first knot and past the default range too)."""
     rng = np.random.default_rng(seed)
     L = nose.depth_unit

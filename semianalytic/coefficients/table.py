@@ -44,12 +44,17 @@ import io
 import json
 import math
 from dataclasses import dataclass, field, replace
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from semianalytic.coefficients import READINGS
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose, SplineCurve
+
+if TYPE_CHECKING:
+    from semianalytic.bem.panels import LayoutOptions
+    from semianalytic.coefficients.depth import DepthCoefficients
 
 TABLE_VERSION = 9  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners; 9: flat tips to 1e-6 R, near-hemispheres in sqrt(P), bounded shallow layouts) bump when the numerics change, to invalidate caches
 

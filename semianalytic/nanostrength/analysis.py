@@ -310,21 +310,3 @@ def analyse(crystals: list[Crystal], studies: list[StudySpec], *, law: str = "cu
         fits = infer_table5(odd_surface_ratio=odd_surface_ratio)
     options = {"law": law, "stress_measure": measure, "odd_surface_ratio": odd_surface_ratio}
     return Analysis(options, results, study_results, fits)
-
-
-def analyse_section(section) -> Analysis:
-    """Run the analysis of a validated ``[nanostrength]`` section; a crystal the law cannot be
-    calibrated to is an InputError naming it."""
-    from semianalytic.errors import InputError
-    from semianalytic.nanostrength.interplanar import CalibrationError
-
-    crystals = section.crystals()
-    custom = [c.name for c in section.crystal]
-    try:
-        out = analyse(crystals, section.studies(), law=section.law, measure=section.stress_measure,
-                      odd_surface_ratio=section.odd_surface_ratio)
-    except CalibrationError as exc:
-        field = f"nanostrength.crystal.{custom.index(exc.crystal)}" if exc.crystal in custom else "nanostrength.materials"
-        raise InputError(field, str(exc)) from None
-    out.options.update({"surface_energy": section.surface_energy, "deformation_energy": section.deformation_energy})
-    return out

@@ -43,7 +43,7 @@ from pydantic import Field, field_validator, model_validator
 
 from semianalytic.schema import Section
 from semianalytic.nanostrength import data, mesolayer
-from semianalytic.nanostrength.analysis import StudySpec
+from semianalytic.nanostrength.analysis import Analysis, StudySpec
 from semianalytic.nanostrength.crystal import Crystal, paper_crystal
 from semianalytic.units import Length, Pressure, SurfaceEnergy
 
@@ -215,3 +215,23 @@ class NanostrengthSection(Section):
 
     def studies(self) -> list[StudySpec]:
         return [s.spec(tuple(self.materials)) for s in self.study]
+
+
+def analyse_section(section) -> Analysis:
+    """Run the analysis (:func:`semianalytic.nanostrength.analysis.analyse`) of a validated
+    ``[nanostrength]`` section; a crystal the law cannot be calibrated to (the model's
+    ``CalibrationError``) is an InputError naming the case key of that crystal."""
+    from semianalytic.errors import InputError
+    from semianalytic.nanostrength.analysis import analyse
+    from semianalytic.nanostrength.interplanar import CalibrationError
+
+    crystals = section.crystals()
+    custom = [c.name for c in section.crystal]
+    try:
+        out = analyse(crystals, section.studies(), law=section.law, measure=section.stress_measure,
+                      odd_surface_ratio=section.odd_surface_ratio)
+    except CalibrationError as exc:
+        field = f"nanostrength.crystal.{custom.index(exc.crystal)}" if exc.crystal in custom else "nanostrength.materials"
+        raise InputError(field, str(exc)) from None
+    out.options.update({"surface_energy": section.surface_energy, "deformation_energy": section.deformation_energy})
+    return out

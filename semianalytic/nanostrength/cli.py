@@ -16,7 +16,8 @@ from pathlib import Path
 from semianalytic.case import load_case
 from semianalytic.io import check_report_target
 from semianalytic.nanostrength import data
-from semianalytic.nanostrength.analysis import Analysis, analyse_section
+from semianalytic.nanostrength.analysis import Analysis
+from semianalytic.nanostrength.case import analyse_section
 
 
 def add_arguments(parser: argparse.ArgumentParser) -> None:

@@ -316,10 +316,6 @@ def check_plate_objective(case: Case, objective: str, striking_velocity: str | N
     if not has_plate(case):
         raise InputError("--objective", f"{objective} needs a plate case: [target] thickness = '20 mm' (or "
                                         "[[target.layers]]); this case is a half-space")
-    try:
-        import semianalytic.perforation.model  # noqa: F401
-    except ImportError:
-        raise InputError("--objective", f"{objective} needs the perforation model (issue 23), not in this version") from None
     velocities = tuple(case.impact.striking_velocities) if case.impact is not None else ()
     if objective == "residual_velocity" and not velocities and striking_velocity is None:
         raise InputError("--objective", "residual_velocity needs [impact] striking_velocities (or --striking-velocity)")

@@ -1,6 +1,6 @@
 """Final depths of Part I, eq. (11) for many (m, rho, R_t, U_s) on one coefficient table, as arrays.
 
-The Monte-Carlo path of the sweeps (issue 14): every sample has its own projectile mass m,
+The Monte-Carlo path of the sweeps: every sample has its own projectile mass m,
 target density rho, resistance R_t and striking velocity U_s, all on the same nose (one A, B, C
 table).  In w = u^2 with P as the variable eq. (11) is linear (see
 :mod:`semianalytic.penetration.motion`): w(P) = e^(-F) (U_s^2 - G), with

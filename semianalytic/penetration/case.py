@@ -47,7 +47,8 @@ from pydantic import (
     model_validator,
 )
 
-from semianalytic.errors import InputError
+from semianalytic.cavity.case import MODEL_FIELDS as CAVITY_FIELDS
+from semianalytic.errors import InputError, ModelError, case_key
 from semianalytic.penetration.resistance import (
     MODELS,
     Brittle,
@@ -304,7 +305,7 @@ def _builds(spec):
     """Case-load check: the inputs must give a model (e.g. eq. (16)'s logarithm positive)."""
     try:
         spec.build()
-    except InputError as exc:
+    except (InputError, ModelError) as exc:  # the model's input name: its last part is the key
         raise ValueError(f"{exc.field.rsplit('.', 1)[-1]}: {exc.message}") from None
     return spec
 
@@ -393,6 +394,8 @@ def parse_resistance(data: Any, field: str = "target.resistance") -> Resistance:
             raise InputError(".".join([field, *loc]), _message(err)) from None
     try:
         return spec.build()
+    except ModelError as exc:  # the cavity model's input names -> the keys of the case (InputError, as documented)
+        raise InputError(case_key(exc.field, CAVITY_FIELDS), exc.message) from None
     except InputError as exc:
         raise InputError(exc.field.replace("target.resistance", field, 1), exc.message) from None
 

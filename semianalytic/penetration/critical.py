@@ -158,8 +158,11 @@ def yield_stress_from_critical_velocity(U_sC: float, inputs: CriticalInputs, phi
     reason = no_real_root_reason(inputs)
     if reason is not None:
         raise InputError("coefficients.reading", f"the dynamic yield stress cannot be found from U_sC: {reason}")
-    phif = phi if callable(phi) else (lambda Y: phi)
-    f = lambda Y: critical_velocity(Y, inputs, phif(Y)) - U_sC
+    def phif(Y):
+        return phi(Y) if callable(phi) else phi
+
+    def f(Y):
+        return critical_velocity(Y, inputs, phif(Y)) - U_sC
     lo, hi = 1e3, 1e8
     while f(hi) < 0:
         lo, hi = hi, hi * 2.0

@@ -29,6 +29,7 @@ from dataclasses import dataclass, field
 
 import numpy as np
 
+from semianalytic.ballistic_limit import theory as rigid
 from semianalytic.errors import ConvergenceError, ModelError
 
 __all__ = [
@@ -123,39 +124,37 @@ class ConstantCoefficientSolution:
     def deceleration0(self) -> float:
         return self.C * self.resistance_pa / self.M
 
+    # B > 0: du/dt = -k (u^2 + a^2), the closed forms of Part IV, eqs. (2)-(4) (their one home,
+    # semianalytic.ballistic_limit.theory); B = 0: constant deceleration.
     @property
     def penetration_time(self) -> float:
         if self.B == 0:
             return self.U0 / self.deceleration0
-        return math.atan(self.U0 / self.a) / (self.a * self.k)
+        return float(rigid.quadratic_drag_stop_time(self.U0, self.a, self.k))
 
     @property
     def final_depth(self) -> float:
         if self.B == 0:
             return self.U0**2 / (2.0 * self.deceleration0)
-        return math.log1p((self.U0 / self.a) ** 2) / (2.0 * self.k)
+        return float(rigid.quadratic_drag_depth_at_velocity(0.0, self.U0, self.a, self.k))
 
     def velocity(self, t):
         t = np.minimum(np.asarray(t, float), self.penetration_time)
         if self.B == 0:
             return self.U0 - self.deceleration0 * t
-        a, U = self.a, self.U0
-        tg = np.tan(a * self.k * t)
-        return a * (U - a * tg) / (a + U * tg)
+        return rigid.quadratic_drag_velocity(t, self.U0, self.a, self.k)
 
     def depth(self, t):
         t = np.minimum(np.asarray(t, float), self.penetration_time)
         if self.B == 0:
             return self.U0 * t - 0.5 * self.deceleration0 * t * t
-        g = self.a * self.k * t
-        return np.log(np.cos(g) + self.U0 / self.a * np.sin(g)) / self.k
+        return rigid.quadratic_drag_depth_at_time(t, self.U0, self.a, self.k)
 
     def depth_at_velocity(self, u):
         u = np.asarray(u, float)
         if self.B == 0:
             return (self.U0**2 - u * u) / (2.0 * self.deceleration0)
-        a2 = self.a**2
-        return np.log((a2 + self.U0**2) / (a2 + u * u)) / (2.0 * self.k)
+        return rigid.quadratic_drag_depth_at_velocity(u, self.U0, self.a, self.k)
 
 
 # --------------------------------------------------------------------------------------
@@ -482,7 +481,7 @@ class DepthProfile:
         done = g == 0
         it = 0
         rate = np.zeros_like(P)
-        for it in range(1, 51):
+        for it in range(1, 51):  # noqa: B007 (the count is returned)
             F, G, dG = self._eval(P, (self._F, self._G, self._dG))
             r = G - g
             lo = np.where(r < 0, P, lo)

@@ -29,6 +29,8 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from semianalytic.ballistic_limit import theory as rigid
+
 __all__ = [
     "ogive_nose_factor",
     "nose_factors",

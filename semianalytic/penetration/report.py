@@ -17,7 +17,6 @@ from __future__ import annotations
 
 import math
 import shlex
-import time
 from collections import OrderedDict
 from pathlib import Path
 
@@ -474,8 +473,7 @@ def _regimes_section(doc, ctx, w, part1_model):
 
 def _histories_section(doc, ctx, w):
     from semianalytic.penetration import rod as rodmod
-    from semianalytic.penetration.elastic import solve_elastic
-    from semianalytic.penetration.motion import solve_motion
+    from semianalytic.penetration.study import histories
     from semianalytic.report.figures import Series, line_figure
 
     hcases = ctx.history_cases()
@@ -489,11 +487,8 @@ def _histories_section(doc, ctx, w):
         coef = ctx.coefficients(case)[0]
         U = float(case.impact.striking_velocities[0])
         nose = case.projectile.nose
-        rigid = solve_motion(coef, setup.mass, setup.target_density, setup.resistance_pa, U, rtol=1e-10)
-        nu = setup.poisson_ratio if setup.poisson_ratio is not None else 0.29
-        ep = solve_elastic(coef, setup.mass, setup.target_density, setup.resistance_pa, U, setup.rod, poisson_ratio=nu, w2="paper", w1=ctx.w1)
-        er = solve_elastic(coef, setup.mass, setup.target_density, setup.resistance_pa, U, setup.rod, poisson_ratio=nu, w2="exact-rod", w1=ctx.w1)
-        qr = ep.quasi_rigid
+        h = histories(setup, coef, U, ctx.w1)
+        rigid, ep, er, qr = h.rigid, h.paper_w2, h.exact_rod_w2, h.quasi_rigid
         t1 = np.linspace(0, rigid.penetration_time, 400)
         tq = np.linspace(0, qr.penetration_time, 400)
         P1, u1 = rigid.at(t1)
@@ -658,50 +653,25 @@ def _appendix_section(doc, ctx):
 
 
 def _numerics_section(doc, ctx, w):
-    from semianalytic.penetration.curve import penetration_curve
-    from semianalytic.penetration.motion import final_depth, solve_motion
+    from semianalytic.penetration.study import curve_timings, tolerance_study
 
     case = (ctx.validation_cases() or ctx.cases)[0]
     setup = ctx.setup(case, require_material=False)
     coef = setup.coefficients
     doc.heading("Numerics and timings")
-    rows = []
-    ref = solve_motion(coef, setup.mass, setup.target_density, setup.resistance_pa, 1000.0, rtol=1e-12)
-    for rtol in (1e-5, 1e-6, 1e-7, 1e-8, 1e-9, 1e-10):
-        r = solve_motion(coef, setup.mass, setup.target_density, setup.resistance_pa, 1000.0, rtol=rtol)
-        rows.append([f"{rtol:.0e}", f"{r.final_depth * MM:.9f}", f"{abs(r.final_depth / ref.final_depth - 1):.1e}",
-                     f"{abs(r.penetration_time / ref.penetration_time - 1):.1e}", len(r.t)])
-    Pf = float(final_depth(coef, setup.mass, setup.target_density, setup.resistance_pa, 1000.0))
+    tol = tolerance_study(coef, setup.mass, setup.target_density, setup.resistance_pa, 1000.0)
+    rows = [[f"{rtol:.0e}", f"{P * MM:.9f}", f"{dP:.1e}", f"{dt:.1e}", steps] for rtol, P, dP, dt, steps in tol.rows]
+    ref, Pf = tol.reference, tol.spectral_depth
     doc.table(["rtol", "final depth [mm]", "rel. change vs rtol 1e-12", "time: rel. change", "steps"], rows,
               caption=f"solve_ivp (DOP853, event u = 0) under tolerance refinement, {case.title.split(':')[0]}, U_s = 1000 m/s. "
                       f"The integration in P (spectral panels) gives {Pf * MM:.9f} mm, "
                       f"{abs(Pf / ref.final_depth - 1):.1e} from the rtol 1e-12 time integration.")
-    U = np.linspace(400.0, 1800.0, 50)
-    times = []
-    for _ in range(3):
-        t0 = time.perf_counter()
-        penetration_curve(setup if setup.rod is not None else ctx.setup(case), U, w1=ctx.w1)
-        times.append(time.perf_counter() - t0)
-    U1000 = np.linspace(300.0, 2000.0, 1000)
-    t0 = time.perf_counter()
-    final_depth(coef, setup.mass, setup.target_density, setup.resistance_pa, U1000)
-    t_rigid = time.perf_counter() - t0
-    from semianalytic.penetration.evaluate import evaluate_case
-
-    import dataclasses
-
-    U50 = np.linspace(500.0, 3000.0, 50)
-    no_data = dataclasses.replace(case, sections={k: v for k, v in case.sections.items() if k != "data"})
-    t_regime = []
-    for _ in range(3):
-        t0 = time.perf_counter()
-        evaluate_case(no_data, coef, w1=ctx.w1, velocities=U50)
-        t_regime.append(time.perf_counter() - t0)
+    t = curve_timings(setup if setup.rod is not None else ctx.setup(case), case, coef, ctx.w1)
     doc.table(["task", "wall time [s] (best of 3 / single)"],
-              [["50 striking velocities, all four Part I models + U_sC (penetration_curve)", f"{min(times):.3f}"],
+              [["50 striking velocities, all four Part I models + U_sC (penetration_curve)", f"{t['curve_50']:.3f}"],
                ["50 striking velocities 0.5-3 km/s in all regimes: everything `penetrate` prints (evaluate_case: Part I, "
-                "peers, regimes, eroding rod, validity; without the [data] comparison)", f"{min(t_regime):.3f}"],
-               ["1000 striking velocities, rigid final depth only (final_depth)", f"{t_rigid:.3f}"]],
+                "peers, regimes, eroding rod, validity; without the [data] comparison)", f"{t['evaluate_50']:.3f}"],
+               ["1000 striking velocities, rigid final depth only (final_depth)", f"{t['rigid_1000']:.3f}"]],
               caption=f"Timings with the cached coefficient table on this machine ({ctx.coefficients(case)[1]}); "
                       "target of the issue: a 50-velocity curve in <= 0.5 s.")
 

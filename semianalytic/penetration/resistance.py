@@ -103,7 +103,8 @@ def hardening_integral(Y: float, E: float, n: float) -> float:
     if not 0 < eps < 1:
         raise ValueError("eq. (18) needs 3Y/(2E) < 1")
     s0 = -math.log1p(-eps)
-    f_log = lambda v: math.exp(v * (n + 1.0)) / math.expm1(math.exp(v))  # s = e^v, ds = s dv
+    def f_log(v):  # s = e^v, ds = s dv
+        return math.exp(v * (n + 1.0)) / math.expm1(math.exp(v))
     head = 0.0
     if s0 < 1.0:
         head = integrate.quad(f_log, math.log(s0), 0.0, epsabs=0.0, epsrel=1e-13, limit=200)[0]

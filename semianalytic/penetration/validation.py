@@ -13,11 +13,15 @@ from __future__ import annotations
 import math
 from dataclasses import dataclass
 from pathlib import Path
+from typing import TYPE_CHECKING
 
 import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.penetration import peers
+
+if TYPE_CHECKING:
+    from semianalytic.penetration.curve import PenetrationSetup
 
 __all__ = ["MODEL_LABELS", "Shot", "read_csv_rows", "load_shots", "rigid_regime_shots", "peer_inputs", "predict_shots", "error_statistics"]
 

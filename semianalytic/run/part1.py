@@ -16,7 +16,7 @@ from semianalytic.report.document import fmt
 from semianalytic.report.figures import Points, Series, line_figure, panels_figure, side_by_side_figure
 from semianalytic.run.case import RunSection
 from semianalytic.run.context import Context
-from semianalytic.run.registry import Step, _coefficient_table, _has, _projectile, register, table_available
+from semianalytic.run.registry import Step, _coefficient_table, _has, _projectile, register
 
 MM = 1e3  # m -> mm for display
 # Integration tolerance of the report's ODE solves: 1e-9 relative is five orders below the four
@@ -35,7 +35,7 @@ def coefficients(ctx: Context):
     (:func:`semianalytic.cache.coefficients_for_case`)."""
     if "coefficients" in ctx.memo:
         return ctx.memo["coefficients"]
-    if ctx.run.coefficients == "bem" and table_available():
+    if ctx.run.coefficients == "bem":
         c = _coefficient_table(ctx)
     else:
         from semianalytic.cache import coefficients_for_case

@@ -18,16 +18,17 @@ def _cavity_solve(case: Case):
     import warnings
 
     from semianalytic.cavity import BrittleMaterial, solve_cavity
-    from semianalytic.errors import ModelValidityWarning
+    from semianalytic.cavity.case import MODEL_FIELDS
+    from semianalytic.errors import ModelValidityWarning, model_field
 
     sec = case.require("material")
-    with warnings.catch_warnings():
+    with warnings.catch_warnings(), model_field(MODEL_FIELDS):
         warnings.simplefilter("ignore", ModelValidityWarning)  # reported in the document
         return BrittleMaterial.from_section(sec), solve_cavity(BrittleMaterial.from_section(sec), sec.solver)
 
 
 def _cavity_preflight(case: Case, run: RunSection) -> None:
-    _cavity_solve(case)  # hard conditions of errata item 20 raise InputError here
+    _cavity_solve(case)  # hard conditions of errata item 20 raise ModelError here (the [material] key)
 
 
 def _cavity_run(ctx: Context) -> None:

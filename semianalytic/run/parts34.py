@@ -108,7 +108,7 @@ def _nano_preflight(case: Case, run: RunSection) -> None:
 
 
 def _nano_run(ctx: Context) -> None:
-    from semianalytic.nanostrength.analysis import analyse_section
+    from semianalytic.nanostrength.case import analyse_section
     from semianalytic.nanostrength.report import build_report
 
     section = ctx.case.require("nanostrength")

@@ -1,4 +1,4 @@
-"""The perforation step of a ``run`` (issue 23): when the case's target has a ``thickness`` or
+"""The perforation step of a ``run``: when the case's target has a ``thickness`` or
 ``[[target.layers]]``, V_r against V_s through :func:`semianalytic.perforation.evaluate.evaluate_case`
 with Part IV's V_cr as vertical lines, measured points as markers and the figure's data as CSV."""
 

@@ -11,7 +11,6 @@ A step whose model package is not installed in this version is listed as skipped
 
 from __future__ import annotations
 
-import importlib
 import math
 from dataclasses import dataclass
 from pathlib import Path
@@ -35,15 +34,6 @@ class Step:
     applies: Callable[[Case], bool]
     preflight: Callable[[Case, RunSection], None]
     run: Callable[[Context], None]
-
-    def available(self) -> str | None:
-        """None if the model packages import, else why not."""
-        for m in self.modules:
-            try:
-                importlib.import_module(m)
-            except ImportError as exc:
-                return f"not available in this version ({m}: {exc})"
-        return None
 
 
 # --------------------------------------------------------------------------------------
@@ -90,13 +80,6 @@ def _coefficient_table(ctx: Context):
         ctx.memo["table"] = coefficients_for_case(ctx.case, "bem", cache_dir=ctx.cache_dir)[0]
     return ctx.memo["table"]
 
-
-def table_available() -> bool:
-    try:
-        importlib.import_module("semianalytic.coefficients.table")
-    except ImportError:
-        return False
-    return True
 
 
 # --------------------------------------------------------------------------------------
@@ -153,14 +136,8 @@ def select_steps(case: Case, run: RunSection, only=None) -> tuple[list[Step], di
                 if case.section(sec) is None:
                     raise InputError(sec, f"the case has no [{sec}] section, which analysis {name!r} ({field}) needs")
         if step is None:
-            if requested is not None:
-                skipped[name] = "not available in this version"
-            continue
+            raise RuntimeError(f"analysis {name!r} has no registered step (semianalytic/run/)")
         if requested is None and not step.applies(case):
-            continue
-        why = step.available()
-        if why:
-            skipped[name] = why
             continue
         chosen.append(step)
     if not chosen:

@@ -138,10 +138,6 @@ def sweep_kernel(case, analysis, cache_dir, full):
     from semianalytic.sweep.perforation import PerforationKernel, has_plate
 
     if analysis == "perforation" or (analysis is None and case.projectile is not None and has_plate(case)):
-        try:
-            import semianalytic.perforation.model  # noqa: F401
-        except ImportError:
-            raise InputError("--analysis", "perforation needs the perforation model (issue 23), not in this version") from None
         if not has_plate(case):
             raise InputError("target.thickness", "--analysis perforation needs a plate case: [target] thickness = "
                                                  "'20 mm' (or [[target.layers]])")

@@ -242,10 +242,7 @@ def warm_up() -> bool:
 
     registry()
     for m in ("semianalytic.case", "semianalytic.penetration", "semianalytic.cavity"):
-        try:
-            importlib.import_module(m)
-        except ImportError:
-            pass
+        importlib.import_module(m)
     return True
 
 

@@ -413,9 +413,15 @@ class CavityKernel:
 
     def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
         from semianalytic.cavity import BrittleMaterial, solve_cavity
+        from semianalytic.cavity.case import MODEL_FIELDS
+        from semianalytic.errors import model_field
 
         sec = case.require("material")
-        r = solve_cavity(BrittleMaterial.from_section(sec), sec.solver, warn=False)
+        try:
+            with model_field(MODEL_FIELDS):
+                r = solve_cavity(BrittleMaterial.from_section(sec), sec.solver, warn=False)
+        except ModelError as exc:  # a sample the model cannot compute: an invalid row (the engine's InputError)
+            raise InputError(exc.field, exc.message) from None
         return {
             "cavity_pressure_Pa": np.array([r.cavity_pressure]),
             "sigma_star_Pa": np.array([r.sigma_star]),
