@@ -116,8 +116,8 @@ reports: report-docs
 report-docs: $(VENV)/.installed
 	$(PY) -m semianalytic run cases/fig12_sphere_velocity_field.toml --out reports/fig12_velocity_field --force
 	$(PY) -m semianalytic run cases/fig13_ogive_velocity_field.toml --out reports/fig13_velocity_field --force
-	$(PY) -m semianalytic.ballistic_limit.report --out reports --force
-	$(PY) -m semianalytic.cavity.report --out reports --force
+	$(PY) -m semianalytic.commands.ballistic_limit.report --out reports --force
+	$(PY) -m semianalytic.commands.cavity.report --out reports --force
 	$(PY) -m semianalytic penetrate $(VALIDATION_CASES) --report reports --force
 	$(PY) -m semianalytic perforate cases/perforation_ogive_6061T651.toml cases/perforation_ogive_6061T651_constant.toml cases/perforation_part4_table3.toml cases/perforation_steel12_hemispherical.toml --report reports
 	$(PY) -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force

@@ -8,7 +8,7 @@ Measures the BEM against exact solutions and writes three reports:
 - ``bem_convergence.md`` (+ PNG): error against unknowns with the observed order;
 - ``bem_coefficients.md`` (+ PNGs): the Fig. 5 tables, Figs. 6-8 analogues, the deep
   values against the paper's, the identity B_bernoulli = dA/dP and the contact region of
-  eq. (15) (see :mod:`semianalytic.coefficients.report`).
+  eq. (15) (see :mod:`semianalytic.commands.coefficients.report`).
 
 Times are the best of several repeats (the machine is shared); ratios are measured in the
 same run.
@@ -73,7 +73,7 @@ def convergence_rows(repeats: int = 3, refinements=REFINEMENTS, aspects=ASPECTS)
             sol = solve_body(meridian, refinement=ref)
             _, peak = tracemalloc.get_traced_memory()
             tracemalloc.stop()
-            seconds = _best_time(lambda: solve_body(meridian, refinement=ref), repeats)
+            seconds = _best_time(lambda: solve_body(meridian, refinement=ref), repeats)  # noqa: B023
             n = sol.nodes
             err_phi = float(np.abs(n.phi - exact * n.x).max() / np.abs(exact * n.x).max())
             rows.append((aspect, ref, sol.unknowns, abs(sol.added_mass_coefficient / exact - 1), err_phi, seconds, peak / 2**20))
@@ -119,7 +119,7 @@ def table_timing(repeats: int = 2, n_depths: int = 60):
         box = {}
 
         def build():
-            box["t"] = coefficient_table(nose, n_depths=n_depths)
+            box["t"] = coefficient_table(nose, n_depths=n_depths)  # noqa: B023
 
         seconds = _best_time(build, repeats)
         tab = box["t"]
@@ -238,10 +238,10 @@ def _kept_sections(path: Path) -> str:
 
 
 def _table_studies(quick: bool):
-    """The certified tables' studies (semianalytic.coefficients.study): random depths per nose,
+    """The certified tables' studies (semianalytic.commands.coefficients.study): random depths per nose,
     the contact region's effect on the depths, the certified tables' cost."""
-    from semianalytic.coefficients import study as st
     from semianalytic.coefficients.table import coefficient_table
+    from semianalytic.commands.coefficients import study as st
 
     table_study = {}
     for kind in (("ogive", "sphere") if quick else st.STUDY_NOSES):
@@ -262,7 +262,7 @@ def _table_studies(quick: bool):
 
 _TIMING_SNIPPET = """
 import sys, time, scipy.interpolate, scipy.linalg, scipy.special
-from semianalytic.coefficients.study import study_nose
+from semianalytic.commands.coefficients.study import study_nose
 from semianalytic.coefficients.table import coefficient_table
 nose = study_nose(sys.argv[1])
 for _ in range(int(sys.argv[2])):
@@ -281,7 +281,6 @@ INTERLEAVED_TITLE = "## Certified Fig. 5 ogive table against the code before it 
 def _revision(python: str) -> str:
     """Short git revision (with ``+dirty``) of the checkout an interpreter imports ``semianalytic`` from."""
     import subprocess
-
     import tempfile
 
     with tempfile.TemporaryDirectory() as neutral:  # not the working folder: each imports its own package
@@ -407,8 +406,8 @@ def write_reach_report(out_dir: Path, force: bool, quick: bool = False) -> list[
     import os
     import sys
 
-    from semianalytic.coefficients.study import STUDY_NOSES, reach_study
     from semianalytic.coefficients.table import CONTROLLED
+    from semianalytic.commands.coefficients.study import STUDY_NOSES, reach_study
     from semianalytic.io import atomic_write_text
     from semianalytic.report.document import Document, to_markdown
 
@@ -429,7 +428,7 @@ def write_reach_report(out_dir: Path, force: bool, quick: bool = False) -> list[
         "below the first knot and in the extrapolated deep piece too). 'bounded' counts the depths where the "
         "table's error estimate is at least the actual error; 'estimate/error' is the smallest ratio over the depths "
         "(>= 1: every estimate bounds its error); errors are relative to the coefficient's largest magnitude (a "
-        f"nose whose errors exceed the tolerance has noise-limited intervals, whose estimates are their discrepancies). CPU times on a shared 2-core machine, load average (1, 5, 15 min) {load0[0]:.1f}, {load0[1]:.1f}, "
+        f"nose whose errors exceed the tolerance has noise-limited intervals, whose estimates are their discrepancies). CPU times on a shared 2-core machine, load average (1, 5, 15 min) {load0[0]:.1f}, {load0[1]:.1f}, "  # noqa: E501
         f"{load0[2]:.1f} before and {load1[0]:.1f}, {load1[1]:.1f}, {load1[2]:.1f} after. The same check is the slow "
         "test `tests/test_tables_speed_and_reach.py::test_tolerance_1e8_with_the_defaults_bounds_1000_random_depths`.")
     doc.table(("nose", "knots", "deepest solve [nose lengths]", "noise-limited intervals", "table CPU [s]",
@@ -472,7 +471,7 @@ def _append_certified(path: Path, certified) -> list[Path]:
 def run(args) -> int:
     out = Path(args.out)
     if getattr(args, "corners", False):
-        from semianalytic.coefficients.corners_report import run_corners
+        from semianalytic.commands.coefficients.corners_report import run_corners
 
         return run_corners(out, args.force, args.quick)
     if getattr(args, "reach", False):
@@ -503,7 +502,7 @@ def run(args) -> int:
     blas = blas_threads(repeats=5 if args.quick else 30)
     written = write_convergence_report(rows, out, True)
     written += write_bench_report(rows, blas, tables, out, True)
-    from semianalytic.coefficients.report import write_coefficients_report
+    from semianalytic.commands.coefficients.report import write_coefficients_report
 
     study, contact, certified = _table_studies(args.quick)
     written += _append_certified(out / "bench_bem.md", certified)

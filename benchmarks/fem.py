@@ -47,8 +47,8 @@ def fem_runs(meridian, k_exact: float, order: int, hs, repeat: int) -> list[dict
             old = os.environ.get("FEM_CHECK_MESH_CACHE")
             os.environ["FEM_CHECK_MESH_CACHE"] = tmp
             try:
-                cold, am = _best(lambda: body_added_mass(meridian, opts, use_cache=False), repeat)
-                warm, am = _best(lambda: body_added_mass(meridian, opts), repeat)
+                cold, am = _best(lambda: body_added_mass(meridian, opts, use_cache=False), repeat)  # noqa: B023
+                warm, am = _best(lambda: body_added_mass(meridian, opts), repeat)  # noqa: B023
             finally:
                 if old is None:
                     os.environ.pop("FEM_CHECK_MESH_CACHE", None)
@@ -68,7 +68,7 @@ def bem_runs(meridian, k_exact: float, settings, repeat: int, threads: int | Non
     rows = []
     for order, ref in settings:
         with threadpool_limits(limits=threads):
-            secs, sol = _best(lambda: solve_body(meridian, order=order, refinement=ref), repeat)
+            secs, sol = _best(lambda: solve_body(meridian, order=order, refinement=ref), repeat)  # noqa: B023
         rows.append({"method": "BEM" + ("" if threads == 1 else f" ({threads or 'default'} BLAS threads)"),
                      "resolution": f"order {order}, refinement {ref:g}", "unknowns": sol.unknowns,
                      "error": abs(sol.added_mass_coefficient / k_exact - 1), "seconds_cold": secs, "seconds_warm": secs})

@@ -107,7 +107,6 @@ def _run(pythonpath: Path, argv: list[str], env: dict, cwd: Path) -> tuple[float
 
 def main(argv: list[str] | None = None) -> int:
     from fem_check.verify import hemisphere_reference
-
     from semianalytic.cli_types import OneLineParser, integer
     from semianalytic.io import extract_revision
 

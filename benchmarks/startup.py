@@ -45,9 +45,9 @@ case = load_case(case_path); mark("load_case")
 from semianalytic.cache import coefficients_for_case
 coefficients, _, _ = coefficients_for_case(case); mark("cached coefficient table (read)")
 import semianalytic.penetration.curve, semianalytic.penetration.critical
-from semianalytic.penetration.evaluate import evaluate_case; mark("import the models (scipy.integrate, interpolate, optimize)")
+from semianalytic.commands.penetrate.evaluate import evaluate_case; mark("import the models (scipy.integrate, interpolate, optimize)")
 if posterior:
-    from semianalytic.calibration.evaluate import predict_with_posterior; mark("import the calibration")
+    from semianalytic.commands.calibrate.evaluate import predict_with_posterior; mark("import the calibration")
     predict_with_posterior(case, coefficients, posterior); mark("predictive quantiles (predict_with_posterior)")
 import warnings
 with warnings.catch_warnings():

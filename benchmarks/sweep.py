@@ -395,10 +395,8 @@ def engine_benchmark(n_designs: int = 64) -> dict:
     import sys
 
     from semianalytic.report.document import fmt
-    from semianalytic.sweep.engine import run_sweep
+    from semianalytic.sweep.engine import connect, run_sweep
     from semianalytic.sweep.spec import build_spec
-
-    from semianalytic.sweep.engine import connect
 
     step = 0.1
     crh = [1.0 + step * k for k in range(n_designs)]

@@ -34,12 +34,23 @@ from pathlib import Path
 
 import numpy as np
 import scipy.sparse.linalg as spla
-from skfem import (Basis, BilinearForm, ElementLineP2, ElementTriP2, ElementTriP3, ElementTriP4, ElementVector, FacetBasis, LinearForm,
-                   MeshLine1, condense, solve)
+from skfem import (
+    Basis,
+    BilinearForm,
+    ElementLineP2,
+    ElementTriP2,
+    ElementTriP3,
+    ElementTriP4,
+    ElementVector,
+    FacetBasis,
+    LinearForm,
+    MeshLine1,
+    condense,
+    solve,
+)
 from skfem.helpers import dot
 
 from fem_check.meshing import MeshOptions, annulus_domain, build_mesh
-
 
 CRACK_REGULARISATION = 1e-6  # fraction of the isotropic stiffness added in the 2D cracked zone
 
@@ -383,8 +394,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
 
 def run(args) -> int:
     from fem_check.report import Report, emit_json
-    from semianalytic.cavity.case import MODEL_FIELDS
     from semianalytic.errors import model_field
+    from semianalytic.sections.cavity import MODEL_FIELDS
 
     with model_field(MODEL_FIELDS):  # the cavity model's input names -> the [material] keys of the case
         material, title = material_from_args(args.case)

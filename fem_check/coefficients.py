@@ -31,7 +31,6 @@ import time
 from dataclasses import dataclass
 
 import numpy as np
-import scipy.sparse.linalg as spla
 from skfem import Basis, BilinearForm
 from skfem.helpers import dot, grad
 

@@ -169,7 +169,7 @@ class MeshOptions:
         if not 0 <= self.grading <= 1:
             raise InputError("mesh.grading", f"must lie in [0, 1]; got {self.grading!r}")
 
-    def refined(self, factor: float) -> "MeshOptions":
+    def refined(self, factor: float) -> MeshOptions:
         """The same grading with all element sizes divided by ``factor``."""
         return dataclasses.replace(self, h=self.h / factor)
 
@@ -575,7 +575,7 @@ class DomainMesh:
             nodes.append(self.mesh.dofs.facet_dofs[:, facets].ravel())
         return np.unique(np.concatenate(nodes))
 
-    def with_doflocs(self, doflocs: np.ndarray) -> "DomainMesh":
+    def with_doflocs(self, doflocs: np.ndarray) -> DomainMesh:
         """Same topology and tags, moved nodes (for shape finite differences)."""
         return dataclasses.replace(self, mesh=moved_mesh(self.mesh, np.ascontiguousarray(doflocs)))
 

@@ -23,9 +23,8 @@ from dataclasses import dataclass
 import numpy as np
 from skfem import Basis, FacetBasis, condense
 
-from fem_check.meshing import Domain, MeshOptions, Piece, _line, _nose_waterline, build_mesh, singular_corners
+from fem_check.meshing import Domain, MeshOptions, Piece, _line, _nose_waterline, build_mesh, moved_mesh, singular_corners
 from fem_check.potential import _body_load, _contact_area, _laplace_r, element_for, mapping_for, symmetric_lu
-from fem_check.meshing import moved_mesh
 from semianalytic.errors import InputError
 from semianalytic.geometry import Nose
 

@@ -158,8 +158,8 @@ def render(study: dict, quick: bool = False):
 
 def write_plate_report(out_dir: Path, quick: bool = False) -> list[Path]:
     """Run :func:`plate_study` and write ``plate_coefficients.md`` and ``.png`` into ``out_dir``."""
-    from semianalytic.bem.solve import _single_threaded_blas
     from fem_check.plate_study import plate_study
+    from semianalytic.bem.solve import _single_threaded_blas
     from semianalytic.io import atomic_write_bytes, atomic_write_text
 
     with _single_threaded_blas():

@@ -167,7 +167,7 @@ def fem_drag(hs=(0.08, 0.05, 0.04)) -> list[dict]:
         bem = plate_coefficients_at(nose, 2.0 * L, [1.4 * L], refinement=1.0, levels=12)
         for hh in hs:
             f = plate_potential(nose, 1.4 * L, 2.0 * L, MeshOptions(h=hh), derivative=True)
-            out.append({"nose": name, "h_over_d": hh, "dofs": f.n_dofs, "B_over_S": float(bem["B_bernoulli"][0] / (math.pi * nose.radius**2)),
+            out.append({"nose": name, "h_over_d": hh, "dofs": f.n_dofs, "B_over_S": float(bem["B_bernoulli"][0] / (math.pi * nose.radius**2)),  # noqa: E501
                         "rel": float(f.dA_dP / bem["B_bernoulli"][0] - 1)})
     return out
 

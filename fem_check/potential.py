@@ -19,7 +19,6 @@ norm (h^2 for P1, h^4 for P2 with curved edges).
 
 from __future__ import annotations
 
-import dataclasses
 import math
 import time
 from dataclasses import dataclass

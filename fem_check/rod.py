@@ -20,9 +20,9 @@ from __future__ import annotations
 import argparse
 import math
 import time
+from collections.abc import Callable
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Callable
 
 import numpy as np
 import scipy.sparse.linalg as spla
@@ -260,8 +260,8 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", nargs="?", help="case TOML with a [projectile] (default: the Fig. 5 ogival rod, 71.1 mm)")
     from semianalytic.cli_types import checked, integer, number, quantity
 
-    parser.add_argument("--sigma0", default=None, type=checked(quantity("pressure")), help="end stress of the step load, e.g. '1 GPa' (default 1 GPa)")
-    parser.add_argument("--round-trips", type=number(10.0, 1000.0), default=10.5, help="duration in round trips 2L/c0 (>= 10; default 10.5)")
+    parser.add_argument("--sigma0", default=None, type=checked(quantity("pressure")), help="end stress of the step load, e.g. '1 GPa' (default 1 GPa)")  # noqa: E501
+    parser.add_argument("--round-trips", type=number(10.0, 1000.0), default=10.5, help="duration in round trips 2L/c0 (>= 10; default 10.5)")  # noqa: E501
     parser.add_argument("--elements", type=integer(10, 20000), default=400, help="number of P1 elements (default 400)")
     add_output_arguments(parser, "fem_rod")
 
@@ -329,10 +329,10 @@ def _write_report(report, case, step: dict, driven: dict | None) -> None:
           "## Errors against the series solution (24)-(27)", "",
           md_table(["quantity", "FEM error", "measure"], [
               ["w(L, t), eq. (24)", step["max_rel_error"], "max over t of abs(error) / max abs(w(L, t)) (rigid motion included)"],
-              ["w(L, t), eq. (24)", step["end_displacement_error_over_elastic_amplitude"], "max abs(error) / (sigma_0 L / 2E_p), the elastic amplitude"],
+              ["w(L, t), eq. (24)", step["end_displacement_error_over_elastic_amplitude"], "max abs(error) / (sigma_0 L / 2E_p), the elastic amplitude"],  # noqa: E501
               ["dw/dt (L, t), eq. (25)", step["end_velocity_rms_rel_error"], "RMS over t / (sigma_0 c_0 / E_p) (Gibbs at the jumps)"],
-              ["dw/dx at t = L/c_0 (2i-1), eq. (27)", max(s["rms_rel"] for s in step["strain_snapshots"]), "max over i of RMS over x / (sigma_0/E_p)"],
-              ["vibrational energy", step["vibrational_energy_max_abs_error_over_max"], "max over t of abs(error) / (pi d^2 sigma_0^2 L / 8E_p)"],
+              ["dw/dx at t = L/c_0 (2i-1), eq. (27)", max(s["rms_rel"] for s in step["strain_snapshots"]), "max over i of RMS over x / (sigma_0/E_p)"],  # noqa: E501
+              ["vibrational energy", step["vibrational_energy_max_abs_error_over_max"], "max over t of abs(error) / (pi d^2 sigma_0^2 L / 8E_p)"],  # noqa: E501
               ["momentum", step["momentum_max_rel_error"], "abs(p - N t) / (N t_end)"],
           ]), "",
           "The loaded end moves like the series says: -sigma_0 c_0 t / E_p holds only during the first round trip "
@@ -391,7 +391,7 @@ def _write_report(report, case, step: dict, driven: dict | None) -> None:
                 ["final depth [mm]", driven["final_depth_m"] * 1e3],
                 ["initial kinetic energy [J]", driven["initial_kinetic_energy_J"]],
                 ["FEM vibrational energy at the stop [J]", driven["vibrational_energy_J"]],
-                ["FEM vibrational energy, max / time mean [J]", f"{fmt(driven['max_vibrational_energy_J'])} / {fmt(driven['mean_vibrational_energy_J'])}"],
+                ["FEM vibrational energy, max / time mean [J]", f"{fmt(driven['max_vibrational_energy_J'])} / {fmt(driven['mean_vibrational_energy_J'])}"],  # noqa: E501
                 ["paper W2 at the stop, sigma_0 = 4N/(pi d^2) [J]", driven["paper_W2_J"]],
                 ["bound pi d^2 sigma_0,max^2 L / 8E_p [J]", driven["bound_pi_d2_sigma0max2_L_over_8E_J"]],
             ]), "",

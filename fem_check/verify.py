@@ -22,7 +22,7 @@ from pathlib import Path
 
 import numpy as np
 
-from fem_check.coefficients import body_added_mass, depth_scale, halfspace_coefficients, halfspace_mesh, solved_once
+from fem_check.coefficients import body_added_mass, depth_scale, halfspace_mesh, solved_once
 from fem_check.meshing import MeshOptions, body_domain, build_mesh
 from fem_check.potential import solve_potential
 from semianalytic.errors import InputError
@@ -227,7 +227,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("case", help="case TOML with a [body] or a [projectile]")
     from semianalytic.cli_types import number, number_list
 
-    parser.add_argument("--depths", default=None, type=number_list(0.0, 1e4, exclude={1.0: "P = L_h is the nose-shank junction, where the BEM layout changes topology; use a nearby depth such as 0.99 or 1.01"}),
+    parser.add_argument("--depths", default=None, type=number_list(0.0, 1e4, exclude={1.0: "P = L_h is the nose-shank junction, where the BEM layout changes topology; use a nearby depth such as 0.99 or 1.01"}),  # noqa: E501
                         help="comma-separated depths in nose lengths L_h (default: " + ",".join(map(str, DEFAULT_DEPTHS)) + ")")
     parser.add_argument("--h", type=number(0.005, 0.5), default=0.04, help="FEM element size on the body over d (default 0.04)")
     parser.add_argument("--quick", action="store_true", help="skip the convergence and far-field studies")

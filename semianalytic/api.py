@@ -24,9 +24,10 @@ from __future__ import annotations
 
 import os
 import warnings
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -433,9 +434,8 @@ def penetrate(case, velocities: Sequence[float] | None = None, *, source: str = 
 
 
 def _penetrate(case, velocities, *, source="bem", w1="neglect", part1_model=None, cache_dir=None) -> dict:
-    from semianalytic.penetration.evaluate import evaluate_case
-
     from semianalytic.cache import coefficients_for_case
+    from semianalytic.commands.penetrate.evaluate import evaluate_case
 
     U = _velocities(velocities)
     table, desc, _fallback = coefficients_for_case(case, source, cache_dir, progress=True)
@@ -520,7 +520,7 @@ def predict_with_posterior(case, posterior: str | os.PathLike | Sequence[str | o
     semianalytic.errors.ValidityWarning
         The notices a command would print on stderr.
     """
-    from semianalytic.calibration.evaluate import predict_with_posterior as _predict
+    from semianalytic.commands.calibrate.evaluate import predict_with_posterior as _predict
 
     paths = [str(posterior)] if isinstance(posterior, (str, os.PathLike)) else [str(p) for p in posterior]
     U = _velocities(velocities)
@@ -591,7 +591,7 @@ def perforate(case, velocities: Sequence[float] | None = None, *, ballistic: boo
     semianalytic.errors.ValidityWarning
         Where the model is used outside its validity (e.g. the plate-table reach).
     """
-    from semianalytic.perforation.evaluate import evaluate_case
+    from semianalytic.commands.perforate.evaluate import evaluate_case
     from semianalytic.progress import stages
 
     for sec in ("projectile", "target", "impact"):
@@ -622,7 +622,7 @@ def ballistic_limit(case) -> Result:
         V_cr of eqs. (7)-(9) and the measured value [m/s]; ``constants``, ``hardness_rule``,
         ``areal_mass_rule``.  ``.to_frame()``: one row per shot.
     """
-    from semianalytic.ballistic_limit.evaluate import evaluate_case
+    from semianalytic.commands.ballistic_limit.evaluate import evaluate_case
 
     return TableResult(evaluate_case(case), "ballistic-limit")
 
@@ -670,7 +670,7 @@ def nanostrength(case) -> Result:
         The analysis JSON (``crystals``, ``studies`` with the printed values compared);
         ``.to_frame()``: one row per study row (material and geometry).
     """
-    from semianalytic.nanostrength.analysis import analyse_section
+    from semianalytic.sections.nanostrength import analyse_section
 
     return NanostrengthResult(analyse_section(case.require("nanostrength")).to_json(), "nanostrength", rows_key=None)
 

@@ -227,7 +227,7 @@ def override_coefficients(case, *, contact: str | None = None, tolerance=None):
     (``--contact``, ``--tolerance``; None keeps the case's value)."""
     import dataclasses
 
-    from semianalytic.coefficients.case import parse_tolerance
+    from semianalytic.sections.coefficients import parse_tolerance
 
     updates = {}
     if contact is not None:

@@ -15,19 +15,20 @@ from __future__ import annotations
 
 import importlib
 import math
-import tomllib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Literal, Mapping
+from typing import Any, Literal
 
 from pydantic import BaseModel, Field, field_validator, model_validator
 
 from semianalytic.errors import InputError
 from semianalytic.geometry import NOSE_KINDS
-from semianalytic.penetration.case import ResistanceField
-from semianalytic.perforation.case import TargetLayerSection, check_target_layers
 from semianalytic.schema import Section, validate_section
 from semianalytic.schema import pydantic_message as _pydantic_message  # noqa: F401 (old name)
+from semianalytic.sections.penetration import ResistanceField
+from semianalytic.sections.perforation import TargetLayerSection, check_target_layers
+from semianalytic.sections.resistances import load_all as _load_added_resistances
 from semianalytic.units import Angle, Density, Length, Mass, NonNegativeLength, Pressure, Velocity
 
 __all__ = [
@@ -57,7 +58,7 @@ class BodySection(Section):
     sphere: ``diameter``; spheroid (prolate or oblate), cylinder (flat-ended) and double_cone
     (two cones base to base): ``length`` along the axis and ``diameter``; table: ``points = [[x, r], ...]`` in ``points_unit``, a meridian from one
     axis point (r = 0) to the other.
-    """
+    """  # noqa: E501
 
     shape: Literal["sphere", "spheroid", "table", "cylinder", "double_cone"]
     length: Length | None = None
@@ -240,8 +241,8 @@ class ProjectileSection(Section):
 
 class TargetSection(Section):
     """``[target]``: the half-space target, or a plate (``thickness``) or layered target
-    (``[[target.layers]]``, :mod:`semianalytic.perforation.case`).  ``resistance``: the schema of
-    :mod:`semianalytic.penetration.case` (a discriminated union on ``model``)."""
+    (``[[target.layers]]``, :mod:`semianalytic.sections.perforation`).  ``resistance``: the schema of
+    :mod:`semianalytic.sections.penetration` (a discriminated union on ``model``)."""
 
     density: Density
     resistance: ResistanceField | None = None
@@ -254,17 +255,7 @@ class TargetSection(Section):
         return self
 
 
-# The generic physical bound of a striking velocity (each model warns about its own, lower
-# validity): the fastest laboratory launchers (two-stage light-gas guns) reach about 10 km/s,
-# and every model of Part I assumes a projectile that stays intact, which it does not at
-# hypervelocity.  Above 12 km/s a case is refused (exit status 2) rather than warned.
-MAX_STRIKING_VELOCITY = 12e3
-# Issue 27 (this project's own limits): below 1 mm/s an impact is a quasi-static indentation
-# (and the ODE of the motion has no resolvable time scale: U_s = 1e-9 m/s overflowed a spline);
-# above 6 km/s the shock pressure of a metal-on-metal impact exceeds ~100 GPa, the projectile
-# melts or vaporises, and no model here (each assumes a solid projectile) reaches: warned.
-MIN_STRIKING_VELOCITY = 1e-3
-SOLID_STRIKING_VELOCITY = 6e3
+from semianalytic.limits import MAX_STRIKING_VELOCITY, MIN_STRIKING_VELOCITY, SOLID_STRIKING_VELOCITY  # noqa: E402,F401
 
 
 class ImpactSection(Section):
@@ -320,14 +311,14 @@ class CoefficientsSection(Section):
 
 # Other analyses' sections: name -> "module:Model" (imported only when used).
 SECTIONS: dict[str, str] = {
-    "material": "semianalytic.cavity.case:MaterialSection",
-    "ballistic_limit": "semianalytic.ballistic_limit.case:BallisticLimitSection",
-    "nanostrength": "semianalytic.nanostrength.case:NanostrengthSection",
-    "data": "semianalytic.penetration.case:DataSection",
+    "material": "semianalytic.sections.cavity:MaterialSection",
+    "ballistic_limit": "semianalytic.sections.ballistic_limit:BallisticLimitSection",
+    "nanostrength": "semianalytic.sections.nanostrength:NanostrengthSection",
+    "data": "semianalytic.sections.penetration:DataSection",
     "run": "semianalytic.run.case:RunSection",
-    "calibration": "semianalytic.calibration.case:CalibrationSection",
-    "perforation": "semianalytic.perforation.case:PerforationSection",
-    "regimes": "semianalytic.penetration.regimes_case:RegimesSection",
+    "calibration": "semianalytic.sections.calibration:CalibrationSection",
+    "perforation": "semianalytic.sections.perforation:PerforationSection",
+    "regimes": "semianalytic.sections.regimes:RegimesSection",
 }
 
 _CORE = {
@@ -365,6 +356,11 @@ class Case:
         from semianalytic.geometry import derived_geometry
 
         return derived_geometry(self.require("projectile"))
+
+    def with_raw(self, raw: Mapping[str, Any]) -> Case:
+        """Another case parsed (and validated) from ``raw``, a changed copy of :attr:`raw`; it has
+        no path (relative file references are not resolved)."""
+        return parse_case(raw, None)
 
     def section(self, name: str) -> Any:
         """Any section by name (core or registered); ``None`` if the case has none."""
@@ -432,3 +428,8 @@ def load_case(path: str | Path) -> Case:
 
     path = Path(resolve_path(path))  # `cases/X.toml` outside a checkout: the bundled case (one note)
     return parse_case(read_toml_text(path), path)
+
+
+# the resistance models added one file each (semianalytic/sections/resistances/): registered once the
+# schemas that hold [target.resistance] exist, so that their union is rebuilt with every model
+_load_added_resistances()

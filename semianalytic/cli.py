@@ -7,7 +7,6 @@ Exit status: 0 success, 2 bad input (one line naming the field), 1 internal fail
 
 from __future__ import annotations
 
-import argparse
 import importlib
 import os
 import sys
@@ -20,16 +19,16 @@ from semianalytic.guards import set_memory_limit
 
 # name -> (module, one-line help)
 COMMANDS: dict[str, tuple[str, str]] = {
-    "coefficients": ("semianalytic.coefficients.cli", "BEM drag coefficients A(P), B(P), C(P) (Part I, eqs. 12-15)"),
+    "coefficients": ("semianalytic.commands.coefficients.cli", "BEM drag coefficients A(P), B(P), C(P) (Part I, eqs. 12-15)"),
     "bench-bem": ("benchmarks.bench_bem", "benchmark the BEM against exact solutions; writes reports/bench_bem.md"),
-    "penetrate": ("semianalytic.penetration.cli", "depth and time of penetration, critical impact velocity (Part I)"),
-    "perforate": ("semianalytic.perforation.cli", "perforation of plates: residual velocity, ballistic limit (Part I eq. 11, Part IV)"),
-    "cavity": ("semianalytic.cavity.cli", "brittle spherical-cavity expansion (Part II)"),
-    "ballistic-limit": ("semianalytic.ballistic_limit.cli", "ballistic limit velocity (Part IV)"),
-    "fit-constants": ("semianalytic.ballistic_limit.fit_cli", "refit the empirical constants C1, C2, C3 (Part IV, eqs. 7-9)"),
-    "nanostrength": ("semianalytic.nanostrength.cli", "theoretical strength of diamond-like nanoparticles (Part III)"),
+    "penetrate": ("semianalytic.commands.penetrate.cli", "depth and time of penetration, critical impact velocity (Part I)"),
+    "perforate": ("semianalytic.commands.perforate.cli", "perforation of plates: residual velocity, ballistic limit (Part I eq. 11, Part IV)"),  # noqa: E501
+    "cavity": ("semianalytic.commands.cavity.cli", "brittle spherical-cavity expansion (Part II)"),
+    "ballistic-limit": ("semianalytic.commands.ballistic_limit.cli", "ballistic limit velocity (Part IV)"),
+    "fit-constants": ("semianalytic.commands.ballistic_limit.fit_cli", "refit the empirical constants C1, C2, C3 (Part IV, eqs. 7-9)"),
+    "nanostrength": ("semianalytic.commands.nanostrength.cli", "theoretical strength of diamond-like nanoparticles (Part III)"),
     "run": ("semianalytic.run.cli", "run everything a case asks for and write a report"),
-    "calibrate": ("semianalytic.calibration.cli", "Bayesian calibration of target parameters on measured depths, predictive intervals, cross-validation"),
+    "calibrate": ("semianalytic.commands.calibrate.cli", "Bayesian calibration of target parameters on measured depths, predictive intervals, cross-validation"),  # noqa: E501
     "sweep": ("semianalytic.sweep.cli", "parallel parameter sweeps and Monte-Carlo studies"),
     "optimize": ("semianalytic.optimize.cli", "nose-shape optimisation with the BEM in the loop (depth or deep drag)"),
     "demo": ("semianalytic.demo", "run the main job on a bundled case and say where its report is"),

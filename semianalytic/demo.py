@@ -1,7 +1,7 @@
 """``python -m semianalytic demo`` (``make demo``): run the bundled Fig. 5 case
 ``cases/demo_fig5_ogive.toml`` (installed with the package: :mod:`semianalytic.bundled`) into ``--out`` (default: the folder ``demo`` of the per-user
 cache, ``$SEMIANALYTIC_CACHE_DIR/demo`` when set; an earlier demo there is replaced) and print
-the path of ``report.html``.  Nothing is written where the command runs unless asked."""
+the path of ``report.html``.  Nothing is written where the command runs unless asked."""  # noqa: E501
 
 from __future__ import annotations
 

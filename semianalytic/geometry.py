@@ -123,14 +123,14 @@ class SplineCurve:
     lo: float | None = None  # a sub-range [lo, hi] of the parameter (one interval between knots)
     hi: float | None = None
 
-    def between_knots(self) -> tuple["SplineCurve", ...]:
+    def between_knots(self) -> tuple[SplineCurve, ...]:
         """The curve cut at its knots: one segment per interval, so that panels never
         straddle a knot (where the third derivative jumps).  Built once per curve; the
         pieces share its splines."""
         return self._between_knots
 
     @cached_property
-    def _between_knots(self) -> tuple["SplineCurve", ...]:
+    def _between_knots(self) -> tuple[SplineCurve, ...]:
         k = self.knots
         pieces = tuple(SplineCurve(self.xs, self.rs, float(a), float(b)) for a, b in zip(k[:-1], k[1:]))
         table = self._scalar_table  # one copy of the coefficients for all pieces (a copy per piece: n^2)
@@ -594,7 +594,7 @@ def _check_tip_options(diameter: float, meplat_diameter: float, tip_radius: floa
     if meplat_diameter and tip_radius:
         raise InputError("projectile.tip_radius", "give either 'meplat_diameter' (flat tip) or 'tip_radius' (rounded tip), not both")
     if not 0 <= meplat_diameter < diameter:
-        raise InputError("projectile.meplat_diameter", f"must lie in [0, d) = [0, {diameter * 1e3:.4g} mm); got {meplat_diameter * 1e3:.4g} mm")
+        raise InputError("projectile.meplat_diameter", f"must lie in [0, d) = [0, {diameter * 1e3:.4g} mm); got {meplat_diameter * 1e3:.4g} mm")  # noqa: E501
     if not tip_radius >= 0:
         raise InputError("projectile.tip_radius", f"must not be negative; got {tip_radius * 1e3:.4g} mm")
 

@@ -25,7 +25,7 @@ from __future__ import annotations
 
 import math
 import os
-from typing import Callable
+from collections.abc import Callable
 
 from semianalytic.errors import InputError
 
@@ -160,8 +160,7 @@ def bem_halfspace_unknowns(nose, order: int = 8, refinement: float = 1.0, max_de
 def bem_body_unknowns(meridian, order: int = 8, refinement: float = 1.0, levels: int = 12) -> float:
     """Unknowns N of a closed body in unbounded fluid (order x panels of the body layout)."""
     from semianalytic.bem.panels import LayoutOptions, body_panels
-    from semianalytic.geometry import segment_arc_length
-    from semianalytic.geometry import EllipseArc
+    from semianalytic.geometry import EllipseArc, segment_arc_length
 
     segs = meridian.segments
     scale = _max_radius(meridian)

@@ -1,7 +1,7 @@
 """Progress on stderr, by one rule for every command and API call that may take more than
 about 2 s: a tqdm bar with a total when stderr is a terminal; one line per stage when stderr is
 a file (a log: ``cmd 2> log``); nothing with ``--quiet`` (``quiet=True``) or when stderr is a
-pipe (tests, ``| tee``).  In a Jupyter notebook (stderr is the kernel's stream) the bar.  ``SEMIANALYTIC_PROGRESS=bar|lines|off`` overrides the choice."""
+pipe (tests, ``| tee``).  In a Jupyter notebook (stderr is the kernel's stream) the bar.  ``SEMIANALYTIC_PROGRESS=bar|lines|off`` overrides the choice."""  # noqa: E501
 
 from __future__ import annotations
 

@@ -217,7 +217,7 @@ def read_toml_text(path: Any) -> dict:
             raise InputError("case", f"file {str(path)!r} {what}")
         size = path.stat().st_size
         if size > MAX_CASE_BYTES:
-            raise InputError("case", f"{path.name} is {size / 2**20:.1f} MiB; a case file is at most {MAX_CASE_BYTES // 2**20} MiB of TOML text")
+            raise InputError("case", f"{path.name} is {size / 2**20:.1f} MiB; a case file is at most {MAX_CASE_BYTES // 2**20} MiB of TOML text")  # noqa: E501
         with path.open("rb") as fh:
             raw = fh.read(MAX_CASE_BYTES + 1)
     except OSError as exc:

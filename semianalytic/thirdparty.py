@@ -100,7 +100,7 @@ def run_mcmc(sampler, p0, steps: int, **kwargs):
     likelihood, emcee's wrapper printed its own traceback first (issue 40)."""
     state = None
     with deferred_interrupts() as got:
-        for state in sampler.sample(p0, iterations=steps, **kwargs):
+        for state in sampler.sample(p0, iterations=steps, **kwargs):  # noqa: B007
             if got:
                 break
     if got:

@@ -120,7 +120,7 @@ def test_missing_table_and_bad_csv(tmp_path, capsys):
 
 
 def test_report_not_overwritten_without_force(tmp_path, capsys):
-    from semianalytic.ballistic_limit.report import main as report_main
+    from semianalytic.commands.ballistic_limit.report import main as report_main
 
     target = tmp_path / "part4_ballistic_limit.md"
     target.write_text("old\n")
@@ -131,7 +131,7 @@ def test_report_not_overwritten_without_force(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_report_builds(tmp_path):
-    from semianalytic.ballistic_limit.report import main as report_main
+    from semianalytic.commands.ballistic_limit.report import main as report_main
 
     assert report_main(["--out", str(tmp_path)]) == 0
     text = (tmp_path / "part4_ballistic_limit.md").read_text()

@@ -22,9 +22,9 @@ import pytest
 from semianalytic.ballistic_limit.empirical import composite_vcr, fit_constants, vcr_eq9
 from semianalytic.ballistic_limit.paper import (
     P3_SOFT_PROJECTILE_HVDELTA,
+    fit_samples,
     implied_areal_mass,
     implied_modulus,
-    fit_samples,
     table2_paper,
     table3_paper,
     table4_paper,

@@ -87,7 +87,7 @@ def test_restretched_stencil_sets_are_the_fresh_panel_sets():
     arrays, nodes and compiled geometry of the panel set built from its pieces: on an ogive cut
     by the free surface (one stretched piece), past its shoulder (a new shank line) and on a
     table nose cut between knots (many pieces, a spline)."""
-    from semianalytic.coefficients.study import study_nose
+    from semianalytic.commands.coefficients.study import study_nose
 
     for nose, P in ((ogive_nose(D, 3.0), 0.5), (ogive_nose(D, 3.0), 2.0), (study_nose("table"), 0.6)):
         P *= nose.length
@@ -104,5 +104,5 @@ def test_restretched_stencil_sets_are_the_fresh_panel_sets():
                 assert np.array_equal(a, b)
             assert not np.array_equal(fresh.nodes.x, centre.nodes.x)  # the test sees a stale copy
             if kernels.compiled() is not None:
-                (ad, kd), (af, kf) = derived._compiled_curves, fresh._compiled_curves
+                (ad, kd), (af, kf) = derived._compiled_curves, fresh._compiled_curves  # noqa: F841
                 assert set(kd) == set(kf) and all(np.array_equal(kd[n], kf[n]) for n in kf)

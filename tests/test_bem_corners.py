@@ -17,7 +17,7 @@ import pytest
 from semianalytic.bem import solve_body, solve_halfspace, unknowns_body, unknowns_halfspace
 from semianalytic.bem.panels import LayoutOptions, corner_exponent, corner_power
 from semianalytic.coefficients.depth import coefficients_at_depth
-from semianalytic.errors import InputError, ModelError
+from semianalytic.errors import ModelError
 from semianalytic.geometry import (
     cone_nose,
     cylinder_body,

@@ -11,7 +11,7 @@ import pytest
 
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
 from semianalytic.bem.solve import near_pairs, near_quadrature
-from semianalytic.coefficients.study import study_nose
+from semianalytic.commands.coefficients.study import study_nose
 
 
 def _distinct_by_unique(rule):

@@ -14,7 +14,6 @@ import sys
 from pathlib import Path
 
 import numpy as np
-import pytest
 
 from semianalytic import cache
 from semianalytic.geometry import ogive_nose

@@ -10,12 +10,12 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from case_blocks import TARGET_6061_T651
 
 from semianalytic.calibration.models import MODELS, DepthModelInputs, ShotSet, build_surrogate, model_depths
 from semianalytic.calibration.priors import HalfNormal, LogNormal
 from semianalytic.calibration.sampler import Problem, ResistanceMap, mixture_quantiles, sample_posterior
 from semianalytic.cli import main
-from case_blocks import TARGET_6061_T651
 
 ROOT = Path(__file__).resolve().parents[1]
 CASES = ROOT / "cases"
@@ -87,9 +87,10 @@ def test_surrogates_match_direct_evaluation_off_the_nodes():
     values that are not nodes.  Tolerances: 1e-7 for the smooth models (16 nodes over a factor
     4 in R_t; the series converges geometrically); 5e-3 for the exact-rod elastic model, whose
     own depth steps by ~3e-3 as R_t moves its stop between oscillation periods of the rod."""
+    import dataclasses
+
     from semianalytic.penetration import peers
     from semianalytic.penetration.curve import penetration_curve
-    import dataclasses
 
     inp = _paper_inputs()
     lo, hi = 0.7e9, 2.8e9
@@ -249,7 +250,7 @@ def test_penetrate_posterior_refuses_other_target_and_bad_files(tmp_path, capsys
                             ('youngs_modulus = "68.9 GPa"', 'youngs_modulus = "70 GPa"', "target.resistance.youngs_modulus"),
                             ('model = "elastic-plastic"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"\npoisson_ratio = 0.33',
                              'model = "constant"\nvalue = "1.4 GPa"', "target.resistance.model")):
-        other = _copy_case(tmp_path, edit=lambda t: t.replace(old, new))
+        other = _copy_case(tmp_path, edit=lambda t: t.replace(old, new))  # noqa: B023
         code, stdout, err = _run(capsys, "penetrate", other, "--posterior", post, "--json", "--coefficients", "paper")
         assert code == 2 and field in err and err.count("\n") == 1, (field, err)
         assert stdout == ""

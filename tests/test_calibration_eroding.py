@@ -55,8 +55,9 @@ def test_eroding_depths_over_draws_against_time_integration():
     """ErodingDepths (every draw and shot at once) against the time integration of tests/tate_reference.py (DOP853 in
     time, rtol 1e-11) at draws on both sides of Y_p = R_t and with one parameter held fixed:
     two converged methods, 1e-7 relative."""
-    from semianalytic.calibration.models import ErodingDepths, ThetaColumn
     from tate_reference import tate_penetration_ode as tate_penetration
+
+    from semianalytic.calibration.models import ErodingDepths, ThetaColumn
 
     U = np.array([1977.0, 2570.0, 2988.0])
     L0 = np.array([0.0655, 0.0656, 0.0654])
@@ -189,7 +190,7 @@ def test_penetrate_refuses_eroding_posterior_of_another_projectile_or_target(ero
     post = out / "posterior.json"
     for old, new, field in (('density = "7830 kg/m^3"', 'density = "7890 kg/m^3"', "projectile.density"),
                             ('[target]\ndensity = "2710 kg/m^3"', '[target]\ndensity = "2800 kg/m^3"', "target.density")):
-        case = _copy(tmp_path, "piekutowski1999_var4340_regimes.toml", edit=lambda t: t.replace(old, new))
+        case = _copy(tmp_path, "piekutowski1999_var4340_regimes.toml", edit=lambda t: t.replace(old, new))  # noqa: B023
         code, stdout, err = _run(capsys, "penetrate", case, "--posterior", post, "--json")
         assert code == 2 and err.startswith(f"error: {field}") and err.count("\n") == 1, (field, err)
         assert stdout == ""

@@ -22,14 +22,14 @@ from semianalytic.cavity.model import (
 )
 from semianalytic.cavity.zones import (
     comminuted_zone,
-    cracked_zone,
     crack_front_ratio,
+    cracked_zone,
     elastic_zone,
     front_strains,
     lame_cavity,
 )
-from semianalytic.cavity.case import MODEL_FIELDS
-from semianalytic.errors import InputError, ModelError, ModelValidityWarning, model_field
+from semianalytic.errors import ModelError, ModelValidityWarning, model_field
+from semianalytic.sections.cavity import MODEL_FIELDS
 
 GPa = 1e9
 AD995 = BrittleMaterial(373.14 * GPa, 0.232, 0.262 * GPa, 2.62 * GPa, 231.8 * GPa)

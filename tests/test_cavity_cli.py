@@ -88,7 +88,7 @@ def test_missing_section_exit_2(tmp_path, capsys):
 
 
 def test_report_not_overwritten_without_force(tmp_path, capsys):
-    from semianalytic.cavity.report import main as report_main
+    from semianalytic.commands.cavity.report import main as report_main
 
     target = tmp_path / "part2_cavity.md"
     target.write_text("old\n")
@@ -98,7 +98,7 @@ def test_report_not_overwritten_without_force(tmp_path, capsys):
 
 @pytest.mark.slow
 def test_report_builds(tmp_path):
-    from semianalytic.cavity.report import main as report_main
+    from semianalytic.commands.cavity.report import main as report_main
 
     assert report_main(["--out", str(tmp_path)]) == 0
     assert "Deviations and findings" in (tmp_path / "part2_cavity.md").read_text()

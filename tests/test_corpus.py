@@ -14,7 +14,6 @@ import os
 from pathlib import Path
 
 import pytest
-
 from corpus_runner import HEAVY, LOADERS, PRIMARY, corpus_files, headers, run_command, working_directory
 
 FILES = corpus_files()

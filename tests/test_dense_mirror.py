@@ -14,9 +14,9 @@ import pytest
 from semianalytic.bem import kernels
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
 from semianalytic.bem.solve import _flat_nodes, _layers, _layers_split, assemble, plan_assembly
-from semianalytic.coefficients.study import study_nose
+from semianalytic.commands.coefficients.study import study_nose
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy): the numpy kernels only")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy): the numpy kernels only")  # noqa: E501
 
 SHIFT = 0.5  # images in the plane x = -0.25: x* = -x - 0.5
 

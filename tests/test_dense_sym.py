@@ -8,7 +8,7 @@ import pytest
 
 from semianalytic.bem import kernels
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy): the numpy kernels only")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy): the numpy kernels only")  # noqa: E501
 
 
 def _nodes(n, seed):

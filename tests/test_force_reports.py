@@ -12,7 +12,7 @@ ROOT = Path(__file__).resolve().parent.parent
 
 
 def _report(out: Path, *flags: str) -> subprocess.CompletedProcess:
-    return subprocess.run([sys.executable, "-m", "semianalytic.ballistic_limit.report", "--out", str(out), *flags],
+    return subprocess.run([sys.executable, "-m", "semianalytic.commands.ballistic_limit.report", "--out", str(out), *flags],
                           capture_output=True, text=True, cwd=ROOT, timeout=300)
 
 

@@ -310,8 +310,8 @@ def test_time_and_memory_budgets_refuse_before_work(capsys, tmp_path, monkeypatc
 def test_posterior_with_string_samples_or_too_large_is_bad_input(tmp_path):
     """A posterior whose draws are strings ("1.5e8" would convert silently) or a file of 100 MB
     (no posterior of calibrate is: ~0.5 MB for 1000 draws) is refused naming the field."""
-    from semianalytic.calibration.case import read_posterior
     from semianalytic.errors import InputError
+    from semianalytic.sections.calibration import read_posterior
 
     good = json.loads((ROOT / "reports" / "calibration_piekutowski1999" / "posterior.json").read_text())
     read_posterior(ROOT / "reports" / "calibration_piekutowski1999" / "posterior.json")  # the real one reads

@@ -57,7 +57,7 @@ class _Server:
         while time.monotonic() < self.stop_at and self.sock.fileno() >= 0:
             try:
                 conn, _ = self.sock.accept()
-            except (socket.timeout, OSError):
+            except (TimeoutError, OSError):
                 continue
             self.conns.append(conn)
             if self.reply is not None:
@@ -263,7 +263,7 @@ def test_signals_leave_no_temporary_file_and_no_traceback(tmp_path, which, signa
         # the sampler running: its output is staged only after sampling, so the signal goes 20 s after the start
         # (imports and the table take a few seconds; 20000 steps take minutes, even on an idle machine)
         "calibrate": (["calibrate", ROOT / "cases" / "piekutowski1999_var4340.toml", "--out", "out", "--steps", "20000",
-                       "--quiet"], lambda w, t0=time.monotonic(): time.monotonic() - t0 > 20.0),
+                       "--quiet"], lambda w, t0=time.monotonic(): time.monotonic() - t0 > 20.0),  # noqa: B008
     }[which]
     rc, err, tmpdir, work, home = _signalled(tmp_path, argv, getattr(signal, signame), ready)
     assert rc == 1, err

@@ -1,8 +1,8 @@
 """``python -m semianalytic nanostrength``: output, bad input (exit 2, field named, nothing
 written), report written atomically and not overwritten without --force."""
 
-import re
 import json
+import re
 from pathlib import Path
 
 import pytest

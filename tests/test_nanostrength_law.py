@@ -36,12 +36,12 @@ def test_csv_files_match_the_constants():
         assert [float(r[k]) for k in ("minus_phi0_e2", "a0", "c0", "a0_exp", "c0_exp")] == [t.minus_phi0_e2, t.a0, t.c0, t.a0_exp, t.c0_exp]
     for r in _rows("part3_table2.csv"):
         t = data.TABLE2[r["crystal"]]
-        assert [float(r[k]) for k in ("sigma1_GPa", "e1", "E1_GPa", "sigma2_GPa", "e2", "E2_GPa")] == [t.sigma1, t.e1, t.E1, t.sigma2, t.e2, t.E2]
+        assert [float(r[k]) for k in ("sigma1_GPa", "e1", "E1_GPa", "sigma2_GPa", "e2", "E2_GPa")] == [t.sigma1, t.e1, t.E1, t.sigma2, t.e2, t.E2]  # noqa: E501
     for r in _rows("part3_table3.csv"):
         t = data.TABLE3[r["crystal"]]
-        assert [float(r[k]) for k in ("Y1c_I_N_per_m", "Y1c_II_N_per_m", "K1c_I_MPa_sqrt_m", "K1c_II_MPa_sqrt_m")] == [t.Y_t, t.Y_c, t.K_t, t.K_c]
+        assert [float(r[k]) for k in ("Y1c_I_N_per_m", "Y1c_II_N_per_m", "K1c_I_MPa_sqrt_m", "K1c_II_MPa_sqrt_m")] == [t.Y_t, t.Y_c, t.K_t, t.K_c]  # noqa: E501
     for r in _rows("part3_deformation_energy.csv"):
-        assert (float(r["delta_phi_tension_Ry_per_bohr2"]), float(r["delta_phi_compression_Ry_per_bohr2"])) == data.DEFORMATION_ENERGY[r["crystal"]]
+        assert (float(r["delta_phi_tension_Ry_per_bohr2"]), float(r["delta_phi_compression_Ry_per_bohr2"])) == data.DEFORMATION_ENERGY[r["crystal"]]  # noqa: E501
     for r in _rows("part3_table4.csv"):
         assert (float(r["sigma1_GPa"]), float(r["sigma2_GPa"])) == data.TABLE4[r["crystal"]][r["column"]]
     for r in _rows("part3_table5.csv"):

@@ -150,7 +150,7 @@ def test_table5_with_l8_i2(laws, basis):
     # Table 5 (SiC) with the inferred l = 8, i = 2: every entry within 1e-4 (measured 7.5e-5)
     # except the parallelogram sigma_1 at m = n = 25 (printed 180.023 = the rectangle m = n = 50
     # value; the model's 182.015 is 1.1 % higher).
-    for k, m in enumerate(data.TABLE5_SIZES):
+    for k, m in enumerate(data.TABLE5_SIZES):  # noqa: B007
         s = _strength(laws, "SiC", basis, 8, m, 2)
         s1, s2 = data.table5_printed(basis, m)
         assert s.sigma_t / 1e9 == pytest.approx(s2, rel=1e-4)

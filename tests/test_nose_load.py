@@ -134,7 +134,7 @@ def test_regimes_section_and_option_flag(tmp_path, capsys):
     text = VAR.read_text()
     p = tmp_path / "c.toml"
     p.write_text(text.replace("[target]\n", '[regimes]\nnose_load = "forrestal"\ndeformed_depth = "part1"\n\n[target]\n', 1)
-                 .replace('file = "piekutowski1999_ogive_6061T6511.csv"', f'file = "{ROOT / "cases" / "piekutowski1999_ogive_6061T6511.csv"}"'))
+                 .replace('file = "piekutowski1999_ogive_6061T6511.csv"', f'file = "{ROOT / "cases" / "piekutowski1999_ogive_6061T6511.csv"}"'))  # noqa: E501
     opt = R.options_for(load_case(p))
     assert opt.nose_load == "forrestal" and opt.deformed_depth == "part1" and opt.onset == R.Options().onset
     assert R.options_for(load_case(p), ["nose_load=part1"]).nose_load == "part1"

@@ -64,7 +64,7 @@ def test_the_home_itself_matches():
 
 @pytest.mark.parametrize("copy", [
     "a = -(0.5 * rho * B * u * u + C * R_t) / (mass + rho * A)",  # the old coefficients/contact.py:49
-    "du_dt = -(B * rho * u * u / 2 + C * R_t) / (mass + rho * A)  # Part I, eq. (11)",  # coefficients/report.py
+    "du_dt = -(B * rho * u * u / 2 + C * R_t) / (mass + rho * A)  # Part I, eq. (11)",  # commands/coefficients/report.py
     "f = mass / (mass + target_density * A) / area",  # the old elastic.start_force_coefficients
 ])
 def test_the_eq11_patterns_catch_the_old_copies(copy):
@@ -79,7 +79,7 @@ def test_eq11_is_defined_once_and_called_by_every_path():
                "def separation_onset"):
         body = motion[motion.index(fn):].split("\n\n\n")[0]
         assert "eq11_acceleration(" in body, fn
-    for rel in ("semianalytic/coefficients/study.py", "semianalytic/penetration/elastic.py"):
+    for rel in ("semianalytic/commands/coefficients/study.py", "semianalytic/penetration/elastic.py"):
         assert "eq11_acceleration(" in _text(rel), rel
 
 
@@ -257,7 +257,7 @@ def test_part4_closed_forms_are_called_by_every_path():
     for fn in ("quadratic_drag_stop_time(", "quadratic_drag_velocity(", "quadratic_drag_depth_at_time(",
                "quadratic_drag_depth_at_velocity("):
         assert fn in body, fn
-    assert "eq1_deceleration(" in _text("semianalytic/ballistic_limit/study.py")
+    assert "eq1_deceleration(" in _text("semianalytic/commands/ballistic_limit/study.py")
 
 
 def test_part4_home_against_eq1_integrated_and_part1_constant_coefficients():

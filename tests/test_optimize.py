@@ -13,11 +13,11 @@ import math
 
 import numpy as np
 import pytest
+from case_blocks import COARSE_TABLES, TARGET_6061_T651
 
 from semianalytic.cli import main
 from semianalytic.geometry import Projectile, ogive_nose
 from semianalytic.optimize.model import Infeasible, shank_for_constraints
-from case_blocks import COARSE_TABLES, TARGET_6061_T651
 
 # Coarse tables (order 4, 16 depths to 30 nose lengths): about 0.5 s per design on one core.
 CASE = """

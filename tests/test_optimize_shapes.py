@@ -10,7 +10,6 @@ optimisers against analytic objectives whose minimum is known.
 
 from __future__ import annotations
 
-import json
 import math
 import subprocess
 import sys
@@ -139,11 +138,11 @@ def test_searches_find_a_known_minimum(method):
 def test_optimise_driver_on_a_known_answer(monkeypatch):
     # the whole driver (quantisation to the resolution, memo, confirmation grid) with the design's
     # evaluation replaced by an analytic objective of the exponent: minimum at n = 0.6437
+    import tomllib
+
     import semianalytic.optimize.evaluate as ev
     from semianalytic.case import parse_case
     from semianalytic.optimize.case import build_problem
-
-    import tomllib
 
     def fake(problem, overrides, cache_dir=None):
         n = float(overrides["projectile.exponent"])
@@ -195,10 +194,10 @@ def test_sweep_over_the_exponent_builds_a_table_per_design(tmp_path, monkeypatch
     import tomllib
 
     import pandas as pd
+    from case_blocks import COARSE_TABLES, TARGET_6061_T651
 
     from semianalytic.sweep.engine import run_sweep
     from semianalytic.sweep.spec import build_spec
-    from case_blocks import COARSE_TABLES, TARGET_6061_T651
 
     monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
     head = POWER_CASE.format(n=0.6).split("[target]")[0]

@@ -59,7 +59,7 @@ def test_bezier_meridian_against_de_casteljau():
         ref = float(_de_casteljau([Fraction(x) for x in w], t))
         assert abs(float(c.point(float(t))[1]) - ref) < 1e-14
         dt = Fraction(1, 10**9)  # the difference of two nearly equal radii: exact here, 1e-7 relative by subtraction
-        exact = float((_de_casteljau([Fraction(x) for x in w], t + dt) - _de_casteljau([Fraction(x) for x in w], t)))
+        exact = float(_de_casteljau([Fraction(x) for x in w], t + dt) - _de_casteljau([Fraction(x) for x in w], t))
         assert abs(float(c.displacement(float(t), float(dt))[1]) / exact - 1) < 1e-9
         x, _ = c.point(float(t))
         assert float(x) == -float(t)  # equally spaced control abscissae: x linear in t
@@ -154,10 +154,10 @@ def test_spline_deep_drag_optimum_over_one_control_radius(tmp_path):
     # a small problem through the Python API: the deep drag over the first control radius of a
     # three-point spline; the optimum is no worse than the bounds' ends, and the known-result
     # comparison fits a power law to it
-    from semianalytic.case import parse_case
-    from semianalytic.optimize.case import build_problem
     import tomllib
 
+    from semianalytic.case import parse_case
+    from semianalytic.optimize.case import build_problem
     from semianalytic.optimize.evaluate import optimise
 
     raw = tomllib.loads(SPLINE_CASE.format(radii="control_radii = [0.45, 0.75, 0.92]", length='nose_length = "11.8 mm"'))

@@ -10,9 +10,9 @@ import math
 from pathlib import Path
 
 import pytest
+from case_blocks import TARGET_6061_T651
 
 from semianalytic.cli import main
-from case_blocks import TARGET_6061_T651
 
 D = 7.11e-3
 AREA = math.pi * D**2 / 4

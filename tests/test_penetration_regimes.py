@@ -10,11 +10,11 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from case_blocks import TARGET_6061_T651
+from tate_reference import tate_penetration_ode as tate_penetration
 
 from semianalytic.cli import main
 from semianalytic.penetration import regime as rg
-from tate_reference import tate_penetration_ode as tate_penetration
-from case_blocks import TARGET_6061_T651
 
 CASES = Path(__file__).resolve().parents[1] / "cases"
 ROD = dict(length=0.0711, nose_length=0.0118, diameter=7.11e-3)
@@ -183,7 +183,7 @@ def test_cli_json_keys_and_warnings(tmp_path, capsys, nose, keys):
                           "--regime-rule", "nose_length")
     assert code == 0, err
     res = json.loads(out)
-    from semianalytic.penetration.cli import JSON_KEYS
+    from semianalytic.commands.penetrate.cli import JSON_KEYS
 
     for key in JSON_KEYS:
         assert key in res

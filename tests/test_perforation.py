@@ -141,7 +141,7 @@ def test_older_cases_keep_their_meaning():
 @pytest.fixture(scope="module")
 def demo_setup(tmp_path_factory):
     from semianalytic.case import load_case
-    from semianalytic.perforation.evaluate import perforation_setup
+    from semianalytic.commands.perforate.evaluate import perforation_setup
 
     case = load_case(_case(tmp_path_factory.mktemp("demo"), _demo_text()))
     return case, perforation_setup(case)

@@ -140,7 +140,7 @@ def test_no_energy_from_nowhere(tmp_path, nose):
     """V_r <= V_s for every thickness from 0.1 mm to 1 m and velocity from 20 m/s to 3 km/s, every
     nose kind (exactly: the energy bound caps V_r at sqrt(V_s^2 - 2W/m) <= V_s), each with a V_bl."""
     from semianalytic.case import load_case
-    from semianalytic.perforation.evaluate import perforation_setup
+    from semianalytic.commands.perforate.evaluate import perforation_setup
     from semianalytic.perforation.model import ballistic_limit_search, perforation_curve
 
     U = np.geomspace(20.0, 3000.0, 25)
@@ -202,7 +202,7 @@ def test_closed_form_limit_equals_the_bisection_on_the_curve(tmp_path, nose, thi
     method, the bracket from the physics and bisection on perforation_curve's 'perforated' flags (the
     path plugs take), finds the same V_bl within its bracket (0.05 m/s)."""
     from semianalytic.case import load_case
-    from semianalytic.perforation.evaluate import perforation_setup
+    from semianalytic.commands.perforate.evaluate import perforation_setup
     from semianalytic.perforation.model import (
         _bisect_curve,
         _bracket,

@@ -217,8 +217,8 @@ def test_regimes_draws_lengths(tmp_path):
 def test_calibrate_posterior_draw_outside_its_prior(tmp_path):
     """The committed calibrate posterior reads; with one yield-stress draw at -5e8 Pa or 1e300 Pa
     (prior lognormal(300 MPa, 0.5)) it is refused naming the file and the parameter."""
-    from semianalytic.calibration.case import read_posterior
     from semianalytic.errors import InputError
+    from semianalytic.sections.calibration import read_posterior
 
     read_posterior(RIGID_POST)
     obj = json.loads(RIGID_POST.read_text())
@@ -236,7 +236,7 @@ def test_calibrate_posterior_draw_outside_its_prior(tmp_path):
 def test_calibrate_transfer_sigma_matches_the_committed_cross_validation():
     """TRANSFER_SIGMA per model recomputed by hand from the committed cross_validation.json
     (0.001: written to 3 decimals)."""
-    from semianalytic.calibration.evaluate import TRANSFER_SIGMA
+    from semianalytic.commands.calibrate.evaluate import TRANSFER_SIGMA
 
     cv = json.loads((ROOT / "reports" / "calibration_piekutowski1999" / "cross_validation.json").read_text())
     (tr,) = cv["transfer"].values()
@@ -253,8 +253,8 @@ def test_calibrate_posterior_on_another_nose_widens(tmp_path):
     the mixture over draws is not one log-normal; the surrogate's R_t spread is the same in both)."""
     import shutil
 
-    from semianalytic.calibration.evaluate import projectile_signature
     from semianalytic.case import load_case
+    from semianalytic.commands.calibrate.evaluate import projectile_signature
 
     for f in ("piekutowski1999_var4340.toml", "piekutowski1999_ogive_6061T6511.csv"):
         shutil.copy(ROOT / "cases" / f, tmp_path)

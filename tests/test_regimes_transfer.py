@@ -397,7 +397,7 @@ def test_rigid_depth_options_against_the_rigid_shots(groups):
     """The two depths of a rod that keeps its nose, at the rigid shots of the data file: Part I and
     Forrestal's cavity-expansion peer with the authors' constants (the default, chosen by transfer).  Measured: mean |error| Part I 7 % (VAR 4340) and 10 % (AerMet 100),
     Forrestal 3 % and 5 %; asserted: each within 12 % and Forrestal's the smaller on both steels
-    (Piekutowski et al. 1999 show their model within about 5-10 % of these shots, their Fig. 5)."""
+    (Piekutowski et al. 1999 show their model within about 5-10 % of these shots, their Fig. 5)."""  # noqa: E501
     from semianalytic.calibration import regimes as R
 
     for g in groups:

@@ -55,7 +55,7 @@ class Scaled:
 
 @pytest.fixture
 def scaled_model():
-    from semianalytic.penetration.case import (
+    from semianalytic.sections.penetration import (
         ResistanceInput,
         register_resistance,
         unregister_resistance,
@@ -86,9 +86,9 @@ def _case(tmp_path, name, resistance):
 def test_a_registered_resistance_model_is_a_case_model(tmp_path, capsys, scaled_model):
     """One registration: the case schema accepts it, penetrate runs it, calibrate knows its default
     parameter, and its depths are the constant model's at the same R_t (4 x 100 MPa)."""
-    from semianalytic.calibration.case import default_parameter
     from semianalytic.case import load_case
     from semianalytic.penetration.resistance import resistance_from_case
+    from semianalytic.sections.calibration import default_parameter
 
     mine = _case(tmp_path, "scaled.toml", 'model = "scaled"\nyield_stress = "100 MPa"\nfactor = 4.0\n')
     same = _case(tmp_path, "constant.toml", 'model = "constant"\nvalue = "400 MPa"\n')
@@ -114,7 +114,7 @@ def test_a_misspelt_model_lists_the_registered_one(tmp_path, capsys, scaled_mode
 
 
 def test_an_unregistered_model_is_refused_again(tmp_path, capsys, scaled_model):
-    from semianalytic.penetration.case import MODELS, unregister_resistance
+    from semianalytic.sections.penetration import MODELS, unregister_resistance
 
     path = _case(tmp_path, "scaled.toml", 'model = "scaled"\nyield_stress = "100 MPa"\nfactor = 4.0\n')
     unregister_resistance("scaled")
@@ -123,15 +123,15 @@ def test_an_unregistered_model_is_refused_again(tmp_path, capsys, scaled_model):
         code, _out, err = run(capsys, "penetrate", path, "--coefficients", "paper")
         assert code == 2 and "target.resistance.model" in err and "'scaled'" in err
     finally:
-        from semianalytic.penetration.case import register_resistance
+        from semianalytic.sections.penetration import register_resistance
 
         register_resistance(scaled_model)  # the fixture removes it again
 
 
 def test_one_file_in_resistances_adds_a_model(tmp_path, monkeypatch, capsys):
-    """The folder semianalytic/penetration/resistances: one module there is one more model."""
-    import semianalytic.penetration.resistances as folder
-    from semianalytic.penetration.case import MODELS, unregister_resistance
+    """The folder semianalytic/sections/resistances: one module there is one more model."""
+    import semianalytic.sections.resistances as folder
+    from semianalytic.sections.penetration import MODELS, unregister_resistance
 
     extra = tmp_path / "plugins"
     extra.mkdir()
@@ -139,7 +139,7 @@ def test_one_file_in_resistances_adds_a_model(tmp_path, monkeypatch, capsys):
         from dataclasses import dataclass
         from typing import Literal
 
-        from semianalytic.penetration.case import ResistanceInput, register_resistance
+        from semianalytic.sections.penetration import ResistanceInput, register_resistance
         from semianalytic.units import Pressure
 
 
@@ -171,7 +171,7 @@ def test_one_file_in_resistances_adds_a_model(tmp_path, monkeypatch, capsys):
         assert json.loads(out)["resistance_Pa"] == 400e6
     finally:
         unregister_resistance("halved")
-        sys.modules.pop("semianalytic.penetration.resistances.halved", None)
+        sys.modules.pop("semianalytic.sections.resistances.halved", None)
 
 
 # -- output formats -------------------------------------------------------------------------
@@ -241,7 +241,7 @@ def test_text_is_the_default(capsys):
 
 
 def test_the_tate_model_of_the_worked_example(tmp_path, capsys):
-    """docs/extending.md's model, shipped as semianalytic/penetration/resistances/tate.py: R_t
+    """docs/extending.md's model, shipped as semianalytic/sections/resistances/tate.py: R_t
     against a hand computation of Tate (1986) at Y_t = 400 MPa, E_t = 68.9 GPa:
     400e6 (2/3 + ln(0.57 * 172.25)) = 2101.3979 MPa (to 1e-9: the digits carried by hand)."""
     path = _case(tmp_path, "tate.toml", 'model = "tate"\nyield_stress = "400 MPa"\nyoungs_modulus = "68.9 GPa"\n')
@@ -263,7 +263,7 @@ def test_the_worked_examples_of_the_docs_are_the_code(capsys):
     """docs/extending.md shows the shipped tate.py (every line of its block is in the file, the
     comments aside) and its format example runs as shown."""
     model, fmt, use, report = _blocks()
-    shipped = (ROOT / "semianalytic" / "penetration" / "resistances" / "tate.py").read_text(encoding="utf-8")
+    shipped = (ROOT / "semianalytic" / "sections" / "resistances" / "tate.py").read_text(encoding="utf-8")
     for line in model.splitlines():
         assert line.split("  #")[0].rstrip() in shipped, line
     from semianalytic.report.formats import FORMATS

@@ -16,7 +16,7 @@ import numpy as np
 import pytest
 
 import semianalytic
-from semianalytic.case import CoefficientsSection, load_case
+from semianalytic.case import load_case
 
 ROOT = Path(__file__).resolve().parent.parent
 REPORTS = sorted(ROOT.glob("reports/*.md")) + sorted(ROOT.glob("reports/*/report.md"))
@@ -50,7 +50,7 @@ def test_report_names_its_version(path):
 
 def test_part4_report_regenerates_identically():
     """Part IV's report is fast: rebuilt here, it equals the committed one but for the version."""
-    from semianalytic.ballistic_limit.report import build
+    from semianalytic.commands.ballistic_limit.report import build
 
     committed = (ROOT / "reports" / "part4_ballistic_limit.md").read_text()
     committed = re.sub(r"\nVersion: [^\n]*\n\n", "\n", committed, count=1)
@@ -132,9 +132,9 @@ def test_normalise_masks_only_what_varies():
 
 
 def test_part2_cavity_report_regenerates_identically(tmp_path):
-    """`python -m semianalytic.cavity.report` (about 2 s in-process): every number but the solver
+    """`python -m semianalytic.commands.cavity.report` (about 2 s in-process): every number but the solver
     timings equals the committed report."""
-    from semianalytic.cavity.report import build
+    from semianalytic.commands.cavity.report import build
 
     text, _ = build(tmp_path)
     _assert_same_report(text, (ROOT / "reports" / "part2_cavity.md").read_text(), "part2_cavity.md")
@@ -143,8 +143,8 @@ def test_part2_cavity_report_regenerates_identically(tmp_path):
 def test_part3_nanostrength_report_regenerates_identically():
     """`python -m semianalytic nanostrength cases/part3_nanostrength.toml --report reports --force`
     (a few seconds in-process): the same analysis and text, but for the elapsed time."""
-    from semianalytic.nanostrength.case import analyse_section
-    from semianalytic.nanostrength.report import build_report
+    from semianalytic.commands.nanostrength.report import build_report
+    from semianalytic.sections.nanostrength import analyse_section
 
     committed = (ROOT / "reports" / "part3_nanostrength.md").read_text()
     command = _command(committed)

@@ -15,7 +15,7 @@ from scipy import integrate, special
 from semianalytic.case import parse_case
 from semianalytic.errors import InputError
 from semianalytic.penetration import resistance as res
-from semianalytic.penetration.case import parse_resistance
+from semianalytic.sections.penetration import parse_resistance
 
 Y, E, NU = 400e6, 68.9e9, 0.33
 
@@ -90,7 +90,7 @@ GOOD = {"model": "elastic-plastic", "yield_stress": "400 MPa", "youngs_modulus":
     "spec, cls",
     [
         (GOOD, res.ElasticPlastic),
-        ({"model": "brittle", "compressive_strength": "2.6 GPa", "tensile_strength": "0.26 GPa", "youngs_modulus": "370 GPa", "poisson_ratio": 0.22, "alpha": 0.9}, res.Brittle),
+        ({"model": "brittle", "compressive_strength": "2.6 GPa", "tensile_strength": "0.26 GPa", "youngs_modulus": "370 GPa", "poisson_ratio": 0.22, "alpha": 0.9}, res.Brittle),  # noqa: E501
         ({"model": "hardening", "yield_stress": "276 MPa", "youngs_modulus": "68.9 GPa", "hardening_exponent": 0.051}, res.Hardening),
         ({"model": "limestone"}, res.Limestone),
         ({"model": "part4", "yield_stress": "400 MPa", "youngs_modulus": "68.9 GPa"}, res.Part4),

@@ -8,8 +8,8 @@ no compiler at run time, nothing in the per-user cache loaded, a library of anot
 
 from __future__ import annotations
 
-import math
 import ast
+import math
 import os
 import subprocess
 import sys
@@ -26,7 +26,7 @@ from semianalytic.geometry import sphere_body
 
 ROOT = Path(__file__).resolve().parent.parent
 
-needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")
+needs_c = pytest.mark.skipif(kernels.compiled() is None, reason="no compiled kernels (built without a C compiler, or SEMIANALYTIC_KERNEL=numpy)")  # noqa: E501
 
 
 @pytest.fixture
@@ -262,7 +262,7 @@ def test_compiled_rules_agree_with_numpy(kind, f, monkeypatch):
     independent quadrature of each entry: tests/test_tables_speed_and_reach.py, on the path in use.)"""
     from semianalytic.bem.panels import LayoutOptions, halfspace_layout
     from semianalytic.bem.solve import _layers, _layers_split, near_pairs, near_quadrature, plan_assembly
-    from semianalytic.coefficients.study import study_nose
+    from semianalytic.commands.coefficients.study import study_nose
 
     nose = study_nose(kind)
     ps = halfspace_layout(nose, f * nose.depth_unit, LayoutOptions(8, 0.3, 6)).panels()
@@ -305,7 +305,7 @@ def test_compiled_panel_geometry(monkeypatch):
     formulas, libm's sin, cos and pow against numpy's, each within an ulp, times up to three
     rounded factors: a few units of 2.2e-16 of each array's size, 4e-15)."""
     from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
-    from semianalytic.coefficients.study import study_nose
+    from semianalytic.commands.coefficients.study import study_nose
     from semianalytic.geometry import spheroid_body
 
     rng = np.random.default_rng(3)
@@ -349,7 +349,7 @@ def test_compiled_second_derivatives(monkeypatch):
     same order, numpy's power passed in on corner panels) on lines, arcs, ellipse arcs and a
     table's spline, plain and corner panels, primary and mirrored."""
     from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
-    from semianalytic.coefficients.study import study_nose
+    from semianalytic.commands.coefficients.study import study_nose
     from semianalytic.geometry import spheroid_body
 
     rng = np.random.default_rng(5)
@@ -399,7 +399,7 @@ def test_compiled_closest_points(monkeypatch):
     layouts with corner panels, near and far targets, images across the axis."""
     from semianalytic.bem.panels import LayoutOptions, body_panels, halfspace_layout
     from semianalytic.bem.solve import closest_points
-    from semianalytic.coefficients.study import study_nose
+    from semianalytic.commands.coefficients.study import study_nose
 
     rng = np.random.default_rng(11)
     ps = body_panels(sphere_body(2.0))
@@ -437,14 +437,13 @@ def test_wide_build_gives_the_baseline_numbers(tmp_path, monkeypatch):
     nose (a spline, a graded corner, tiny panels): the dense blocks, the near and self rules.
     Exact equality: any difference in operations would show in the last bits of some entry."""
     import ctypes
-
-    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
-    from semianalytic.bem.solve import assemble, plan_assembly
-    from semianalytic.coefficients.study import study_nose
-
     import shlex
     import shutil
     import sysconfig
+
+    from semianalytic.bem.panels import LayoutOptions, halfspace_layout
+    from semianalytic.bem.solve import assemble, plan_assembly
+    from semianalytic.commands.coefficients.study import study_nose
 
     cmd = shlex.split(os.environ.get("CC") or sysconfig.get_config_var("CC") or "cc")
     if not cmd or shutil.which(cmd[0]) is None:

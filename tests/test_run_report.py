@@ -15,9 +15,9 @@ from pathlib import Path
 
 import numpy as np
 import pytest
+from case_blocks import TARGET_6061_T651
 
 from semianalytic.cli import main
-from case_blocks import TARGET_6061_T651
 
 CASE = """
 title = "run test: Fig. 5 ogive into 6061-T651 with the paper's constants"

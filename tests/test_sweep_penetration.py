@@ -8,16 +8,15 @@ test.  One test runs on a real two-worker LocalCluster.
 
 from __future__ import annotations
 
-
 import numpy as np
 import pandas as pd
 import pytest
+from case_blocks import TARGET_6061_T651
 
 from semianalytic.coefficients import ConstantCoefficients
 from semianalytic.sweep.engine import run_sweep
 from semianalytic.sweep.kernels import PenetrationKernel
 from semianalytic.sweep.spec import build_spec
-from case_blocks import TARGET_6061_T651
 
 D = 7.11e-3
 COEF = ConstantCoefficients.from_normalised(1.0e-3, 0.11, 1.0, D)  # the paper's quoted ogive values

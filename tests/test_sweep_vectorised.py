@@ -10,12 +10,12 @@ from __future__ import annotations
 import numpy as np
 import pandas as pd
 import pytest
+from case_blocks import COARSE_TABLES
 
 from semianalytic.coefficients import ConstantCoefficients
 from semianalytic.sweep.engine import choose_engine, run_sweep
 from semianalytic.sweep.kernels import PenetrationKernel
 from semianalytic.sweep.spec import build_spec
-from case_blocks import COARSE_TABLES
 
 D = 7.11e-3
 COEF = ConstantCoefficients.from_normalised(1.0e-3, 0.11, 1.0, D)

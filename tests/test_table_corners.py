@@ -15,8 +15,6 @@ import math
 import numpy as np
 import pytest
 
-from semianalytic.coefficients.corners_report import ISSUE_TABLE, off_knot_depths
-from semianalytic.coefficients.study import table_error_study
 from semianalytic.coefficients.table import (
     CONTROLLED,
     DEFAULT_TOLERANCE,
@@ -26,6 +24,8 @@ from semianalytic.coefficients.table import (
     depth_pieces,
     direct_coefficients,
 )
+from semianalytic.commands.coefficients.corners_report import ISSUE_TABLE, off_knot_depths
+from semianalytic.commands.coefficients.study import table_error_study
 from semianalytic.geometry import cone_nose, ogive_nose, sphere_nose, table_nose
 
 D = 7.11e-3

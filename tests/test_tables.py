@@ -18,13 +18,13 @@ import numpy as np
 import pytest
 
 from semianalytic.cli import main
-from semianalytic.coefficients.study import random_depths, study_nose, table_error_study
 from semianalytic.coefficients.table import (
     CONTROLLED,
     breakpoints,
     coefficient_table,
     direct_coefficients,
 )
+from semianalytic.commands.coefficients.study import random_depths, study_nose, table_error_study
 from semianalytic.errors import InputError
 
 TOL = 1e-5  # the default tolerance: relative to each coefficient's largest magnitude over the table

@@ -21,8 +21,8 @@ import pytest
 from semianalytic.bem.panels import LayoutOptions, halfspace_layout
 from semianalytic.bem.solve import AssemblyCache, assemble, plan_assembly
 from semianalytic.coefficients import table as table_mod
-from semianalytic.coefficients.study import reach_study, study_nose, table_error_study
 from semianalytic.coefficients.table import CONTROLLED, coefficient_table, direct_coefficients
+from semianalytic.commands.coefficients.study import reach_study, study_nose, table_error_study
 from semianalytic.geometry import cone_nose, flat_nose, ogive_nose
 
 D = 7.11e-3
@@ -216,12 +216,12 @@ def test_block_sums_of_the_rules_match_adaptive_quadrature(kind, f):
             split = [float(rule.target_u[i])] if rule.target_u is not None else []
 
             def integrand(u, j, which):
-                x, r, xu, ru = ps.evaluate(np.array([k]), np.array([u]))
+                x, r, xu, ru = ps.evaluate(np.array([k]), np.array([u]))  # noqa: B023
                 J = np.hypot(xu, ru)
                 # on the target's own panel the differences from the panel's anchor keep their digits
-                delta = ps.relative(np.array([k]), np.array([u]), np.array([split[0]])) if split else None
+                delta = ps.relative(np.array([k]), np.array([u]), np.array([split[0]])) if split else None  # noqa: B023
                 with np.errstate(divide="ignore", invalid="ignore"):
-                    val = single_double(xt[t], rt[t], x, r, ru / J, -xu / J, delta)[which]
+                    val = single_double(xt[t], rt[t], x, r, ru / J, -xu / J, delta)[which]  # noqa: B023
                 return float(val[0] * J[0] * lagrange_matrix(nodes, np.array([u]))[0, j]) if np.isfinite(val[0]) else 0.0
 
             for j in (0, p // 2, p - 1):

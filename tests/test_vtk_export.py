@@ -119,7 +119,6 @@ def test_fem_field_file(tmp_path):
     from fem_check.api import potential_field
     from fem_check.meshing import MeshOptions, build_mesh, halfspace_domain
     from fem_check.potential import solve_potential
-
     from semianalytic.bem import solve_halfspace
     from semianalytic.geometry import ogive_nose
     from semianalytic.run.fields import bem_at_vertices

@@ -234,10 +234,12 @@ def edit_contracts(dry: bool) -> list[str]:
 
     insert_after("semianalytic.run | semianalytic.sweep", "semianalytic.commands")
     insert_after("semianalytic.case", "semianalytic.sections")
-    m = re.search(r'^(\s*)"semianalytic\.bem \| semianalytic\.exact \| semianalytic\.cli_types",\n', text, re.M)
+    m = re.search(r'^(\s*)"semianalytic\.bem \| semianalytic\.exact \| semianalytic\.cli_types((?: \| [\w.]+)*)",\n',
+                  text, re.M)
     if not m:
         sys.exit("pyproject.toml: the layer 'semianalytic.bem | semianalytic.exact | semianalytic.cli_types' not found")
-    text = text[:m.start()] + f'{m.group(1)}"{MODELS_LAYER}",\n{m.group(1)}"semianalytic.cli_types",\n' + text[m.end():]
+    text = (text[:m.start()] + f'{m.group(1)}"{MODELS_LAYER}",\n{m.group(1)}"semianalytic.cli_types{m.group(2)}",\n'
+            + text[m.end():])
     notes.append("models as one layer, cli_types under them")
     # the per-package layers: the command folders (and the models that keep sub-layers)
     cmds = sorted(set(COMMAND_OF.values()))

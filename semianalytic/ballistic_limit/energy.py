@@ -14,8 +14,8 @@ and the projectile's kinetic energy w_k = m v^2 / 2 (Table 5).
 from __future__ import annotations
 
 import math
+from collections.abc import Iterable
 from dataclasses import dataclass
-from typing import Iterable
 
 __all__ = ["Region", "plastic_work_density", "region_energy", "plastic_energy", "kinetic_energy"]
 

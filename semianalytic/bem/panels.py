@@ -25,8 +25,8 @@ from functools import cached_property, lru_cache
 import numpy as np
 
 from semianalytic.bem.quadrature import gauss_legendre
+from semianalytic.geometry import Arc, EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, segment_arc_length
 from semianalytic.native import address
-from semianalytic.geometry import EllipseArc, Line, Meridian, Nose, Segment, SplineCurve, Arc, segment_arc_length
 
 GRADING_RATIO = 0.35  # size ratio between successive graded panels (hp-type grading)
 
@@ -213,7 +213,7 @@ class PanelSet:
         another curve (a power law, a Bezier nose, two different splines: the numpy path)."""
         return self._compiled_with(self._compiled_segments(self.__dict__.get("_like")))
 
-    def _compiled_segments(self, like: "PanelSet | None" = None):
+    def _compiled_segments(self, like: PanelSet | None = None):
         """The curve part of :attr:`_compiled_curves` (kind, c0, c1 per panel; the spline's knots
         and coefficients) as (addresses, arrays), or None.  ``like``: a panel set of the same
         topology whose part is reused when its segments are these, or when only the last
@@ -476,7 +476,7 @@ class PanelSet:
         return du
 
     @cached_property
-    def nodes(self) -> "NodeGeometry":
+    def nodes(self) -> NodeGeometry:
         u, w = gauss_legendre(self.order)
         shape = (self.n_panels, self.order)
         pk, uu, pk_at, u_at = _node_grid(*shape)
@@ -559,7 +559,7 @@ class Piece:
     # conical tip, see corner_power)
     powers: tuple[float, float] = (1.0, 1.0)
 
-    def stretched(self, t1: float, p1: tuple[float, float]) -> "Piece":
+    def stretched(self, t1: float, p1: tuple[float, float]) -> Piece:
         return Piece(self.segment, self.t0, t1, self.p0, p1, self.panels, self.powers)
 
 
@@ -802,7 +802,7 @@ def body_panels(meridian: Meridian, options: LayoutOptions = LayoutOptions()) ->
         if isinstance(seg, SplineCurve):
             n = max(n, len(seg.knots) - 1)
         g0 = options.levels if (k == 0 and tip0 > 1e-6) else (options.corner_grading(corners[k - 1]) if k > 0 and corners[k - 1] else 0)
-        g1 = options.levels if (k == len(segs) - 1 and tip1 > 1e-6) else (options.corner_grading(corners[k]) if k < len(segs) - 1 and corners[k] else 0)
+        g1 = options.levels if (k == len(segs) - 1 and tip1 > 1e-6) else (options.corner_grading(corners[k]) if k < len(segs) - 1 and corners[k] else 0)  # noqa: E501
         q0 = (TIP_POWER if tip0 > 1e-6 else 1.0) if k == 0 else corner_power(corners[k - 1])
         q1 = (TIP_POWER if tip1 > 1e-6 else 1.0) if k == len(segs) - 1 else corner_power(corners[k])
         p0, p1 = joints[k], joints[k + 1]
@@ -854,7 +854,7 @@ class HalfspaceLayout:
     options: LayoutOptions
     shank: bool  # the last piece is the cylinder r = d/2 from the shoulder to x = 0
 
-    def at_depth(self, depth: float) -> "HalfspaceLayout":
+    def at_depth(self, depth: float) -> HalfspaceLayout:
         *head, last = self.pieces
         R, Lh = self.nose.radius, self.nose.length
         if self.shank:

@@ -56,8 +56,8 @@ from semianalytic.bem.panels import (
     GRADING_RATIO,
     HalfspaceLayout,
     LayoutOptions,
-    Piece,
     PanelSet,
+    Piece,
     graded_panels,
     halfspace_layout,
     panel_set,
@@ -111,7 +111,7 @@ class SlabLayout:
         """The tip has passed the back face (the wetted surface is an open band)."""
         return self.depth > self.thickness
 
-    def at_depth(self, depth: float) -> "SlabLayout":
+    def at_depth(self, depth: float) -> SlabLayout:
         half = self.half.at_depth(depth)
         if not self.through:
             if depth > self.thickness:
@@ -190,7 +190,7 @@ def slab_layout(nose: Nose, depth: float, thickness: float, options: LayoutOptio
         pieces[0] = Piece(first.segment, first.t0, first.t1, first.p0, first.p1, _split_first(first.panels, lev), first.powers)
         return SlabLayout(half, thickness, tuple(pieces))
     x_cut = thickness - depth  # body frame, < 0
-    for k, piece in enumerate(pieces):
+    for k, piece in enumerate(pieces):  # noqa: B007
         if float(piece.p1[0]) < x_cut:
             break
     else:  # pragma: no cover - excluded by the check on depth above

@@ -37,20 +37,23 @@ from functools import cached_property
 import numpy as np
 import scipy.linalg
 
-from semianalytic.bem.kernels import (
-    gradient_kernels, pair_rules_prepare, pair_rules_run, single_double, single_double_split,
-)
 from semianalytic.bem import kernels as _kernels
+from semianalytic.bem.kernels import (
+    gradient_kernels,
+    pair_rules_prepare,
+    pair_rules_run,
+    single_double,
+    single_double_split,
+)
 from semianalytic.bem.panels import PanelSet, _node_grid
-from semianalytic.native import address
-from semianalytic.errors import ModelError
 from semianalytic.bem.quadrature import (
     differentiation_matrix,
-    dyadic_rule,
     gauss_legendre,
     gauss_log,
     lagrange_matrix,
 )
+from semianalytic.errors import ModelError
+from semianalytic.native import address
 
 N_SELF = 6  # points per half-panel in the self rules (plain and log)
 N_NEAR = 8  # Gauss points per dyadic piece in the near rules
@@ -385,7 +388,7 @@ class PairQuadrature:
 
 
     @staticmethod
-    def build(target, panel, order, parts, target_u=None) -> "PairQuadrature":
+    def build(target, panel, order, parts, target_u=None) -> PairQuadrature:
         """From parts (pair indices (n,), u (n, Q), a (n, Q), b (n, Q), lag) with any Q
         each; lag is the (n, Q, p) or shared (Q, p) Lagrange matrix, or None.  The pairs
         are reordered part by part, so that each pair's points are contiguous."""
@@ -420,7 +423,7 @@ class PairQuadrature:
             None if target_u is None else target_u[order_idx], tuple(blocks),
         )
 
-    def subset(self, keep: np.ndarray) -> "PairQuadrature":
+    def subset(self, keep: np.ndarray) -> PairQuadrature:
         """The rules of the pairs where ``keep`` (a mask over pairs) is true (kept per mask, up
         to 64 masks: the self rules, shared by the depths of a table, are cut by the same masks
         of reused blocks at many depths; this project's own shortcut, the same rules)."""
@@ -435,7 +438,7 @@ class PairQuadrature:
                 memo[key] = got
         return got
 
-    def _subset(self, keep: np.ndarray) -> "PairQuadrature":
+    def _subset(self, keep: np.ndarray) -> PairQuadrature:
         points = keep[self.pair]
         renumber = np.cumsum(keep) - 1
         pair = renumber[self.pair[points]]

@@ -65,7 +65,7 @@ class ShotSet:
     def __len__(self) -> int:
         return len(self.velocity)
 
-    def subset(self, index) -> "ShotSet":
+    def subset(self, index) -> ShotSet:
         idx = np.atleast_1d(np.arange(len(self))[index])
         return ShotSet(self.velocity[idx], self.mass[idx], self.depth[idx], tuple(self.ids[i] for i in idx))
 
@@ -203,7 +203,7 @@ class DepthSurrogate:
         out[~ok] = np.nan
         return out
 
-    def subset(self, keep) -> "DepthSurrogate":
+    def subset(self, keep) -> DepthSurrogate:
         """The surrogate of the shots ``keep`` (column indices)."""
         return dataclasses.replace(self, coef=self.coef[:, keep])
 
@@ -275,6 +275,6 @@ class ErodingDepths:
         out = np.log(np.maximum(d * self.rod_length[None, :], 1e-12))
         return np.where(ok, out, np.nan)
 
-    def subset(self, keep) -> "ErodingDepths":
+    def subset(self, keep) -> ErodingDepths:
         keep = np.atleast_1d(keep)
         return dataclasses.replace(self, velocity=self.velocity[keep], rod_length=self.rod_length[keep])

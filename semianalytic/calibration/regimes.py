@@ -89,7 +89,7 @@ class Options:
                 "rigid_depth": self.rigid_depth, "nose_load": self.nose_load, "deformed_depth": self.deformed_depth}
 
     @classmethod
-    def from_dict(cls, d: dict) -> "Options":
+    def from_dict(cls, d: dict) -> Options:
         """Options from a posterior's ``options`` (a version-1 posterior lacks the nose-load keys: its
         model set had no nose load and the Part I depth for a bent rod)."""
         d = dict(d)
@@ -97,7 +97,7 @@ class Options:
         d.setdefault("deformed_depth", d.get("rigid_depth", "part1"))
         return cls(**d)
 
-    def check(self, field: str = "--option") -> "Options":
+    def check(self, field: str = "--option") -> Options:
         """InputError naming the key and the allowed values if a choice does not exist."""
         from semianalytic.errors import InputError
 
@@ -655,9 +655,8 @@ def sample_regimes(shots: RegimeShots, opt: Options, *, chains: int = 4, walkers
     ensemble one chain (as arviz.from_emcee reads an ensemble), after ``burn`` steps."""
     import emcee
 
-    from semianalytic.thirdparty import run_mcmc
-
     from semianalytic.calibration.sampler import MOVES, chain_diagnostics
+    from semianalytic.thirdparty import run_mcmc
 
     rng = np.random.default_rng(seed)
     has_b, per, nl = _uses_breakup(opt), opt.discrepancy == "per_regime", uses_nose_load(opt)
@@ -758,9 +757,13 @@ def regime_shots(case, coefficients) -> RegimeShots:
     from semianalytic.errors import InputError
     from semianalytic.penetration import critical as crit
     from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
-    from semianalytic.penetration.hardness import (meyer_hardness_from_vickers, parse_hardness,
-                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
-                                                   yield_stress_from_vickers)
+    from semianalytic.penetration.hardness import (
+        meyer_hardness_from_vickers,
+        parse_hardness,
+        ultimate_strength_from_vickers,
+        vickers_from_rockwell_c,
+        yield_stress_from_vickers,
+    )
     from semianalytic.penetration.regime_setup import RESPONSE_REGIME, eroding_inputs
     from semianalytic.penetration.validation import load_shots, peer_depths
 
@@ -808,8 +811,8 @@ def regime_shots(case, coefficients) -> RegimeShots:
     return RegimeShots(
         group="+".join(groups) or (data.name or "data"), ids=tuple(s.id for s in shots), velocity=np.array(U),
         mass=np.array(m), depth=np.array(P), recorded=np.array(rec), responses=tuple(s.row.get(col, "") if col else "" for s in shots),
-        static_yield=np.asarray(yield_stress_from_vickers(HV), float), static_ultimate=np.asarray(ultimate_strength_from_vickers(HV), float),
-        meyer_hardness=np.asarray(meyer_hardness_from_vickers(HV), float), part1_depth=np.array(p1), forrestal_depth=np.array(fd), critical=critical, rod_length=rod,
+        static_yield=np.asarray(yield_stress_from_vickers(HV), float), static_ultimate=np.asarray(ultimate_strength_from_vickers(HV), float),  # noqa: E501
+        meyer_hardness=np.asarray(meyer_hardness_from_vickers(HV), float), part1_depth=np.array(p1), forrestal_depth=np.array(fd), critical=critical, rod_length=rod,  # noqa: E501
         length=ei.length, nose_length=ei.nose_length, diameter=ei.diameter, density=ei.density,
         target_density=ei.target_density, resistance={"part1": base.resistance_pa, "tate1986": tate},
         nose_loads=case_nose_loads(case, base))
@@ -875,7 +878,7 @@ def point_scores(shots: RegimeShots, opt: Options, f: float, b: float | None, e:
     out = model_outcome([f], shots, opt, None if b is None else [b], None if e is None else [e])
     code, depth = out.code[0], out.depth[0]
     rec = shots.recorded
-    res = {"f": float(f), "b": None if b is None else float(b), "e": None if e is None else float(e), "label_right": int(np.sum(code[rec >= 0] == rec[rec >= 0])),
+    res = {"f": float(f), "b": None if b is None else float(b), "e": None if e is None else float(e), "label_right": int(np.sum(code[rec >= 0] == rec[rec >= 0])),  # noqa: E501
            "labelled": int(np.sum(rec >= 0))}
     for k, name in enumerate(rg.REGIMES):
         sel = (rec == k) & np.isfinite(shots.depth)
@@ -994,7 +997,7 @@ def posterior_parameters(draws: dict, opt: Options, idx) -> dict:
     first = parameter_names(opt)[0]
     sd = draws.get("sigma_deformed")
     sig = np.column_stack([draws["sigma"][idx], (sd if sd is not None else draws["sigma"])[idx]])
-    get = (lambda k: np.asarray(draws[k])[idx] if k in draws else None)
+    get = (lambda k: np.asarray(draws[k])[idx] if k in draws else None)  # noqa: E731
     return {"f": np.asarray(draws[first])[idx], "sigma": sig, "tau": np.asarray(draws["tau"])[idx],
             "b": get("breakup_factor"), "e": get("erosion_factor")}
 
@@ -1025,7 +1028,7 @@ DRAW_SUPPORT = {
 docstring, with the bounds its log-density enforces); sigma and tau exclude 0."""
 
 
-def check_draws(path, samples: dict, opt: "Options | None" = None) -> dict:
+def check_draws(path, samples: dict, opt: Options | None = None) -> dict:
     """The draws of a regimes posterior's ``samples`` as arrays, checked: the model set's first
     parameter (``nose_load_factor`` or ``dynamic_factor``, :func:`parameter_names`), sigma and tau
     present; every list non-empty, of JSON numbers, finite, of one length; every draw inside
@@ -1069,8 +1072,8 @@ def check_draws(path, samples: dict, opt: "Options | None" = None) -> dict:
 
 
 def _check_range(path, rng) -> list:
-    from semianalytic.case import MAX_STRIKING_VELOCITY
     from semianalytic.errors import InputError
+    from semianalytic.limits import MAX_STRIKING_VELOCITY
 
     ok = (isinstance(rng, list) and len(rng) == 2 and all(isinstance(x, (int, float)) and not isinstance(x, bool)
                                                            for x in rng))
@@ -1084,7 +1087,7 @@ def _check_range(path, rng) -> list:
     return [lo, hi]
 
 
-def load_regimes_file(path) -> tuple[dict, "Options", dict]:
+def load_regimes_file(path) -> tuple[dict, Options, dict]:
     """(the JSON object, its :class:`Options`, the checked draws) of a regimes posterior file: every
     check that needs no case (format version, options and their values, draws by
     :func:`check_draws`, the calibrated velocity range); InputError naming the file otherwise."""
@@ -1126,7 +1129,6 @@ def load_regimes_file(path) -> tuple[dict, "Options", dict]:
 def read_regimes_posterior(path, case) -> dict:
     """Read a regimes posterior (:func:`load_regimes_file`) and check it against ``case``: another
     nose or target is a transfer, accepted with a note (:func:`transfer_notes`)."""
-    from semianalytic.errors import InputError
 
     obj, opt, draws = load_regimes_file(path)
     sig = obj["signature"]
@@ -1151,11 +1153,15 @@ def read_regimes_posterior(path, case) -> dict:
 def shots_at(case, coefficients, U) -> RegimeShots:
     """Prediction points: the case's projectile (nominal hardness and mass) at velocities ``U``."""
     from semianalytic.errors import InputError
-    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
     from semianalytic.penetration import critical as crit
-    from semianalytic.penetration.hardness import (meyer_hardness_from_vickers, parse_hardness,
-                                                   ultimate_strength_from_vickers, vickers_from_rockwell_c,
-                                                   yield_stress_from_vickers)
+    from semianalytic.penetration.curve import PenetrationSetup, penetration_curve
+    from semianalytic.penetration.hardness import (
+        meyer_hardness_from_vickers,
+        parse_hardness,
+        ultimate_strength_from_vickers,
+        vickers_from_rockwell_c,
+        yield_stress_from_vickers,
+    )
     from semianalytic.penetration.regime_setup import eroding_inputs
     from semianalytic.penetration.validation import peer_depths
 
@@ -1174,7 +1180,7 @@ def shots_at(case, coefficients, U) -> RegimeShots:
     n = len(U)
     return RegimeShots(
         group="prediction", ids=tuple(str(k) for k in range(n)), velocity=U, mass=np.full(n, setup.mass),
-        depth=np.full(n, np.nan), recorded=np.full(n, -1), responses=("",) * n, static_yield=np.full(n, float(yield_stress_from_vickers(HV))),
+        depth=np.full(n, np.nan), recorded=np.full(n, -1), responses=("",) * n, static_yield=np.full(n, float(yield_stress_from_vickers(HV))),  # noqa: E501
         static_ultimate=np.full(n, float(ultimate_strength_from_vickers(HV))),
         meyer_hardness=np.full(n, float(meyer_hardness_from_vickers(HV))), part1_depth=p1, forrestal_depth=fd, critical=vcrit,
         rod_length=np.full(n, rg.eroding_rod_length(ei.length, ei.nose_length, ei.diameter, ei.density, setup.mass)),
@@ -1365,14 +1371,12 @@ _NOSE_KEYS_ALL = ("nose", "crh", "half_angle", "bluntness", "nose_length", "tip_
 def nose_variant(case, nose: dict):
     """The case with its ``[projectile]`` nose replaced by ``nose`` (the rest of the rod and the
     target unchanged); ``[data]`` is kept for the cavity constants of the Forrestal load."""
-    from semianalytic.case import parse_case
-
     raw = {k: (dict(v) if isinstance(v, dict) else v) for k, v in case.raw.items()}
     proj = {k: v for k, v in raw["projectile"].items() if k not in _NOSE_KEYS_ALL}
     proj.update(nose)
     raw["projectile"] = proj
     raw.pop("data", None)  # no shots; the cavity law of the original case is passed on (nose_ordering_study)
-    return parse_case(raw, None)
+    return case.with_raw(raw)
 
 
 def nose_ordering_study(case, coefficients_for, opt: Options, f: float, b: float | None, e: float | None,
@@ -1384,7 +1388,6 @@ def nose_ordering_study(case, coefficients_for, opt: Options, f: float, b: float
     ``coefficients_for(case)`` gives a case's coefficient table (BEM, cached)."""
     from semianalytic.penetration.curve import PenetrationSetup
     from semianalytic.penetration.hardness import meyer_hardness_from_vickers, parse_hardness, vickers_from_rockwell_c
-
     from semianalytic.penetration.validation import peer_inputs
 
     law, _ = peer_inputs(case, PenetrationSetup.from_case(case, coefficients_for(case)))
@@ -1396,7 +1399,7 @@ def nose_ordering_study(case, coefficients_for, opt: Options, f: float, b: float
         setup = PenetrationSetup.from_case(c, coefficients_for(c))
         loads = case_nose_loads(c, setup, law)
         L = loads[opt.nose_load]
-        one = RegimeShots(group=label, ids=("0",), velocity=np.array([reference_velocity]), mass=np.array([setup.mass]),
+        one = RegimeShots(group=label, ids=("0",), velocity=np.array([reference_velocity]), mass=np.array([setup.mass]),  # noqa: F841
                           depth=np.array([np.nan]), recorded=np.array([-1]), responses=("",), static_yield=np.array([np.nan]),
                           static_ultimate=np.array([np.nan]), meyer_hardness=np.array([HM]), part1_depth=np.array([np.nan]),
                           forrestal_depth=np.array([np.nan]), critical=None, rod_length=np.array([np.nan]), length=np.nan,
@@ -1421,7 +1424,7 @@ def nose_ordering_study(case, coefficients_for, opt: Options, f: float, b: float
             "rows": rows, "ordered": bool(ordered)}
 
 
-def eroding_trend(shots: RegimeShots, opt: Options, f: float | None = None, U=np.linspace(1500.0, 3500.0, 21)) -> dict:
+def eroding_trend(shots: RegimeShots, opt: Options, f: float | None = None, U=np.linspace(1500.0, 3500.0, 21)) -> dict:  # noqa: B008
     """The eroding rod's depth over 1.5-3.5 km/s for the group's mean rod: whether it rises with the
     striking velocity (towards the hydrodynamic limit L sqrt(rho_p / rho_t)) and whether Y_p > R_t
     (then it falls towards the limit from above, which the bundled eroded shots contradict)."""
@@ -1430,7 +1433,7 @@ def eroding_trend(shots: RegimeShots, opt: Options, f: float | None = None, U=np
         static = shots.static_ultimate if opt.rod_strength == "static_ultimate" else shots.static_yield
         Y = rg.ROD_FLOW_FACTOR * float(np.mean(static))
     else:
-        Y = float(f if f is not None else 1.5) * float(np.mean(shots.static_ultimate if opt.rod_strength == "ultimate" else shots.static_yield))
+        Y = float(f if f is not None else 1.5) * float(np.mean(shots.static_ultimate if opt.rod_strength == "ultimate" else shots.static_yield))  # noqa: E501
     per_len, _, _ = rg.eroding_depth_per_length(U, density=shots.density, target_density=shots.target_density,
                                                  target_resistance=R, rod_strength=Y)
     L0 = float(np.mean(shots.rod_length))
@@ -1502,9 +1505,7 @@ def seed_sphere_statement(case, coefficients_for, opt: Options, f: float, b: flo
     raw = dict(c.raw)
     raw["projectile"] = {**raw["projectile"], "shank_length": f"{(SEED_SPHERE['length_m'] - nose_len) * 1e3:.4f} mm",
                          "density": f"{SEED_SPHERE['density_kg_m3']:g} kg/m^3"}
-    from semianalytic.case import parse_case
-
-    c = parse_case(raw, None)
+    c = case.with_raw(raw)
     rows = []
     for H in SEED_SPHERE["hardness_hrc"]:
         res = _one_nose(case, c, coefficients_for, opt, f, b, e, H)

@@ -29,7 +29,7 @@ from scipy import special
 
 from semianalytic.calibration.models import DepthSurrogate
 
-__all__ = ["ResistanceMap", "Problem", "Posterior", "sample_posterior", "chain_diagnostics", "CHAINS", "mixture_quantiles", "log_predictive_density"]
+__all__ = ["ResistanceMap", "Problem", "Posterior", "sample_posterior", "chain_diagnostics", "CHAINS", "mixture_quantiles", "log_predictive_density"]  # noqa: E501
 
 
 @dataclass(frozen=True)
@@ -43,7 +43,7 @@ class ResistanceMap:
 
     table: tuple | None = None  # (ln theta knots, ln R_t) of one positive parameter, see tabulated()
 
-    def tabulated(self, lo: float, hi: float, n: int = 4001) -> "ResistanceMap":
+    def tabulated(self, lo: float, hi: float, n: int = 4001) -> ResistanceMap:
         """The same map for one positive parameter as linear interpolation of ln R_t in ln theta
         on ``n`` knots over [lo, hi] (outside: the direct evaluation).  The closed forms of
         eqs. (16)-(19) are smooth in ln theta: with knots 1e-3 apart in ln theta the

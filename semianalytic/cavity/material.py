@@ -68,8 +68,8 @@ class BrittleMaterial:
         return self.youngs_modulus / (3.0 * (1.0 - 2.0 * self.poisson_ratio))
 
     @classmethod
-    def from_section(cls, section) -> "BrittleMaterial":
-        """From a validated ``[material]`` case section (:class:`semianalytic.cavity.case.MaterialSection`)."""
+    def from_section(cls, section) -> BrittleMaterial:
+        """From a validated ``[material]`` case section (:class:`semianalytic.sections.cavity.MaterialSection`)."""
         return cls(
             youngs_modulus=section.youngs_modulus,
             poisson_ratio=section.poisson_ratio,

@@ -48,13 +48,13 @@ import numpy as np
 
 from semianalytic.coefficients import READINGS
 from semianalytic.coefficients.table import (
-    CoefficientAccessors,
     BREAK_OFFSET,
     FLAT_TIP_DEPTH,
     NEAR_BREAK,
     ROUND_OFF,
-    _PieceKnots,
+    CoefficientAccessors,
     _coef6,
+    _PieceKnots,
     breakpoints,
     check_tolerance,
     flat_tip,
@@ -394,7 +394,7 @@ class PlateCoefficientTable(CoefficientAccessors):
         e = np.asarray(self.intervals[f"err_{name}"])[j] + self.bem_errors.get(name, 0.0)
         return np.where(P >= self._end, 0.0, e)[()]
 
-    def with_reading(self, reading: str) -> "PlateCoefficientTable":
+    def with_reading(self, reading: str) -> PlateCoefficientTable:
         return replace(self, reading=reading)
 
     @property
@@ -407,7 +407,7 @@ class PlateCoefficientTable(CoefficientAccessors):
         return table_npz_bytes(self, {"thickness": self.thickness, "version": PLATE_VERSION})
 
     @classmethod
-    def from_npz(cls, source) -> "PlateCoefficientTable":
+    def from_npz(cls, source) -> PlateCoefficientTable:
         with np.load(source, allow_pickle=False) as z:
             meta, nodes, values, intervals = read_table_npz(z, PLATE_VERSION, "plate coefficient table")
             return cls(meta["nose_kind"], meta["diameter"], meta["nose_length"], meta["thickness"], z["depth"],
@@ -465,7 +465,7 @@ class ScaledPlateTable:
         k = SCALE_POWERS["B"] if name.startswith("B") else SCALE_POWERS.get(name, 2)
         return self.table.error(name, self._p(P)) * self.scale**k
 
-    def with_reading(self, reading: str) -> "ScaledPlateTable":
+    def with_reading(self, reading: str) -> ScaledPlateTable:
         return ScaledPlateTable(self.table.with_reading(reading), self.scale)
 
 

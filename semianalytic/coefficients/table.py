@@ -34,7 +34,7 @@ order, which converges spectrally) and by the residual of the identity B_bernoul
 Breakpoints (also a table spline's knots where its third derivative jumps): the knots nearest a breakpoint b are at b (1 -+ BREAK_OFFSET) (the BEM layout
 changes topology at b itself), solved with a fourth-order difference in P whose step is a
 hundredth of the distance to b; across the gap the table is linear.
-"""
+"""  # noqa: E501
 
 from __future__ import annotations
 
@@ -56,7 +56,7 @@ if TYPE_CHECKING:
     from semianalytic.bem.panels import LayoutOptions
     from semianalytic.coefficients.depth import DepthCoefficients
 
-TABLE_VERSION = 9  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners; 9: flat tips to 1e-6 R, near-hemispheres in sqrt(P), bounded shallow layouts) bump when the numerics change, to invalidate caches
+TABLE_VERSION = 9  # (5: certified tables; 6-7: with the corner-aware BEM; 8: graded pieces past corners; 9: flat tips to 1e-6 R, near-hemispheres in sqrt(P), bounded shallow layouts) bump when the numerics change, to invalidate caches  # noqa: E501
 
 DEFAULT_TOLERANCE = 1e-5  # relative to each coefficient's largest magnitude over the table
 # the default depth range (nose lengths, Nose.depth_unit); when the tolerance needs deeper solves
@@ -670,7 +670,7 @@ class CoefficientTable(CoefficientAccessors):
         j = self._index(P)
         return (np.asarray(self.intervals[f"err_{name}"])[j] + self.bem_errors.get(name, 0.0))[()]
 
-    def with_reading(self, reading: str) -> "CoefficientTable":
+    def with_reading(self, reading: str) -> CoefficientTable:
         """The same table with another default B reading."""
         return replace(self, reading=reading)
 
@@ -731,7 +731,7 @@ class CoefficientTable(CoefficientAccessors):
                                       "limit_errors": self.limit_errors})
 
     @classmethod
-    def from_npz(cls, source) -> "CoefficientTable":
+    def from_npz(cls, source) -> CoefficientTable:
         """The table from an ``.npz`` archive (a path or a binary file object)."""
         with np.load(source, allow_pickle=False) as z:
             meta, nodes, values, intervals = read_table_npz(z, TABLE_VERSION, "coefficient table")
@@ -925,7 +925,7 @@ class _Builder:
             self.noise_limited += settle_unfinished(self.knots, pending, parent)
 
     @staticmethod
-    def shallow_estimate(pk: "_PieceKnots") -> dict:
+    def shallow_estimate(pk: _PieceKnots) -> dict:
         """Error of the constant X(P_1) below a flat tip's first knot: 2 |X(4 P_1) - X(P_1)|
         (the knot at v = 2 v_1 of the root piece, v = sqrt(P/l))."""
         v0 = pk.v[0]

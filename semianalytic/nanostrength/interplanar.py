@@ -175,7 +175,7 @@ class CutoffLaw(_Law):
         q1 = self._q(x, 1)
         return -self.phi0 * (self._q(x, 2) - q1 * q1) * np.exp(-self._q(x))
 
-    def scaled(self, factor: float) -> "CutoffLaw":
+    def scaled(self, factor: float) -> CutoffLaw:
         """The same curve with Phi multiplied by ``factor`` (a mesolayer: Phi_i / Phi_0)."""
         return replace(self, phi0=self.phi0 * factor)
 
@@ -208,7 +208,7 @@ class UberLaw(_Law):
         a = x / lam
         return self.phi_b / lam**2 * (1 - a) * np.exp(-a)
 
-    def scaled(self, factor: float) -> "UberLaw":
+    def scaled(self, factor: float) -> UberLaw:
         return replace(self, phi_b=self.phi_b * factor)
 
 

@@ -18,14 +18,22 @@ from __future__ import annotations
 
 import itertools
 import json
+from collections.abc import Mapping
 from dataclasses import dataclass, field
 from pathlib import Path
-from typing import Any, Mapping
+from typing import Any
 
 from semianalytic.case import Case, ProjectileSection, parse_case
 from semianalytic.errors import InputError
-from semianalytic.optimize.model import (CONSTRAINTS, DEPTH_MODELS, OBJECTIVES, PLATE_OBJECTIVES,
-                                         SEARCH_KNOTS_PER_PIECE, Infeasible, shank_for_constraints)
+from semianalytic.optimize.model import (
+    CONSTRAINTS,
+    DEPTH_MODELS,
+    OBJECTIVES,
+    PLATE_OBJECTIVES,
+    SEARCH_KNOTS_PER_PIECE,
+    Infeasible,
+    shank_for_constraints,
+)
 from semianalytic.sweep.spec import apply_overrides
 
 # key -> (nose kinds it applies to (None: any with the schema key), SI unit of its values, parse kind)
@@ -133,7 +141,7 @@ def parse_variable(text: str) -> Variable:
         raise InputError(flag, f"bounds are LOW:HIGH; got {rest!r}")
     lo_t, hi_t = parts
     if kind is not None:  # a bare number borrows the other bound's unit ("0:2 mm")
-        unit_of = lambda t: t.strip().lstrip("+-0123456789.eE ").strip()
+        unit_of = lambda t: t.strip().lstrip("+-0123456789.eE ").strip()  # noqa: E731
         if not unit_of(lo_t) and unit_of(hi_t):
             lo_t = f"{lo_t.strip()} {unit_of(hi_t)}"
         if not unit_of(hi_t) and unit_of(lo_t):

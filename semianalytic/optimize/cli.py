@@ -12,7 +12,6 @@ from __future__ import annotations
 import argparse
 import shlex
 import sys
-from pathlib import Path
 
 from semianalytic.errors import InputError
 
@@ -25,7 +24,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--vary", action="append", default=[], metavar="KEY=LOW:HIGH",
                         help="nose parameter and bounds: projectile.crh, projectile.half_angle, "
                              "projectile.meplat_diameter, projectile.tip_radius, projectile.exponent, "
-                             "projectile.nose_length, projectile.control_radii.K (a spline nose's K-th control radius, 0-based) (repeatable)")
+                             "projectile.nose_length, projectile.control_radii.K (a spline nose's K-th control radius, 0-based) (repeatable)")  # noqa: E501
     parser.add_argument("--objective", default="depth", help="depth (mean final depth, maximised), deep_drag (Bbar, "
                         "minimised), ballistic_limit (a plate's V_bl, minimised) or residual_velocity (a plate's mean V_r, "
                         "maximised)")

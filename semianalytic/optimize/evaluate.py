@@ -42,15 +42,23 @@ from __future__ import annotations
 import json
 import math
 import time
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass, field
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from semianalytic.errors import InputError
 from semianalytic.optimize.case import Problem, design_case
-from semianalytic.optimize.model import (CONFIRM_KNOTS_PER_PIECE, PLATE_OBJECTIVES, Infeasible, confirmation_grid,
-                                         deep_drag, depth_objective, quantise)
+from semianalytic.optimize.model import (
+    CONFIRM_KNOTS_PER_PIECE,
+    PLATE_OBJECTIVES,
+    Infeasible,
+    confirmation_grid,
+    deep_drag,
+    depth_objective,
+    quantise,
+)
 
 PENALTY = 1.0e3  # objective of an invalid or infeasible design (objectives are O(0.1) in SI)
 _SHAPE_KEYS = ("projectile.crh", "projectile.half_angle", "projectile.corner_radius", "projectile.meplat_diameter",
@@ -173,8 +181,8 @@ def plate_objective(problem: Problem, case, cache_dir=None) -> dict:
     minimised; ``residual_velocity``: minus the mean V_r over the striking velocities
     (:func:`semianalytic.perforation.residual_velocity`).  A design not perforated inside the model's
     range (or stopped at every velocity) raises :class:`Infeasible` (issue 37: never a number)."""
+    from semianalytic.commands.perforate.evaluate import perforation_setup
     from semianalytic.perforation import residual_velocity
-    from semianalytic.perforation.evaluate import perforation_setup
 
     setup = perforation_setup(case, cache_dir)
     out: dict = {"plate_thickness_m": setup.thickness}

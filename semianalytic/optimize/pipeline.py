@@ -37,12 +37,12 @@ def optimize_case(case_path: str | None, vary: list[str], objective: str = "dept
     of the same names).  ``case`` (a loaded case) replaces reading ``case_path``.  Returns the
     optimum as the JSON ``optimize --json`` prints; writes ``out``/``report`` when given."""
     constraint = list(constraint)
-    from semianalytic.case import load_case
     from semianalytic.cache import table_dir
+    from semianalytic.case import load_case
+    from semianalytic.io import check_report_target
     from semianalytic.optimize.case import build_problem
     from semianalytic.optimize.evaluate import optimise
     from semianalytic.report.output import check_output_dir
-    from semianalytic.io import check_report_target
     from semianalytic.sweep.engine import connect
 
     for name, value, low in (("--popsize", popsize, 2), ("--maxiter", maxiter, 1), ("--workers", workers, 1),

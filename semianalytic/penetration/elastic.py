@@ -48,6 +48,7 @@ __all__ = [
 
 W2_MODELS = ("paper", "exact-rod")
 from semianalytic.penetration.options import W1_MODELS  # noqa: E402,F401 (a leaf module: a cheap --help)
+
 W1_TIME_DOMAIN = W1_MODELS + ("pressure",)  # + eq. (9)'s pressure from the BEM table
 
 

@@ -32,7 +32,7 @@ from semianalytic.ballistic_limit.theory import meyer_hardness as meyer_from_vic
 from semianalytic.errors import InputError
 
 __all__ = ["E140_HRC_HV", "HRC_RANGE", "DEFAULT_DYNAMIC_FACTOR", "vickers_from_rockwell_c", "yield_stress_from_vickers",
-           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "meyer_from_vickers_number",
+           "yield_stress_from_hardness", "ultimate_strength_from_vickers", "vickers_from_yield_stress", "meyer_hardness_from_vickers", "meyer_from_vickers_number",  # noqa: E501
            "VICKERS_HALF_ANGLE", "dynamic_yield_stress", "parse_hardness"]
 
 # ASTM E140, Table 1: HRC -> HV (non-austenitic steels), HRC 20..68

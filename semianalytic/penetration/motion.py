@@ -518,7 +518,7 @@ class DepthProfile:
         eF, eG = self._tail[0][k], self._tail[1][k]  # through the end of P's panel (an upper bound)
         return eF, eG + np.abs(self.G(P)) * eF
 
-    def shifted(self, dF, dG, ddF, ddG) -> "DepthProfile":
+    def shifted(self, dF, dG, ddF, ddG) -> DepthProfile:
         """The profile with F, G and their slopes changed by the given node arrays (first-order
         perturbed profiles of the error estimate: no coefficient evaluation, no integration)."""
         import dataclasses
@@ -687,7 +687,7 @@ def separated_acceleration(nodes: dict, reading: str, mass: float, rho: float, u
 
 
 @functools.lru_cache(maxsize=1024)
-def _separated_run(wetted: "WettedCorrection", rtol: float, U0: float):
+def _separated_run(wetted: WettedCorrection, rtol: float, U0: float):
     """(P_f, dense output of w(P), -dw/dP at the stop) of one start velocity with the contact
     region of eq. (15) (DOP853 in P with an event at w = 0).  Cached here, outside the frozen
     :class:`SeparatedProfile`, keyed by the (identity of the) wetted correction, rtol and U0."""

@@ -29,8 +29,6 @@ from dataclasses import dataclass
 
 import numpy as np
 
-from semianalytic.ballistic_limit import theory as rigid
-
 __all__ = [
     "ogive_nose_factor",
     "nose_factors",
@@ -87,7 +85,7 @@ class CavityLaw:
     C: float
 
     @classmethod
-    def two_term(cls, yield_stress: float, A: float, B: float) -> "CavityLaw":
+    def two_term(cls, yield_stress: float, A: float, B: float) -> CavityLaw:
         """sigma_r / Y = A + B (rho/Y) V^2 (Forrestal's two-term form)."""
         return cls(yield_stress, A, 0.0, B)
 

@@ -53,6 +53,7 @@ from dataclasses import dataclass
 
 import numpy as np
 
+from semianalytic.ballistic_limit.theory import stop_time
 from semianalytic.errors import InputError
 
 __all__ = [
@@ -209,22 +210,21 @@ def eroding_time_per_length(striking_velocity, *, density: float, target_density
                             rod_strength: float):
     """Duration of the Alekseevskii-Tate penetration per unit rod length [s/m] (scalar U_s): from
     dt = -rho_p L dv / Y_p, t / L_0 = (rho_p / Y_p) int_{v_e}^{U} exp(-k (I(U) - I(w))) dw, plus the
-    rigid phase of the residual rod (Y_p > R_t; Part IV eq. (3)): 2 rho_p L_r / (rho_t a) atan(v_e / a),
-    a = sqrt(2 R_t / rho_t).  Below v_e the rod is rigid throughout; with u = 0 (Y_p < R_t, U below the
+    rigid phase of the residual rod of length L_r (Y_p > R_t): Part IV eq. (3)'s stop time from v_e
+    (:func:`semianalytic.ballistic_limit.theory.stop_time`).  Below v_e the rod is rigid throughout; with u = 0 (Y_p < R_t, U below the
     stall velocity) the rod erodes on the surface in rho_p U / Y_p."""
     rho_p, rho_t, Y, R = float(density), float(target_density), float(rod_strength), float(target_resistance)
     U = float(striking_velocity)
     k = rho_p / Y
     v_e = float(_erosion_end_array(rho_p, Y, rho_t, R))
-    a = math.sqrt(2.0 * R / rho_t)
     if U <= v_e:
-        return 2.0 * rho_p / (rho_t * a) * math.atan(U / a) if Y > R else rho_p * U / Y
+        return stop_time(U, R, rho_t, rho_p, 1.0) if Y > R else rho_p * U / Y  # rigid rod: Part IV eq. (3)
     IU = float(tate_integral(U, v_e, rho_p, Y, rho_t, R))
     w = v_e + (U - v_e) * _S**2
     Iw = tate_integral(w, v_e, rho_p, Y, rho_t, R)
     t = k * float(np.exp(-k * (IU - Iw)) * 2.0 * (U - v_e) * _S @ _WS)
     if Y > R:
-        t += 2.0 * rho_p * math.exp(-k * IU) / (rho_t * a) * math.atan(v_e / a)
+        t += stop_time(v_e, R, rho_t, rho_p, math.exp(-k * IU))  # the residual rod, rigid: Part IV eq. (3)
     return t
 
 

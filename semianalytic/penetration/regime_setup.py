@@ -153,9 +153,14 @@ def rod_strengths(case, setup) -> tuple[float, float, float, float]:
     ultimate strength is f sigma_u(HV) (ASTM E140, Pavlina & Van Tyne 2008, eqs. (4)-(5)).  With a
     ``yield_stress`` only, it is read as f sigma_y of a steel (f = ``dynamic_factor`` default) and
     sigma_u follows through the Vickers hardness eq. (4) implies (eq. (4) inverted, then eq. (5))."""
-    from semianalytic.penetration.hardness import (DEFAULT_DYNAMIC_FACTOR, meyer_hardness_from_vickers,
-                                                   parse_hardness, ultimate_strength_from_vickers,
-                                                   vickers_from_rockwell_c, vickers_from_yield_stress)
+    from semianalytic.penetration.hardness import (
+        DEFAULT_DYNAMIC_FACTOR,
+        meyer_hardness_from_vickers,
+        parse_hardness,
+        ultimate_strength_from_vickers,
+        vickers_from_rockwell_c,
+        vickers_from_yield_stress,
+    )
 
     psec = case.projectile
     f = float(getattr(psec, "dynamic_factor", None) or DEFAULT_DYNAMIC_FACTOR)
@@ -198,15 +203,14 @@ def case_nose_loads(case, setup, law=None) -> dict:
 
 
 def _regimes_choices(case) -> dict:
-    """The case's ``[regimes]`` keys (penetration/regimes_case.py), {} without the section."""
+    """The case's ``[regimes]`` keys (sections/regimes.py), {} without the section."""
     sec = case.section("regimes") if hasattr(case, "section") else None
     return sec.choices() if sec is not None else {}
 
 
 def _nose_load_labels(case, setup, U, ei: ErodingInputs):
     """``regime_labels`` of the ``nose_load`` rule (:data:`REGIME_RULES`, :data:`NOSE_LOAD_DEFAULTS`)."""
-    from semianalytic.penetration.hardness import (parse_hardness, ultimate_strength_from_vickers,
-                                                   vickers_from_rockwell_c)
+    from semianalytic.penetration.hardness import parse_hardness, ultimate_strength_from_vickers, vickers_from_rockwell_c
     from semianalytic.penetration.nose_load import transition_velocity
 
     d = NOSE_LOAD_DEFAULTS
@@ -432,7 +436,7 @@ def fit_eroding_parameters(ei: ErodingInputs, shots, start=None) -> tuple[float,
 
     def resid(x):
         R, Y = np.exp(x)
-        return np.array([math.log(float(rg.eroding_depth(s.velocity, **ei.kwargs(target_resistance=R, rod_strength=Y, mass=s.mass)).depth[0]))
+        return np.array([math.log(float(rg.eroding_depth(s.velocity, **ei.kwargs(target_resistance=R, rod_strength=Y, mass=s.mass)).depth[0]))  # noqa: E501
                          - math.log(s.depth) for s in shots])
 
     sol = least_squares(resid, x0, bounds=(np.log([1e7, 1e7]), np.log([2e10, 2e10])), x_scale=1.0, diff_step=1e-4)

@@ -3,7 +3,7 @@ and Part IV, eq. (6).
 
 Each model is a frozen dataclass with ``pressure(diameter)`` -> R_t [Pa] (only the limestone
 model, eq. (19), depends on the projectile; the others ignore the argument).  The case-file
-table ``[target.resistance]`` (its schema lives in :mod:`semianalytic.penetration.case`) picks
+table ``[target.resistance]`` (its schema lives in :mod:`semianalytic.sections.penetration`) picks
 one by its ``model`` key:
 
 =================  ==================================  ==========================================
@@ -226,7 +226,7 @@ class Part4:
 class Cavity:
     """The Part II brittle cavity-expansion pressure R_r of Part II, eq. (34), in Pa."""
 
-    material: "BrittleMaterial"
+    material: BrittleMaterial
     name = "cavity"
     equation = "Part II, eq. (34)"
 
@@ -252,13 +252,13 @@ Resistance = ElasticPlastic | Brittle | Hardening | Limestone | Part4 | Cavity |
 
 MODELS: list[str] = []
 """The names of the registered ``[target.resistance]`` models, in order: kept by
-:func:`semianalytic.penetration.case.register_resistance` (the one list of models)."""
+:func:`semianalytic.sections.penetration.register_resistance` (the one list of models)."""
 
 
 def resistance_from_case(case) -> Resistance:
     """The resistance model of a validated case's ``[target.resistance]`` (an error if it has none).
 
-    The section holds the validated input (:mod:`semianalytic.penetration.case`); its
+    The section holds the validated input (:mod:`semianalytic.sections.penetration`); its
     ``build()`` gives the model.
     """
     spec = case.require("target").resistance

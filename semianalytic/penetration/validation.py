@@ -118,8 +118,8 @@ def load_shots(case, *, require_depth: bool = True) -> list[Shot]:
     data = case.require("data")
     if data.file is None:
         return []
-    from semianalytic.case import MAX_STRIKING_VELOCITY, MIN_STRIKING_VELOCITY
     from semianalytic.io import case_input_path
+    from semianalytic.limits import MAX_STRIKING_VELOCITY, MIN_STRIKING_VELOCITY
 
     path = case_input_path(case.path, data.file, "data.file")
     if not path.is_file():

@@ -6,8 +6,8 @@ agree.  Tables hold strings already formatted with their units in the header.
 
 from __future__ import annotations
 
+from collections.abc import Sequence
 from dataclasses import dataclass, field
-from typing import Sequence
 
 
 @dataclass(frozen=True)
@@ -56,25 +56,25 @@ class Document:
     title: str
     blocks: list[Block] = field(default_factory=list)
 
-    def add(self, *blocks: Block) -> "Document":
+    def add(self, *blocks: Block) -> Document:
         self.blocks.extend(blocks)
         return self
 
-    def heading(self, text: str, level: int = 2) -> "Document":
+    def heading(self, text: str, level: int = 2) -> Document:
         return self.add(Heading(text, level))
 
-    def para(self, text: str) -> "Document":
+    def para(self, text: str) -> Document:
         return self.add(Paragraph(text))
 
-    def note(self, text: str, kind: str = "note") -> "Document":
+    def note(self, text: str, kind: str = "note") -> Document:
         return self.add(Note(text, kind))
 
-    def table(self, header: Sequence[str], rows: Sequence[Sequence[object]], caption: str = "") -> "Document":
+    def table(self, header: Sequence[str], rows: Sequence[Sequence[object]], caption: str = "") -> Document:
         return self.add(
             Table(tuple(str(h) for h in header), tuple(tuple(str(c) for c in r) for r in rows), caption)
         )
 
-    def image(self, path: str, caption: str, alt: str = "") -> "Document":
+    def image(self, path: str, caption: str, alt: str = "") -> Document:
         return self.add(Image(path, caption, alt or caption))
 
 

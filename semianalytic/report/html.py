@@ -11,7 +11,7 @@ from __future__ import annotations
 import base64
 import html
 import re
-from typing import Callable
+from collections.abc import Callable
 
 from semianalytic.report.document import Code, Document, Heading, Image, Note, Paragraph, Table
 

@@ -17,12 +17,12 @@ import json
 import os
 import shutil
 import tempfile
+from collections.abc import Iterable
 from pathlib import Path
-from typing import Any, Iterable
+from typing import Any
 
 from semianalytic.errors import InputError
-from semianalytic.io import (atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path,
-                             interrupt_on_termination)
+from semianalytic.io import atomic_write_bytes, atomic_write_json, atomic_write_text, contained_path, interrupt_on_termination
 
 MANIFEST = ".semianalytic-manifest.json"
 
@@ -237,7 +237,7 @@ class StagedDir:
         self._restore_signals = lambda: None
 
     # -- context -------------------------------------------------------------------------
-    def __enter__(self) -> "StagedDir":
+    def __enter__(self) -> StagedDir:
         try:
             self.final.parent.mkdir(parents=True, exist_ok=True)
             remove_stale_staging(self.final)
@@ -350,12 +350,10 @@ def report_command(prog: str, description: str, filename: str, build, argv: list
     ``build(out) -> (markdown, {png name: bytes})``; the figures and then the report are
     written atomically; an existing report is kept unless ``--force`` (exit status 2).
     """
-    import argparse
     import sys
 
-    from semianalytic.io import check_report_target
-
     from semianalytic.cli_types import OneLineParser, output_dir
+    from semianalytic.io import check_report_target
 
     parser = OneLineParser(prog=prog, description=description)
     parser.add_argument("--out", default="reports", type=output_dir, help="output folder (default reports/)")

@@ -20,7 +20,7 @@ from typing import TYPE_CHECKING
 import numpy as np
 
 if TYPE_CHECKING:
-    from semianalytic.bem.field import FieldOnGrid
+    pass
 
 __all__ = [
     "meridian_mesh",

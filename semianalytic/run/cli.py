@@ -20,7 +20,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
     parser.add_argument("--only", action="append", choices=ANALYSES, default=None, metavar="ANALYSIS",
                         help=f"run only these analyses (repeatable; one of: {', '.join(ANALYSES)})")
     parser.add_argument("--no-render", action="store_true", help="skip the pyvista render (VTK files are still written)")
-    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")  # noqa: E501
     from semianalytic.report.formats import add_format_arguments
 
     add_format_arguments(parser, provides=("data", "text", "rows"), json_help="print results.json to stdout as well")
@@ -41,7 +41,7 @@ def run(args: argparse.Namespace) -> int:
     fmt = chosen_format(args)
     check_case(load_case(args.case), field=True)  # refuse before solving what would not fit in memory
     if args.csv is not None:
-        from semianalytic.penetration.table_out import check_csv_target
+        from semianalytic.commands.penetrate.table_out import check_csv_target
 
         check_csv_target(args.csv, args.force, inputs=[args.case])
     out = Path(args.out)
@@ -49,10 +49,10 @@ def run(args: argparse.Namespace) -> int:
         args.case, out, force=args.force, only=args.only, render=not args.no_render, cache_dir=args.cache_dir,
         contact=args.contact, tolerance=args.tolerance, quiet=args.quiet,
     )
-    from semianalytic.penetration.table_out import depth_csv
+    from semianalytic.commands.penetrate.table_out import depth_csv
 
     pen = results["analyses"].get("penetration") or {}
-    rows = lambda: depth_csv([(Path(args.case).name, pen)] if pen else [])
+    rows = lambda: depth_csv([(Path(args.case).name, pen)] if pen else [])  # noqa: E731
     if args.csv is not None:
         from semianalytic.io import atomic_write_text
 

@@ -230,7 +230,7 @@ def _velocity_field_run(ctx: Context) -> None:
             f"Speed |v| of the target material around the {case.projectile.nose} nose at P = {P * 1e3:.1f} mm "
             f"(cf. Part I, Figs. 12-13) on the body-fitted grid ({n_theta} x {n_rho} nodes), window x = 0 to "
             f"{x1:.1f} mm, |r| <= {r1:.1f} mm, mirrored about the axis. The free surface x = 0 is inside the window "
-            "(blue line; dphi/dn = 0 there in the mirror method of eqs. (20)-(22), so v is tangential to it); the wetted surface (the submerged projectile, x >= 0, where eq. (7) holds) is orange; "
+            "(blue line; dphi/dn = 0 there in the mirror method of eqs. (20)-(22), so v is tangential to it); the wetted surface (the submerged projectile, x >= 0, where eq. (7) holds) is orange; "  # noqa: E501
             f"white lines are streamlines of v. Colour: {scale}.",
         )
         if ctx.render:
@@ -282,7 +282,6 @@ def bem_at_vertices(field, bem) -> np.ndarray:
 
 def _fem_field_run(ctx: Context) -> None:
     from fem_check.api import halfspace_potential_field
-
     from semianalytic.bem import solve_halfspace
     from semianalytic.report import vtk
 

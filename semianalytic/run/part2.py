@@ -18,8 +18,8 @@ def _cavity_solve(case: Case):
     import warnings
 
     from semianalytic.cavity import BrittleMaterial, solve_cavity
-    from semianalytic.cavity.case import MODEL_FIELDS
     from semianalytic.errors import ModelValidityWarning, model_field
+    from semianalytic.sections.cavity import MODEL_FIELDS
 
     sec = case.require("material")
     with warnings.catch_warnings(), model_field(MODEL_FIELDS):

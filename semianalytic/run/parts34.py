@@ -1,5 +1,5 @@
 """Part III and Part IV steps of a ``run``: the ballistic limit velocity (Part IV, through
-:func:`semianalytic.ballistic_limit.evaluate.evaluate_case`) and the theoretical strength of
+:func:`semianalytic.commands.ballistic_limit.evaluate.evaluate_case`) and the theoretical strength of
 nanoparticles (Part III, through :mod:`semianalytic.nanostrength`)."""
 
 from __future__ import annotations
@@ -29,7 +29,7 @@ _BL_COLUMNS = [
 
 
 def _bl_evaluate(case: Case) -> dict:
-    from semianalytic.ballistic_limit.evaluate import evaluate_case
+    from semianalytic.commands.ballistic_limit.evaluate import evaluate_case
 
     return evaluate_case(case)
 
@@ -93,7 +93,7 @@ def _bl_run(ctx: Context) -> None:
     ctx.results["ballistic_limit"] = res
 
 
-register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.ballistic_limit.evaluate",),
+register(Step("ballistic_limit", "Ballistic limit", ("ballistic_limit",), ("semianalytic.commands.ballistic_limit.evaluate",),
               _has("ballistic_limit"), _bl_preflight, _bl_run))
 
 
@@ -108,8 +108,8 @@ def _nano_preflight(case: Case, run: RunSection) -> None:
 
 
 def _nano_run(ctx: Context) -> None:
-    from semianalytic.nanostrength.case import analyse_section
-    from semianalytic.nanostrength.report import build_report
+    from semianalytic.commands.nanostrength.report import build_report
+    from semianalytic.sections.nanostrength import analyse_section
 
     section = ctx.case.require("nanostrength")
     a = analyse_section(section)

@@ -1,5 +1,5 @@
 """The perforation step of a ``run``: when the case's target has a ``thickness`` or
-``[[target.layers]]``, V_r against V_s through :func:`semianalytic.perforation.evaluate.evaluate_case`
+``[[target.layers]]``, V_r against V_s through :func:`semianalytic.commands.perforate.evaluate.evaluate_case`
 with Part IV's V_cr as vertical lines, measured points as markers and the figure's data as CSV."""
 
 from __future__ import annotations
@@ -17,7 +17,7 @@ def _applies(case: Case) -> bool:
 
 
 def _preflight(case: Case, run: RunSection) -> None:
-    from semianalytic.perforation.evaluate import load_perforation_data
+    from semianalytic.commands.perforate.evaluate import load_perforation_data
 
     if not _applies(case):
         raise InputError("target.thickness", "missing: the perforation analysis needs a plate ('thickness') or [[target.layers]]")
@@ -25,8 +25,8 @@ def _preflight(case: Case, run: RunSection) -> None:
 
 
 def _run(ctx: Context) -> None:
-    from semianalytic.perforation.evaluate import evaluate_case
-    from semianalytic.perforation.report import error_rows, figure_csv, perforation_figure
+    from semianalytic.commands.perforate.evaluate import evaluate_case
+    from semianalytic.commands.perforate.report import error_rows, figure_csv, perforation_figure
 
     try:
         res = evaluate_case(ctx.case, cache_dir=ctx.cache_dir)

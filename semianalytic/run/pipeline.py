@@ -16,12 +16,17 @@ from __future__ import annotations
 import time
 from pathlib import Path
 
-from semianalytic.case import Case
 from semianalytic.errors import InputError
 from semianalytic.report.document import fmt
 from semianalytic.report.provenance import generated_by, version
-from semianalytic.run import bodies, fields, part1, part2, parts34  # noqa: F401 (steps register on import)
-from semianalytic.run import perforation  # noqa: F401 (issue 23: registers the perforation step)
+from semianalytic.run import (  # noqa: F401 (steps register on import)
+    bodies,
+    fields,
+    part1,
+    part2,
+    parts34,
+    perforation,  # noqa: F401 (issue 23: registers the perforation step)
+)
 from semianalytic.run.context import Context
 from semianalytic.run.registry import Step, _mm, _projectile, select_steps
 

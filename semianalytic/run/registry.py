@@ -11,18 +11,16 @@ A step whose model package is not installed in this version is listed as skipped
 
 from __future__ import annotations
 
-import math
+from collections.abc import Callable
 from dataclasses import dataclass
-from pathlib import Path
-from typing import Callable
 
 import numpy as np
 
 from semianalytic.case import Case
 from semianalytic.errors import InputError
+from semianalytic.report.document import fmt
 from semianalytic.run.case import ANALYSES, RunSection
 from semianalytic.run.context import Context
-from semianalytic.report.document import fmt
 
 
 @dataclass(frozen=True)

@@ -49,7 +49,7 @@ def add_arguments(parser: argparse.ArgumentParser) -> None:
                              "a local cluster for geometry sweeps)")
     parser.add_argument("--workers", type=integer(1, 256), default=2, help="workers of the local cluster (default 2)")
     parser.add_argument("--batch-size", type=integer(1, 10_000_000), default=None, help="cases per task (default: automatic)")
-    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")
+    parser.add_argument("--cache-dir", default=None, type=output_dir, help="coefficient-table cache folder (default: $SEMIANALYTIC_CACHE_DIR, else the per-user cache)")  # noqa: E501
     parser.add_argument("--resume", action="store_true", help="continue an interrupted sweep in --out")
     parser.add_argument("--force", action="store_true", help="discard existing results in --out")
     parser.add_argument("--no-progress", action="store_true", help="no progress bar")

@@ -21,19 +21,20 @@ import shutil
 import sys
 import time
 from collections import defaultdict
+from collections.abc import Callable, Mapping
 from dataclasses import dataclass
 from pathlib import Path
-from typing import Any, Callable, Mapping
+from typing import Any
 
 import numpy as np
 
 from semianalytic.case import Case, load_case, parse_case
 from semianalytic.errors import InputError
 from semianalytic.io import atomic_write_json
-from semianalytic.thirdparty import deferred_interrupts
 from semianalytic.sweep.kernels import Kernel, select_kernel
 from semianalytic.sweep.spec import SweepSpec, apply_overrides, raw_value
 from semianalytic.sweep.store import Columns, ResultStore, results_path
+from semianalytic.thirdparty import deferred_interrupts
 
 BASE_COLUMNS = ("case_id", "status", "message")
 MANIFEST = "sweep.json"
@@ -436,7 +437,7 @@ def probe_scheduler(address: str, connect_seconds: float = PROBE_CONNECT_SECONDS
     except ConnectionRefusedError:
         raise InputError("--scheduler", f"nothing listens at {host}:{port} (connection refused); start the dask "
                                         "scheduler there or give 'local'") from None
-    except (socket.timeout, TimeoutError):
+    except TimeoutError:
         raise InputError("--scheduler", f"{host}:{port} did not answer within {connect_seconds:g} s") from None
     except OSError as exc:
         raise InputError("--scheduler", f"cannot connect to {host}:{port}: {exc.strerror or exc}") from None
@@ -450,7 +451,7 @@ def probe_scheduler(address: str, connect_seconds: float = PROBE_CONNECT_SECONDS
             sock.settimeout(left)
             try:
                 chunk = sock.recv(16 - len(data))
-            except (socket.timeout, TimeoutError):
+            except TimeoutError:
                 break
             if not chunk:
                 break

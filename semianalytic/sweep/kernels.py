@@ -16,8 +16,9 @@ geometry and the BEM options).
 from __future__ import annotations
 
 import contextlib
+from collections.abc import Mapping
 from dataclasses import dataclass, field
-from typing import Any, Mapping
+from typing import Any
 
 import numpy as np
 
@@ -413,8 +414,8 @@ class CavityKernel:
 
     def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
         from semianalytic.cavity import BrittleMaterial, solve_cavity
-        from semianalytic.cavity.case import MODEL_FIELDS
         from semianalytic.errors import model_field
+        from semianalytic.sections.cavity import MODEL_FIELDS
 
         sec = case.require("material")
         try:

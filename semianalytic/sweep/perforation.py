@@ -2,7 +2,7 @@
 
 A case with a plate (``[target] thickness`` or ``[[target.layers]]``) swept over any key,
 ``target.thickness`` included (``--vary target.thickness=10:30:5 mm``): per case the layered
-coefficients and the mass (:func:`semianalytic.perforation.evaluate.perforation_setup`, the plate
+coefficients and the mass (:func:`semianalytic.commands.perforate.evaluate.perforation_setup`, the plate
 tables cached on disk), then for its striking velocities (the fast key, evaluated together)
 the residual velocity (:func:`semianalytic.perforation.residual_velocity`: Part I, eq. (11)
 through the plate; 0 where it stops) and, once per case, the ballistic limit with its error
@@ -31,7 +31,7 @@ def has_plate(case: Case) -> bool:
 
 
 def plate_ballistic_limit(setup, start: float):
-    """(V_bl, its error) [m/s] of a :class:`~semianalytic.perforation.evaluate.PerforationSetup`:
+    """(V_bl, its error) [m/s] of a :class:`~semianalytic.commands.perforate.evaluate.PerforationSetup`:
     the model's own search (:func:`semianalytic.perforation.ballistic_limit_search`, up to the
     rigid-projectile limit ``setup.v_max``); NaN where nothing perforates inside the model's range
     (issue 37: never a number for an unperforated design).  ``start`` is kept for the callers."""
@@ -70,8 +70,8 @@ class PerforationKernel(CavityKernel):
             raise InputError("impact.striking_velocity", "must be positive (m/s)")
 
     def evaluate(self, case: Case, resource, fast) -> dict[str, np.ndarray]:
+        from semianalytic.commands.perforate.evaluate import perforation_setup
         from semianalytic.perforation import residual_velocity
-        from semianalytic.perforation.evaluate import perforation_setup
 
         U = np.atleast_1d(np.asarray(fast.get(VELOCITY_KEY), float))
         setup = perforation_setup(case, self.cache_dir)

@@ -22,8 +22,9 @@ import hashlib
 import json
 import math
 import re
+from collections.abc import Mapping, Sequence
 from dataclasses import dataclass
-from typing import Any, Mapping, Sequence
+from typing import Any
 
 import numpy as np
 
@@ -195,7 +196,7 @@ def parse_vary(text: str, option: str = "--vary") -> Axis:
         values = [start + i * step for i in range(n)]
     else:
         values, unit = _parse_numbers(rest.split(","), field)
-    integer = not unit and all(float(v).is_integer() for v in values) and not any("." in p or "e" in p.lower() for p in re.split("[,:]", rest))
+    integer = not unit and all(float(v).is_integer() for v in values) and not any("." in p or "e" in p.lower() for p in re.split("[,:]", rest))  # noqa: E501
     return Axis(key, tuple(values), unit, integer)
 
 

@@ -18,8 +18,8 @@ import csv
 import io
 import math
 import os
+from collections.abc import Iterable, Mapping, Sequence
 from pathlib import Path
-from typing import Iterable, Mapping, Sequence
 
 import numpy as np
 
@@ -145,7 +145,7 @@ class ResultStore:
         return df.sort_values("case_id").reset_index(drop=True)
 
     # -- writing -------------------------------------------------------------------------
-    def open(self, fresh: bool) -> "ResultStore":
+    def open(self, fresh: bool) -> ResultStore:
         self.out.mkdir(parents=True, exist_ok=True)
         if self.fmt == "csv":
             if fresh or not self.path.exists() or self.path.stat().st_size == 0:

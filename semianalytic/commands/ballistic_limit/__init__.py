@@ -1,0 +1,1 @@
+"""The ``ballistic-limit`` command."""
