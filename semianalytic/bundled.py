@@ -27,13 +27,13 @@ def cases_dir() -> Path | None:
     here = Path(__file__).resolve().parent.parent
     if (here / "pyproject.toml").is_file() and (here / "cases" / "__init__.py").is_file():
         return here / "cases"
-    try:
-        from importlib.resources import files
+    import importlib.util
 
-        root = files("semianalytic.cases")
-    except (ModuleNotFoundError, TypeError):
+    if importlib.util.find_spec("semianalytic.cases") is None:  # a build without the package data
         return None
-    path = Path(str(root))  # a folder on disk for a normal or editable install (not a zip)
+    from importlib.resources import files
+
+    path = Path(str(files("semianalytic.cases")))  # a folder on disk for a normal or editable install (not a zip)
     return path if path.is_dir() else None
 
 

@@ -8,6 +8,7 @@ imported from there; from an installed wheel the command exits 2 with one line s
 from __future__ import annotations
 
 import importlib
+import importlib.util
 import sys
 from pathlib import Path
 
@@ -18,11 +19,8 @@ __all__ = ["import_benchmark"]
 
 def import_benchmark(module_name: str, command: str):
     """The module ``benchmarks.X`` of the checkout; InputError (exit 2) outside a checkout."""
-    try:
+    if importlib.util.find_spec("benchmarks") is not None:
         return importlib.import_module(module_name)
-    except ModuleNotFoundError as exc:
-        if exc.name not in ("benchmarks", module_name):
-            raise
     root = Path(__file__).resolve().parent.parent
     if (root / "benchmarks" / "__init__.py").is_file() and (root / "pyproject.toml").is_file():
         sys.path.insert(0, str(root))

@@ -4,7 +4,9 @@ that the commands work and that what they check independently holds)."""
 
 from __future__ import annotations
 
+import os
 import re
+from pathlib import Path
 
 import pytest
 
@@ -16,6 +18,10 @@ def test_sweep_benchmark_small(tmp_path, monkeypatch):
     from benchmarks.sweep import main
 
     monkeypatch.setenv("SEMIANALYTIC_CACHE_DIR", str(tmp_path / "cache"))
+    # benchmarks/ is a folder of the checkout, not of the installed package: the local dask cluster's
+    # worker processes unpickle its functions, so they need the checkout on their path too
+    root = str(Path(__file__).resolve().parents[1])
+    monkeypatch.setenv("PYTHONPATH", os.pathsep.join(p for p in (root, os.environ.get("PYTHONPATH")) if p))
     report = tmp_path / "bench.md"
     assert main(["--designs", "2", "--report", str(report)]) == 0
     text = report.read_text()

@@ -228,7 +228,8 @@ striking_velocities = ["433 m/s", "917 m/s"]
                     assert q["regime_aware"][p][i] == q["rigid"][p][i]
         for m, qq in q.items():
             assert len(qq["0.05"]) == len(qq["0.5"]) == len(qq["0.95"]) == 2
-            assert all(a < b < c for a, b, c in zip(qq["0.05"], qq["0.5"], qq["0.95"])), m
+            # null where no model holds (the regime-aware intervals at an eroding velocity, above)
+            assert all(a < b < c for a, b, c in zip(qq["0.05"], qq["0.5"], qq["0.95"]) if b is not None), m
         # median near the model at the posterior-median resistance (the mixture of log-normals
         # is nearly symmetric in ln P): 2 %
         Y = post["models"]["rigid"]["summary"]["target.resistance.yield_stress"]["q50"]

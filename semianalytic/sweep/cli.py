@@ -122,7 +122,7 @@ def sweep_case(case_path: str, out: str, vary: list[str] = (), sample: list[str]
     check_sweep_size(spec.n_cases, geometries, "--samples" if spec.samplers else "--vary")
     kernel = sweep_kernel(case, analysis, cache_dir, full)
     summary = run_sweep(
-        case_path, spec, out, fmt=fmt, resume=resume, force=force,
+        str(case.path or case_path), spec, out, fmt=fmt, resume=resume, force=force,  # the bundled case, if so
         scheduler=scheduler, workers=workers, batch_size=batch_size,
         progress=progress, kernel=kernel,
     )
