@@ -491,7 +491,10 @@ class DepthProfile:
                 Pn_ = P - r / dG
             bad = ~np.isfinite(Pn_) | (Pn_ < lo) | (Pn_ > hi)
             Pn_ = np.where(bad, 0.5 * (lo + hi), Pn_)
-            done = done | (((np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)) & np.isfinite(r))
+            # converged: the step or the bracket at round-off, or the residual G - U0^2 itself at the
+            # round-off of G (where G is flat, past a plate's back face, the step cannot settle)
+            done = done | (((np.abs(Pn_ - P) <= 1e-13 * np.abs(P)) | (hi - lo <= 1e-15 * hi)
+                            | (np.abs(r) <= 8.0 * np.finfo(float).eps * g)) & np.isfinite(r))
             P = np.where(g == 0, P, Pn_)
             if np.all(done):
                 break
