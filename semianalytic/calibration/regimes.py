@@ -504,15 +504,8 @@ def _grid_posterior_nose(shots: RegimeShots, opt: Options) -> dict:
     out = model_outcome(kg, shots, opt, bg if two else None, eg)
     sig = _SIGMA_GRID_N[::2] if per else _SIGMA_GRID_N  # (7 x 7 with two sigmas)
     tau = _TAU_GRID_N
-    lp = _grid_loglik(shots, out, sig, sig if per else None, tau)
-    ls = np.log(sig) - 0.5 * (sig / SIGMA_PRIOR_SCALE) ** 2
-    lp += ls[None, :, None, None] + (ls[None, None, :, None] if per else 0.0)
-    lp += (np.log(tau) - 0.5 * (tau / TAU_PRIOR_SCALE) ** 2)[None, None, None, :]
     # kappa log-uniform on a grid uniform in ln kappa: flat weights per row
-    lp -= lp.max()
-    w = np.exp(lp)
-    w /= w.sum()
-    wrow = w.sum(axis=(1, 2, 3))
+    w, wrow = _grid_weights(_grid_loglik(shots, out, sig, sig if per else None, tau), sig, per, tau)
     q = _weighted_quantiles(kg, wrow)
     dlk = float(np.log(_K_GRID[1] / _K_GRID[0]))
     lo, hi = np.log(KAPPA_PRIOR)
@@ -525,6 +518,18 @@ def _grid_posterior_nose(shots: RegimeShots, opt: Options) -> dict:
         res["b_at_grid_edge"] = bool(wrow[bg >= _B_GRID_N[-2]].sum() > 0.05)
     res["e_at_grid_edge"] = bool(wrow[eg >= _E_GRID_N[-2]].sum() > 0.05)
     return res
+
+
+def _grid_weights(lp, sig, per: bool, tau):
+    """(joint weights, row weights) of a grid log-likelihood ``lp`` (rows, n_sigma_r, n_sigma_d,
+    n_tau) with the half-normal priors of sigma and tau; the grids are uniform in ln sigma and ln
+    tau, hence + ln sigma + ln tau (the Jacobian)."""
+    ls = np.log(sig) - 0.5 * (sig / SIGMA_PRIOR_SCALE) ** 2
+    lp = lp + ls[None, :, None, None] + (ls[None, None, :, None] if per else 0.0)
+    lp = lp + (np.log(tau) - 0.5 * (tau / TAU_PRIOR_SCALE) ** 2)[None, None, None, :]
+    w = np.exp(lp - lp.max())
+    w /= w.sum()
+    return w, w.sum(axis=(1, 2, 3))
 
 
 def grid_posterior(shots: RegimeShots, opt: Options) -> dict:
@@ -542,15 +547,7 @@ def grid_posterior(shots: RegimeShots, opt: Options) -> dict:
     per = opt.discrepancy == "per_regime"
     sig = _SIGMA_GRID_2 if per else _SIGMA_GRID
     tau = _TAU_GRID
-    lp = _grid_loglik(shots, out, sig, sig if per else None, tau)
-    # half-normal priors; the grids are uniform in ln sigma and ln tau: + ln sigma + ln tau (Jacobian)
-    ls = np.log(sig) - 0.5 * (sig / SIGMA_PRIOR_SCALE) ** 2
-    lp += ls[None, :, None, None] + (ls[None, None, :, None] if per else 0.0)
-    lp += (np.log(tau) - 0.5 * (tau / TAU_PRIOR_SCALE) ** 2)[None, None, None, :]
-    lp -= lp.max()
-    w = np.exp(lp)
-    w /= w.sum()
-    wrow = w.sum(axis=(1, 2, 3))
+    w, wrow = _grid_weights(_grid_loglik(shots, out, sig, sig if per else None, tau), sig, per, tau)
     fgrid = _F_GRID_2D if bg is not None else _F_GRID
     wf = wrow.reshape(len(fgrid), -1).sum(axis=1)
     cdf = np.cumsum(wf)

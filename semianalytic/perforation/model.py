@@ -25,7 +25,7 @@ f_k the back-face factor below.  All layers are folded into one coefficient obje
 
 Back face (the resistance falls as the plastic zone reaches it), ``back_face``:
 
-* ``"finite-sphere"`` (default): the quasi-static pressure to expand a spherical cavity of
+* ``"finite-sphere"``: the quasi-static pressure to expand a spherical cavity of
   radius a in an incompressible elastic-perfectly plastic sphere of finite outer radius b
   (Hill 1950, *The Mathematical Theory of Plasticity*, ch. V, sec. 3: the thick spherical
   shell; partly plastic p = 2Y ln(c/a) + (2Y/3)(1 - c^3/b^3), fully plastic p = 2Y ln(b/a),

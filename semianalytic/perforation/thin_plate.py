@@ -84,7 +84,7 @@ def cylindrical_cavity_stress(yield_stress: float, youngs_modulus: float) -> flo
     Y, E = float(yield_stress), float(youngs_modulus)
     if not (Y > 0 and E > math.sqrt(3.0) * Y):
         raise ValueError("the cylindrical cavity needs 0 < sqrt(3) Y < E")
-    return Y / math.sqrt(3.0) * (1.0 + math.log(E / (math.sqrt(3.0) * Y)))
+    return von_mises_shear_strength(Y) * (1.0 + math.log(E / (math.sqrt(3.0) * Y)))
 
 
 def hole_enlargement_work(radius: float, thickness: float, stress: float) -> float:
@@ -103,6 +103,12 @@ def energy_residual(Vs, V_bl: float):
     that loses a fixed work; Lambert & Jonas with a = 1, p = 2)."""
     Vs = np.asarray(Vs, float)
     return np.sqrt(np.maximum(Vs * Vs - V_bl * V_bl, 0.0))[()]
+
+
+def von_mises_shear_strength(yield_stress: float) -> float:
+    """tau = Y / sqrt 3 [Pa]: the shear yield stress of a von Mises material of tensile yield Y
+    (the plug's shear strength where the case gives none)."""
+    return float(yield_stress) / math.sqrt(3.0)
 
 
 def plugging_work(diameter: float, thickness: float, shear_strength: float) -> float:

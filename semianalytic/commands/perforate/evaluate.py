@@ -262,7 +262,7 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
                 if Y is None:
                     raise InputError("perforation.shear_strength", "missing: the plug criterion needs the target's shear "
                                      "strength (e.g. '230 MPa') or a resistance model with a yield stress")
-                tau = float(Y) / math.sqrt(3.0)
+                tau = tp.von_mises_shear_strength(Y)
             layer_back = "plug"
         elif back in ("finite-sphere", "cylindrical", "sphere-to-cylinder") and not has_YE:
             if opts.back_face != "auto":
@@ -287,7 +287,7 @@ def perforation_setup(case, cache_dir=None, shift: str | None = None) -> Perfora
                                  "[1 + ln(E/(sqrt 3 Y))] (Forrestal, Rosenberg, Luk & Bless 1987) to the exit")
                 layer_back = "cylindrical"
             else:
-                ratio = (2.0 * E / (3.0 * Y)) ** (1.0 / 3.0)
+                ratio = tp.spherical_plastic_radius(1.0, float(Y), float(E))  # c / a
                 if layer_back == "sphere-to-cylinder":
                     floor = sigma_s
         modes.append({"layer": k, "failure_mode": mode, "reason": why, "back_face": layer_back})
@@ -618,7 +618,7 @@ def back_face_study(case, cache_dir=None) -> dict | None:
         from semianalytic.perforation import thin_plate as tp
 
         d, H, m = shot.projectile_diameter, shot.thickness, shot.projectile_mass
-        row["recht-ipson"] = tp.plugging_limit(m, d, H, Y / math.sqrt(3.0), shot.target_density)
+        row["recht-ipson"] = tp.plugging_limit(m, d, H, tp.von_mises_shear_strength(Y), shot.target_density)
         row["hole (quasi-static)"] = tp.hole_enlargement_limit(m, 0.5 * d, H, tp.cylindrical_cavity_stress(Y, E))
         for bf in STUDY_BACK_FACES:
             raw = copy.deepcopy(dict(case.raw))
